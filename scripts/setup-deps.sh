@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages subscan needs to build, test and run (DESIGN.md §10).
+# Idempotent: when everything is present it only asks dpkg and returns in well under a second.
+set -euo pipefail
+
+packages=(
+    # build
+    cmake g++ ninja-build pkg-config
+    # fuzzing (scripts/fuzz.sh): clang with its libFuzzer/sanitizer runtimes
+    clang libclang-rt-14-dev
+    # GL: loader, EGL headers, Mesa's software rasterizer for GPU-less machines
+    libepoxy-dev libegl-dev libgl1-mesa-dri libegl-mesa0
+    # viewer
+    libglfw3-dev libimgui-dev xvfb xauth
+    # libraries
+    libglm-dev libstb-dev libcli11-dev libfmt-dev nlohmann-json3-dev libfast-float-dev
+    liblzf-dev libnanoflann-dev libeigen3-dev
+    # tests and benchmarks
+    libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+# One dpkg-query for all packages; those it does not report as installed are missing.
+installed=$(dpkg-query -W -f='${Package} ${Status}\n' "${packages[@]}" 2>/dev/null |
+    awk '$4 == "installed" { print $1 }' || true)
+missing=()
+for package in "${packages[@]}"; do
+    grep -qx "$package" <<<"$installed" || missing+=("$package")
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+echo "setup-deps: installing ${missing[*]}" >&2
+sudo=()
+if [[ $(id -u) -ne 0 ]]; then
+    command -v sudo >/dev/null || { echo "setup-deps: not root and no sudo; install as root: ${missing[*]}" >&2; exit 1; }
+    sudo=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo[@]}" apt-get update -qq
+"${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2

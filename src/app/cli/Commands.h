@@ -1,0 +1,22 @@
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace subscan::cli {
+
+/// A subcommand as registered on the top-level app: its CLI11 node and what runs it once
+/// parsed (returning the exit code). The options live in the closure.
+struct Command {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+
+Command addInfoCommand(CLI::App& parent);
+
+/// Parses the command line and runs the chosen subcommand. Exit codes: 0 success, 1 an error
+/// with the input or the machine (one sentence on stderr), 2 bad command-line usage.
+int run(int argc, char** argv);
+
+}  // namespace subscan::cli

@@ -1,0 +1,77 @@
+#include "core/PointCloud.h"
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+
+namespace subscan {
+
+PointCloudBuilder::PointCloudBuilder(PointAttributes attributes, std::size_t expectedPoints,
+                                     bool mapVertexIndices)
+    : attributes_(attributes), mapVertexIndices_(mapVertexIndices) {
+    cloud_.positions.reserve(expectedPoints);
+    if (attributes_.color) {
+        cloud_.colors.reserve(expectedPoints);
+    }
+    if (attributes_.normal) {
+        cloud_.normals.reserve(expectedPoints);
+    }
+    if (attributes_.intensity) {
+        cloud_.intensities.reserve(expectedPoints);
+    }
+}
+
+void PointCloudBuilder::dropVertex() {
+    if (mapVertexIndices_) {
+        if (droppedPoints_ == 0) {
+            vertexRemap_.resize(cloud_.positions.size());
+            for (std::size_t i = 0; i < vertexRemap_.size(); ++i) {
+                vertexRemap_[i] = static_cast<std::uint32_t>(i);
+            }
+        }
+        vertexRemap_.push_back(kInvalidIndex);
+    }
+    ++droppedPoints_;
+}
+
+PointCloud PointCloudBuilder::finish(std::vector<std::string>& warnings) {
+    const std::size_t total = validPoints() + droppedPoints_;
+    if (validPoints() == 0) {
+        if (total == 0) {
+            throw Error("it contains no points");
+        }
+        throw Error(fmt::format("all {} points have NaN or infinite coordinates", total));
+    }
+    if (droppedPoints_ > 0) {
+        warnings.push_back(fmt::format("dropped {} of {} points with NaN or infinite coordinates",
+                                       droppedPoints_, total));
+    }
+
+    if (!vertexRemap_.empty()) {
+        std::size_t kept = 0;
+        for (const Triangle& t : cloud_.triangles) {
+            const Triangle mapped{vertexRemap_[t[0]], vertexRemap_[t[1]], vertexRemap_[t[2]]};
+            if (mapped[0] != kInvalidIndex && mapped[1] != kInvalidIndex &&
+                mapped[2] != kInvalidIndex) {
+                cloud_.triangles[kept++] = mapped;
+            }
+        }
+        if (kept < cloud_.triangles.size()) {
+            warnings.push_back(fmt::format("dropped {} faces that used a dropped vertex",
+                                           cloud_.triangles.size() - kept));
+        }
+        cloud_.triangles.resize(kept);
+    }
+
+    // Re-centre on the middle of the bounds: floats then carry the least magnitude, hence the
+    // finest steps. The shift is computed in double and applied once.
+    const glm::dvec3 newOrigin = cloud_.bounds.center();
+    const glm::dvec3 shift = cloud_.origin - newOrigin;
+    for (glm::vec3& p : cloud_.positions) {
+        p = glm::vec3(glm::dvec3(p) + shift);
+    }
+    cloud_.origin = newOrigin;
+    return std::move(cloud_);
+}
+
+}  // namespace subscan

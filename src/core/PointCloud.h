@@ -1,0 +1,134 @@
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
+
+namespace subscan {
+
+/// 8-bit sRGB-encoded colour as scanners store it; alpha is 255 unless the file says otherwise.
+struct Rgba8 {
+    std::uint8_t r = 0, g = 0, b = 0, a = 255;
+    friend bool operator==(const Rgba8&, const Rgba8&) = default;
+};
+static_assert(sizeof(Rgba8) == 4, "uploaded to the GPU as one uint32 per point");
+
+using Triangle = std::array<std::uint32_t, 3>;
+
+/// Points are addressed by 32-bit indices on the GPU; one value is reserved as "no point".
+inline constexpr std::uint64_t kMaxPoints = 0xFFFFFFFEu;
+inline constexpr std::uint32_t kInvalidIndex = 0xFFFFFFFFu;
+
+/// Axis-aligned box in the file's own coordinates (double: UTM and ECEF coordinates need it).
+struct Bounds {
+    glm::dvec3 min{std::numeric_limits<double>::infinity()};
+    glm::dvec3 max{-std::numeric_limits<double>::infinity()};
+
+    bool empty() const { return !(min.x <= max.x); }
+    glm::dvec3 center() const { return 0.5 * (min + max); }
+    glm::dvec3 extent() const { return max - min; }
+    void add(const glm::dvec3& p) {
+        min = glm::min(min, p);
+        max = glm::max(max, p);
+    }
+};
+
+/// A point cloud in memory, one array per attribute (structure of arrays).
+///
+/// Positions are floats relative to `origin`, a double offset near the centre of the cloud, so
+/// a scan in UTM coordinates keeps millimetre precision: file coordinate = origin + position.
+/// Optional attributes are either empty or exactly one entry per point.
+struct PointCloud {
+    glm::dvec3 origin{0.0};
+    std::vector<glm::vec3> positions;
+    std::vector<Rgba8> colors;          // sRGB-encoded
+    std::vector<glm::vec3> normals;     // unit length where the file had them
+    std::vector<float> intensities;     // as stored in the file (no normalisation)
+    std::vector<Triangle> triangles;    // vertex indices; ground-truth meshes only
+    Bounds bounds;                      // exact, in file coordinates
+
+    std::size_t size() const { return positions.size(); }
+    bool hasColors() const { return !colors.empty(); }
+    bool hasNormals() const { return !normals.empty(); }
+    bool hasIntensities() const { return !intensities.empty(); }
+    glm::dvec3 fileCoordinates(std::size_t i) const { return origin + glm::dvec3(positions[i]); }
+};
+
+/// Which optional attributes a reader will provide for every point.
+struct PointAttributes {
+    bool color = false;
+    bool normal = false;
+    bool intensity = false;
+};
+
+/// One decoded point as a reader produces it; attributes not announced to the builder are ignored.
+struct PointRecord {
+    glm::dvec3 position{0.0};
+    Rgba8 color;
+    glm::vec3 normal{0.0f};
+    float intensity = 0.0f;
+};
+
+/// Collects points from a reader: drops points with NaN/Inf coordinates (counting them), tracks
+/// exact double bounds and stores float positions relative to the first valid point; finish()
+/// then re-centres them on the middle of the bounds.
+class PointCloudBuilder {
+public:
+    /// `mapVertexIndices`: the file has faces, so remember which file vertex became which point.
+    PointCloudBuilder(PointAttributes attributes, std::size_t expectedPoints,
+                      bool mapVertexIndices = false);
+
+    void add(const PointRecord& point) {
+        const glm::dvec3& p = point.position;
+        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) {
+            dropVertex();
+            return;
+        }
+        if (cloud_.positions.empty()) {
+            cloud_.origin = p;
+        }
+        if (mapVertexIndices_ && droppedPoints_ > 0) {
+            vertexRemap_.push_back(static_cast<std::uint32_t>(cloud_.positions.size()));
+        }
+        cloud_.bounds.add(p);
+        cloud_.positions.emplace_back(p - cloud_.origin);
+        if (attributes_.color) {
+            cloud_.colors.push_back(point.color);
+        }
+        if (attributes_.normal) {
+            cloud_.normals.push_back(point.normal);
+        }
+        if (attributes_.intensity) {
+            cloud_.intensities.push_back(point.intensity);
+        }
+    }
+
+    /// Triangles use the file's vertex numbering; finish() maps them past dropped vertices and
+    /// drops triangles that touched one.
+    void addTriangle(const Triangle& t) { cloud_.triangles.push_back(t); }
+
+    std::size_t validPoints() const { return cloud_.positions.size(); }
+    std::size_t droppedPoints() const { return droppedPoints_; }
+
+    /// Throws subscan::Error when no valid point is left; warns (through `warnings`) about drops.
+    PointCloud finish(std::vector<std::string>& warnings);
+
+private:
+    void dropVertex();
+
+    PointAttributes attributes_;
+    bool mapVertexIndices_;
+    PointCloud cloud_;
+    std::size_t droppedPoints_ = 0;
+    // File vertex index -> kept index (kInvalidIndex when dropped); filled only for files with
+    // faces and only once a drop happened, so clean files pay nothing.
+    std::vector<std::uint32_t> vertexRemap_;
+};
+
+}  // namespace subscan

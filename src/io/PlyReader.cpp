@@ -1,0 +1,632 @@
+#include "io/PlyReader.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+#include "io/ByteOrder.h"
+#include "io/TextParsing.h"
+
+namespace subscan {
+
+namespace {
+
+enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
+enum class PlyType : std::uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+
+struct PlyProperty {
+    std::string name;
+    PlyType type = PlyType::Float32;  // the item type for lists
+    bool isList = false;
+    PlyType countType = PlyType::UInt8;
+};
+
+struct PlyElement {
+    std::string name;
+    std::uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+
+    /// Byte size of one item when it has no lists, else nullopt.
+    std::optional<std::size_t> fixedStride() const;
+    std::optional<std::size_t> find(std::string_view propertyName) const {
+        for (std::size_t i = 0; i < properties.size(); ++i) {
+            if (properties[i].name == propertyName) {
+                return i;
+            }
+        }
+        return std::nullopt;
+    }
+};
+
+struct PlyHeader {
+    PlyEncoding encoding = PlyEncoding::Ascii;
+    std::string version;
+    std::vector<PlyElement> elements;
+    std::size_t bodyOffset = 0;
+};
+
+std::size_t sizeOf(PlyType type) {
+    switch (type) {
+        case PlyType::Int8:
+        case PlyType::UInt8:
+            return 1;
+        case PlyType::Int16:
+        case PlyType::UInt16:
+            return 2;
+        case PlyType::Int32:
+        case PlyType::UInt32:
+        case PlyType::Float32:
+            return 4;
+        case PlyType::Float64:
+            return 8;
+    }
+    return 0;
+}
+
+bool isInteger(PlyType type) { return type != PlyType::Float32 && type != PlyType::Float64; }
+
+std::optional<PlyType> parseType(std::string_view name) {
+    static constexpr std::array<std::pair<std::string_view, PlyType>, 16> kNames{{
+        {"char", PlyType::Int8},     {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
+        {"uint8", PlyType::UInt8},   {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+        {"ushort", PlyType::UInt16}, {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
+        {"int32", PlyType::Int32},   {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
+        {"float", PlyType::Float32}, {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+        {"float64", PlyType::Float64},
+    }};
+    for (const auto& [typeName, type] : kNames) {
+        if (typeName == name) {
+            return type;
+        }
+    }
+    return std::nullopt;
+}
+
+std::optional<std::size_t> PlyElement::fixedStride() const {
+    std::size_t stride = 0;
+    for (const PlyProperty& property : properties) {
+        if (property.isList) {
+            return std::nullopt;
+        }
+        stride += sizeOf(property.type);
+    }
+    return stride;
+}
+
+/// Reads the header up to and including the `end_header` line.
+PlyHeader parseHeader(std::string_view file) {
+    PlyHeader header;
+    std::size_t position = 0;
+    int lineNumber = 0;
+    bool sawFormat = false;
+    auto nextLine = [&]() -> std::optional<std::string_view> {
+        if (position >= file.size()) {
+            return std::nullopt;
+        }
+        std::size_t end = file.find('\n', position);
+        if (end == std::string_view::npos) {
+            return std::nullopt;  // the header must end with a newline after end_header
+        }
+        std::string_view line = file.substr(position, end - position);
+        position = end + 1;
+        ++lineNumber;
+        if (!line.empty() && line.back() == '\r') {
+            line.remove_suffix(1);
+        }
+        return line;
+    };
+
+    const auto magic = nextLine();
+    if (!magic || *magic != "ply") {
+        throw Error("it does not start with the PLY magic line 'ply'");
+    }
+    while (true) {
+        const auto line = nextLine();
+        if (!line) {
+            throw Error("the PLY header has no 'end_header' line (file truncated?)");
+        }
+        const std::vector<std::string_view> words = splitWords(*line);
+        if (words.empty()) {
+            continue;
+        }
+        const std::string_view keyword = words[0];
+        auto fail = [&](std::string_view what) {
+            throw Error(fmt::format("PLY header line {} {} {}", lineNumber,
+                                    quoteForMessage(*line, 60), what));
+        };
+        if (keyword == "end_header") {
+            break;
+        }
+        // Stanford's range scans carry 'obj_info' and stray 'bye' lines; both say nothing
+        // about the layout, like comments.
+        if (keyword == "comment" || keyword == "obj_info" || keyword == "bye") {
+            continue;
+        }
+        if (keyword == "format") {
+            if (words.size() != 3) {
+                fail("should read 'format <encoding> 1.0'");
+            }
+            if (words[1] == "ascii") {
+                header.encoding = PlyEncoding::Ascii;
+            } else if (words[1] == "binary_little_endian") {
+                header.encoding = PlyEncoding::BinaryLittleEndian;
+            } else if (words[1] == "binary_big_endian") {
+                header.encoding = PlyEncoding::BinaryBigEndian;
+            } else {
+                fail("names an unknown encoding (expected ascii, binary_little_endian or "
+                     "binary_big_endian)");
+            }
+            header.version = std::string(words[2]);
+            sawFormat = true;
+        } else if (keyword == "element") {
+            if (words.size() != 3) {
+                fail("should read 'element <name> <count>'");
+            }
+            PlyElement element;
+            element.name = std::string(words[1]);
+            const auto [end, ec] =
+                std::from_chars(words[2].data(), words[2].data() + words[2].size(), element.count);
+            if (ec != std::errc() || end != words[2].data() + words[2].size()) {
+                fail("has an element count that is not a non-negative integer");
+            }
+            header.elements.push_back(std::move(element));
+        } else if (keyword == "property") {
+            if (header.elements.empty()) {
+                fail("declares a property before any element");
+            }
+            PlyProperty property;
+            if (words.size() >= 2 && words[1] == "list") {
+                if (words.size() != 5) {
+                    fail("should read 'property list <count type> <item type> <name>'");
+                }
+                const auto countType = parseType(words[2]);
+                const auto itemType = parseType(words[3]);
+                if (!countType || !itemType) {
+                    fail("uses an unknown property type");
+                }
+                if (!isInteger(*countType)) {
+                    fail("has a list count type that is not an integer type");
+                }
+                property.isList = true;
+                property.countType = *countType;
+                property.type = *itemType;
+                property.name = std::string(words[4]);
+            } else {
+                if (words.size() != 3) {
+                    fail("should read 'property <type> <name>'");
+                }
+                const auto type = parseType(words[1]);
+                if (!type) {
+                    fail("uses an unknown property type");
+                }
+                property.type = *type;
+                property.name = std::string(words[2]);
+            }
+            header.elements.back().properties.push_back(std::move(property));
+        } else {
+            fail("is not a PLY header keyword");
+        }
+    }
+    if (!sawFormat) {
+        throw Error("the PLY header has no 'format' line");
+    }
+    header.bodyOffset = position;
+    return header;
+}
+
+/// Which vertex properties hold what we keep; indices into PlyElement::properties.
+struct VertexLayout {
+    std::array<std::size_t, 3> position{};
+    std::optional<std::array<std::size_t, 3>> color;
+    std::optional<std::size_t> alpha;
+    std::optional<std::array<std::size_t, 3>> normal;
+    std::optional<std::size_t> intensity;
+};
+
+VertexLayout findVertexLayout(const PlyElement& vertex) {
+    auto scalar = [&](std::string_view name) -> std::optional<std::size_t> {
+        const auto index = vertex.find(name);
+        if (index && vertex.properties[*index].isList) {
+            throw Error(fmt::format("the PLY vertex property '{}' is declared as a list, but it "
+                                    "must be a single value",
+                                    name));
+        }
+        return index;
+    };
+    auto triple = [&](std::string_view a, std::string_view b,
+                      std::string_view c) -> std::optional<std::array<std::size_t, 3>> {
+        const auto ia = scalar(a), ib = scalar(b), ic = scalar(c);
+        if (ia && ib && ic) {
+            return std::array<std::size_t, 3>{*ia, *ib, *ic};
+        }
+        return std::nullopt;
+    };
+
+    VertexLayout layout;
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::string_view name = std::array{"x", "y", "z"}[axis];
+        const auto index = scalar(name);
+        if (!index) {
+            throw Error(fmt::format("the PLY vertex element has no '{}' property", name));
+        }
+        layout.position[axis] = *index;
+    }
+    layout.color = triple("red", "green", "blue");
+    layout.alpha = scalar("alpha");
+    if (!layout.color) {
+        layout.color = triple("diffuse_red", "diffuse_green", "diffuse_blue");
+        layout.alpha = scalar("diffuse_alpha");
+    }
+    layout.normal = triple("nx", "ny", "nz");
+    layout.intensity = scalar("intensity");
+    if (!layout.intensity) {
+        layout.intensity = scalar("scalar_intensity");
+    }
+    return layout;
+}
+
+/// Colour channels: 8-bit as is, 16-bit scaled down, floats taken as 0..1.
+std::uint8_t toColorChannel(double value, PlyType type) {
+    double scaled = value;
+    if (type == PlyType::UInt16 || type == PlyType::Int16) {
+        scaled = value / 257.0;
+    } else if (!isInteger(type)) {
+        scaled = value * 255.0;
+    }
+    if (!(scaled > 0.0)) {
+        return 0;  // also NaN
+    }
+    return static_cast<std::uint8_t>(std::min(255.0, scaled + 0.5));
+}
+
+constexpr std::string_view kFaceListNames[] = {"vertex_indices", "vertex_index"};
+
+std::optional<std::size_t> findFaceList(const PlyElement& face) {
+    for (std::string_view name : kFaceListNames) {
+        if (const auto index = face.find(name); index && face.properties[*index].isList) {
+            return index;
+        }
+    }
+    return std::nullopt;
+}
+
+/// Decodes the body: binary (either byte order) and ascii share everything but value access.
+class PlyBodyReader {
+public:
+    PlyBodyReader(const PlyHeader& header, std::span<const std::byte> file, ReadContext& context)
+        : header_(header), file_(file), context_(context) {}
+
+    PointCloud read();
+
+private:
+    // The decoded values of one item.
+    struct ItemValues {
+        std::vector<double> scalar;                 // per property (scalars only)
+        std::vector<std::uint32_t> faceIndices;     // the face list, when reading faces
+    };
+
+    bool binary() const { return header_.encoding != PlyEncoding::Ascii; }
+    double loadBinary(PlyType type, const std::byte* p) const;
+    void readItem(const PlyElement& element, std::uint64_t itemIndex,
+                  std::optional<std::size_t> faceList, ItemValues& values);
+    void skipElement(const PlyElement& element);
+    [[noreturn]] void failTruncated(const PlyElement& element, std::uint64_t itemIndex) const;
+    double nextAsciiNumber(const PlyElement& element, std::uint64_t itemIndex);
+
+    const PlyHeader& header_;
+    std::span<const std::byte> file_;
+    ReadContext& context_;
+    std::size_t position_ = 0;
+};
+
+double PlyBodyReader::loadBinary(PlyType type, const std::byte* p) const {
+    const bool big = header_.encoding == PlyEncoding::BinaryBigEndian;
+    auto load = [&]<class T>(T) -> double {
+        return static_cast<double>(big ? loadBigEndian<T>(p) : loadLittleEndian<T>(p));
+    };
+    switch (type) {
+        case PlyType::Int8:
+            return load(std::int8_t{});
+        case PlyType::UInt8:
+            return load(std::uint8_t{});
+        case PlyType::Int16:
+            return load(std::int16_t{});
+        case PlyType::UInt16:
+            return load(std::uint16_t{});
+        case PlyType::Int32:
+            return load(std::int32_t{});
+        case PlyType::UInt32:
+            return load(std::uint32_t{});
+        case PlyType::Float32:
+            return load(float{});
+        case PlyType::Float64:
+            return load(double{});
+    }
+    return 0.0;
+}
+
+void PlyBodyReader::failTruncated(const PlyElement& element, std::uint64_t itemIndex) const {
+    throw Error(fmt::format("the PLY body ends inside {} {} of {} declared in the header (file "
+                            "truncated, or the count is wrong)",
+                            element.name, itemIndex + 1, element.count));
+}
+
+double PlyBodyReader::nextAsciiNumber(const PlyElement& element, std::uint64_t itemIndex) {
+    const char* text = reinterpret_cast<const char*>(file_.data());
+    const std::size_t size = file_.size();
+    while (position_ < size && isWhitespace(text[position_])) {
+        ++position_;
+    }
+    if (position_ >= size) {
+        failTruncated(element, itemIndex);
+    }
+    double value = 0.0;
+    const char* end = parseNumber(text + position_, text + size, value);
+    if (end == nullptr || (end < text + size && !isWhitespace(*end))) {
+        std::size_t tokenEnd = position_;
+        while (tokenEnd < size && !isWhitespace(text[tokenEnd])) {
+            ++tokenEnd;
+        }
+        throw Error(fmt::format("the PLY body has the non-numeric value {} in {} {}",
+                                quoteForMessage({text + position_, tokenEnd - position_}),
+                                element.name, itemIndex + 1));
+    }
+    position_ = static_cast<std::size_t>(end - text);
+    return value;
+}
+
+/// Reads one item: scalars into values.scalar, the face list (if asked) into values.faceIndices;
+/// every other list is skipped.
+void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
+                             std::optional<std::size_t> faceList, ItemValues& values) {
+    values.faceIndices.clear();
+    for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& property = element.properties[p];
+        if (!property.isList) {
+            if (binary()) {
+                const std::size_t size = sizeOf(property.type);
+                if (file_.size() - position_ < size) {
+                    failTruncated(element, itemIndex);
+                }
+                values.scalar[p] = loadBinary(property.type, file_.data() + position_);
+                position_ += size;
+            } else {
+                values.scalar[p] = nextAsciiNumber(element, itemIndex);
+            }
+            continue;
+        }
+        double countValue = 0.0;
+        if (binary()) {
+            const std::size_t size = sizeOf(property.countType);
+            if (file_.size() - position_ < size) {
+                failTruncated(element, itemIndex);
+            }
+            countValue = loadBinary(property.countType, file_.data() + position_);
+            position_ += size;
+        } else {
+            countValue = nextAsciiNumber(element, itemIndex);
+        }
+        if (!(countValue >= 0.0 && countValue == std::floor(countValue))) {
+            throw Error(fmt::format("the PLY body has the invalid list length {} in {} {}",
+                                    countValue, element.name, itemIndex + 1));
+        }
+        const auto count = static_cast<std::uint64_t>(countValue);
+        const bool keep = faceList && *faceList == p;
+        if (binary()) {
+            const std::size_t itemSize = sizeOf(property.type);
+            if (count > (file_.size() - position_) / itemSize) {
+                failTruncated(element, itemIndex);
+            }
+            if (keep) {
+                for (std::uint64_t i = 0; i < count; ++i) {
+                    const double index = loadBinary(property.type, file_.data() + position_);
+                    values.faceIndices.push_back(
+                        index >= 0.0 && index < 4294967295.0 ? static_cast<std::uint32_t>(index)
+                                                             : kInvalidIndex);
+                    position_ += itemSize;
+                }
+            } else {
+                position_ += static_cast<std::size_t>(count) * itemSize;
+            }
+        } else {
+            for (std::uint64_t i = 0; i < count; ++i) {
+                const double index = nextAsciiNumber(element, itemIndex);
+                if (keep) {
+                    values.faceIndices.push_back(
+                        index >= 0.0 && index < 4294967295.0 && index == std::floor(index)
+                            ? static_cast<std::uint32_t>(index)
+                            : kInvalidIndex);
+                }
+            }
+        }
+    }
+}
+
+void PlyBodyReader::skipElement(const PlyElement& element) {
+    if (element.properties.empty()) {
+        return;  // items without properties occupy no bytes, however many are declared
+    }
+    if (const auto stride = element.fixedStride(); binary() && stride) {
+        const std::size_t remaining = file_.size() - position_;
+        if (*stride > 0 && element.count > remaining / *stride) {
+            failTruncated(element, remaining / *stride);
+        }
+        position_ += static_cast<std::size_t>(element.count) * *stride;
+        return;
+    }
+    ItemValues values;
+    values.scalar.resize(element.properties.size());
+    for (std::uint64_t i = 0; i < element.count; ++i) {
+        readItem(element, i, std::nullopt, values);
+    }
+}
+
+PointCloud PlyBodyReader::read() {
+    const PlyElement* vertex = nullptr;
+    const PlyElement* face = nullptr;
+    std::size_t lastNeeded = 0;
+    for (std::size_t e = 0; e < header_.elements.size(); ++e) {
+        const PlyElement& element = header_.elements[e];
+        if (element.name == "vertex" && vertex == nullptr) {
+            vertex = &element;
+            lastNeeded = e;
+        } else if (element.name == "face" && face == nullptr) {
+            face = &element;
+            lastNeeded = e;
+        }
+    }
+    if (vertex == nullptr) {
+        throw Error("the PLY file has no 'vertex' element");
+    }
+    if (vertex->count > kMaxPoints) {
+        throw Error(fmt::format("the PLY header declares {} vertices, more than the {} points "
+                                "subscan can hold",
+                                vertex->count, kMaxPoints));
+    }
+    const VertexLayout layout = findVertexLayout(*vertex);
+    std::optional<std::size_t> faceList;
+    if (face != nullptr) {
+        faceList = findFaceList(*face);
+        if (!faceList) {
+            context_.warnings.push_back(
+                "the PLY face element has no vertex_indices list; faces ignored");
+            face = nullptr;
+        }
+    }
+
+    // Never reserve more than the body could hold: a lying header must not allocate gigabytes.
+    const std::size_t body = file_.size() - position_;
+    const std::size_t minimumVertexBytes =
+        binary() ? std::max<std::size_t>(1, vertex->fixedStride().value_or(1))
+                 : 2 * vertex->properties.size();
+    const std::size_t expected =
+        static_cast<std::size_t>(std::min<std::uint64_t>(vertex->count, body / minimumVertexBytes));
+
+    PointAttributes attributes;
+    attributes.color = layout.color.has_value();
+    attributes.normal = layout.normal.has_value();
+    attributes.intensity = layout.intensity.has_value();
+    PointCloudBuilder builder(attributes, expected, face != nullptr);
+
+    const auto colorType = [&](std::size_t index) { return vertex->properties[index].type; };
+    auto makeRecord = [&](auto&& value) {
+        PointRecord record;
+        record.position = {value(layout.position[0]), value(layout.position[1]),
+                           value(layout.position[2])};
+        if (layout.color) {
+            const auto& c = *layout.color;
+            record.color = {toColorChannel(value(c[0]), colorType(c[0])),
+                            toColorChannel(value(c[1]), colorType(c[1])),
+                            toColorChannel(value(c[2]), colorType(c[2])),
+                            layout.alpha ? toColorChannel(value(*layout.alpha),
+                                                          colorType(*layout.alpha))
+                                         : std::uint8_t{255}};
+        }
+        if (layout.normal) {
+            const auto& n = *layout.normal;
+            record.normal = {static_cast<float>(value(n[0])), static_cast<float>(value(n[1])),
+                             static_cast<float>(value(n[2]))};
+        }
+        if (layout.intensity) {
+            record.intensity = static_cast<float>(value(*layout.intensity));
+        }
+        return record;
+    };
+    constexpr std::uint64_t kProgressEvery = 1 << 16;
+
+    for (std::size_t e = 0; e <= lastNeeded; ++e) {
+        const PlyElement& element = header_.elements[e];
+        if (&element == vertex) {
+            const auto stride = vertex->fixedStride();
+            if (binary() && stride) {
+                // Fast path: fixed-size records, one bounds check for the whole element.
+                const std::size_t available = (file_.size() - position_) / *stride;
+                if (vertex->count > available) {
+                    failTruncated(*vertex, available);
+                }
+                std::vector<std::size_t> offsets(vertex->properties.size());
+                for (std::size_t p = 1; p < offsets.size(); ++p) {
+                    offsets[p] = offsets[p - 1] + sizeOf(vertex->properties[p - 1].type);
+                }
+                for (std::uint64_t i = 0; i < vertex->count; ++i) {
+                    const std::byte* record = file_.data() + position_;
+                    builder.add(makeRecord([&](std::size_t p) {
+                        return loadBinary(vertex->properties[p].type, record + offsets[p]);
+                    }));
+                    position_ += *stride;
+                    if (i % kProgressEvery == 0) {
+                        context_.reportProgress(position_, file_.size());
+                    }
+                }
+            } else {
+                ItemValues values;
+                values.scalar.resize(vertex->properties.size());
+                for (std::uint64_t i = 0; i < vertex->count; ++i) {
+                    readItem(*vertex, i, std::nullopt, values);
+                    builder.add(makeRecord([&](std::size_t p) { return values.scalar[p]; }));
+                    if (i % kProgressEvery == 0) {
+                        context_.reportProgress(position_, file_.size());
+                    }
+                }
+            }
+        } else if (&element == face) {
+            ItemValues values;
+            values.scalar.resize(face->properties.size());
+            std::uint64_t skippedPolygons = 0;
+            for (std::uint64_t i = 0; i < face->count; ++i) {
+                readItem(*face, i, faceList, values);
+                const auto& indices = values.faceIndices;
+                for (const std::uint32_t index : indices) {
+                    if (index == kInvalidIndex || index >= vertex->count) {
+                        throw Error(fmt::format(
+                            "PLY face {} refers to a vertex index outside 0..{} (the file has {} "
+                            "vertices)",
+                            i + 1, vertex->count == 0 ? 0 : vertex->count - 1, vertex->count));
+                    }
+                }
+                if (indices.size() < 3) {
+                    ++skippedPolygons;
+                    continue;
+                }
+                for (std::size_t k = 1; k + 1 < indices.size(); ++k) {
+                    builder.addTriangle({indices[0], indices[k], indices[k + 1]});
+                }
+                if (i % kProgressEvery == 0) {
+                    context_.reportProgress(position_, file_.size());
+                }
+            }
+            if (skippedPolygons > 0) {
+                context_.warnings.push_back(fmt::format(
+                    "skipped {} PLY faces with fewer than 3 vertices", skippedPolygons));
+            }
+        } else {
+            skipElement(element);
+        }
+    }
+    context_.reportProgress(file_.size(), file_.size());
+    return builder.finish(context_.warnings);
+}
+
+}  // namespace
+
+PointCloud readPly(std::span<const std::byte> file, ReadContext& context) {
+    const std::string_view text(reinterpret_cast<const char*>(file.data()), file.size());
+    const PlyHeader header = parseHeader(text);
+    static constexpr std::array kEncodingNames{"ascii", "binary_little_endian",
+                                               "binary_big_endian"};
+    context.formatDetail = fmt::format("PLY {} {}", header.version,
+                                       kEncodingNames[static_cast<int>(header.encoding)]);
+    PlyBodyReader reader(header, file.subspan(header.bodyOffset), context);
+    return reader.read();
+}
+
+}  // namespace subscan

@@ -1,0 +1,26 @@
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace subscan {
+
+/// What a reader may report besides the cloud: progress for long loads, warnings about data it
+/// had to skip and a description of the variant it read. Errors are thrown as subscan::Error.
+struct ReadContext {
+    /// Called with the fraction done (0..1), at most every few megabytes; may be empty.
+    std::function<void(double)> progress;
+    std::vector<std::string> warnings;
+    /// Filled by the reader, e.g. "PLY 1.0 binary_little_endian" or "LAS 1.4, point format 7".
+    std::string formatDetail;
+
+    void reportProgress(std::size_t done, std::size_t total) const {
+        if (progress && total > 0) {
+            progress(static_cast<double>(done) / static_cast<double>(total));
+        }
+    }
+};
+
+}  // namespace subscan

@@ -1,0 +1,156 @@
+#include "io/ScanLoader.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+#include "io/LasReader.h"
+#include "io/MappedFile.h"
+#include "io/PcdReader.h"
+#include "io/PlyReader.h"
+#include "io/ReadContext.h"
+#include "io/XyzReader.h"
+#include "scan/SyntheticScenes.h"
+
+namespace subscan {
+
+namespace {
+
+constexpr std::string_view kSyntheticPrefix = "synthetic:";
+
+bool startsWith(std::span<const std::byte> file, std::string_view prefix) {
+    return file.size() >= prefix.size() &&
+           std::equal(prefix.begin(), prefix.end(), file.begin(),
+                      [](char c, std::byte b) { return static_cast<char>(b) == c; });
+}
+
+/// PCD headers start with comment lines and then VERSION (or FIELDS in old files).
+bool looksLikePcd(std::span<const std::byte> file) {
+    const std::string_view text(reinterpret_cast<const char*>(file.data()),
+                                std::min<std::size_t>(file.size(), 4096));
+    std::size_t position = 0;
+    while (position < text.size()) {
+        const std::size_t end = std::min(text.find('\n', position), text.size());
+        const std::string_view line = text.substr(position, end - position);
+        position = end + 1;
+        if (line.empty() || line.front() == '#') {
+            if (line.starts_with("# .PCD")) {
+                return true;
+            }
+            continue;
+        }
+        return line.starts_with("VERSION") || line.starts_with("FIELDS");
+    }
+    return false;
+}
+
+std::string lowerExtension(const std::filesystem::path& path) {
+    std::string extension = path.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return extension;
+}
+
+}  // namespace
+
+ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::path& path) {
+    if (startsWith(file, "ply\n") || startsWith(file, "ply\r\n")) {
+        return ScanFormat::Ply;
+    }
+    if (startsWith(file, "LASF")) {
+        return ScanFormat::Las;
+    }
+    if (startsWith(file, "ASTM-E57")) {
+        return ScanFormat::E57;
+    }
+    if (looksLikePcd(file)) {
+        return ScanFormat::Pcd;
+    }
+    // Content was not conclusive: the extension decides, and that reader explains what is wrong.
+    const std::string extension = lowerExtension(path);
+    if (extension == ".ply") {
+        return ScanFormat::Ply;
+    }
+    if (extension == ".las" || extension == ".laz") {
+        return ScanFormat::Las;
+    }
+    if (extension == ".pcd") {
+        return ScanFormat::Pcd;
+    }
+    if (extension == ".e57") {
+        return ScanFormat::E57;
+    }
+    if (extension == ".xyz" || extension == ".pts" || extension == ".txt" ||
+        extension == ".csv" || extension == ".asc") {
+        return ScanFormat::Xyz;
+    }
+    if (looksLikePointText(file)) {
+        return ScanFormat::Xyz;
+    }
+    return ScanFormat::Unknown;
+}
+
+LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
+                      const std::function<void(double)>& progress) {
+    if (file.empty()) {
+        throw Error("the file is empty");
+    }
+    ReadContext context;
+    context.progress = progress;
+    LoadedScan scan;
+    switch (format) {
+        case ScanFormat::Ply:
+            scan.format = "ply";
+            scan.cloud = readPly(file, context);
+            break;
+        case ScanFormat::Las:
+            scan.format = "las";
+            scan.cloud = readLas(file, context);
+            break;
+        case ScanFormat::Pcd:
+            scan.format = "pcd";
+            scan.cloud = readPcd(file, context);
+            break;
+        case ScanFormat::Xyz:
+            scan.format = "xyz";
+            scan.cloud = readXyz(file, context);
+            break;
+        case ScanFormat::E57:
+            throw Error("E57 files are not supported yet; convert the scan to PLY, LAS or PCD "
+                        "(e.g. with CloudCompare or PDAL)");
+        case ScanFormat::Unknown:
+            throw Error("its format is unknown: it is not PLY, LAS, PCD, E57 or a text list of "
+                        "coordinates");
+    }
+    scan.formatDetail = std::move(context.formatDetail);
+    scan.warnings = std::move(context.warnings);
+    return scan;
+}
+
+LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress) {
+    const auto start = std::chrono::steady_clock::now();
+    LoadedScan scan;
+    try {
+        if (source.starts_with(kSyntheticPrefix)) {
+            scan.cloud = makeSyntheticScene(source.substr(kSyntheticPrefix.size()));
+            scan.format = "synthetic";
+            scan.formatDetail = fmt::format("built-in scene {}", source);
+        } else {
+            const std::filesystem::path path{std::string(source)};
+            const MappedFile mapped(path);
+            scan = decodeScan(mapped.bytes(), detectFormat(mapped.bytes(), path), progress);
+        }
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", source, error.what()));
+    }
+    scan.loadMilliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count();
+    return scan;
+}
+
+}  // namespace subscan

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/PointCloud.h"
+
+namespace subscan {
+
+enum class ScanFormat { Ply, Las, Pcd, Xyz, E57, Unknown };
+
+/// Picks the reader: by content (magic bytes) first, by file extension second.
+ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::path& path);
+
+struct LoadedScan {
+    PointCloud cloud;
+    std::string format;        // "ply", "las", "pcd", "xyz" or "synthetic"
+    std::string formatDetail;  // e.g. "PLY 1.0 binary_little_endian"
+    std::vector<std::string> warnings;
+    double loadMilliseconds = 0.0;  // reading and decoding, nothing after
+};
+
+/// Loads a scan file, or builds a built-in scene for "synthetic:NAME[?points=N]".
+/// Throws subscan::Error with one sentence that names the source and the problem.
+/// `progress` (may be empty) receives the fraction done while a file is decoded.
+LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress = {});
+
+/// Decodes an in-memory file of a known format; what loadScan does after mapping the file.
+/// Errors are not prefixed with a file name.
+LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
+                      const std::function<void(double)>& progress = {});
+
+}  // namespace subscan

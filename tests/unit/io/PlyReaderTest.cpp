@@ -1,0 +1,258 @@
+#include <cmath>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::appendBytes;
+using test::decode;
+using test::decodeError;
+using ::testing::HasSubstr;
+
+/// Exact binary values are compared exactly: floats survive the float -> double -> float trip.
+void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, double z) {
+    const glm::dvec3 p = cloud.fileCoordinates(i);
+    // Positions are floats relative to the cloud centre; clouds here span < 10 units, so
+    // float steps near 10 bound the error (about 1e-6).
+    EXPECT_NEAR(p.x, x, 2e-6) << "point " << i;
+    EXPECT_NEAR(p.y, y, 2e-6) << "point " << i;
+    EXPECT_NEAR(p.z, z, 2e-6) << "point " << i;
+}
+
+std::string binaryHeader(const char* encoding, const std::string& body) {
+    return std::string("ply\nformat ") + encoding + " 1.0\n" + body + "end_header\n";
+}
+
+TEST(PlyReaderTest, AsciiPositionsAnyPropertyOrderWithColorNormalIntensity) {
+    const std::string file =
+        "ply\nformat ascii 1.0\ncomment made by hand\nobj_info scanner 42\n"
+        "element vertex 2\n"
+        "property float nx\nproperty uchar red\nproperty float z\nproperty float ny\n"
+        "property uchar green\nproperty double x\nproperty float nz\nproperty uchar blue\n"
+        "property float y\nproperty float intensity\n"
+        "end_header\n"
+        "0 10 3 1 20 1 0 30 2 0.5\n"
+        "1 255 -3.5 0 0 +4.25 0 128 -2e1 7\n";
+    const LoadedScan scan = decode(file, "hand.ply");
+    EXPECT_EQ(scan.format, "ply");
+    EXPECT_EQ(scan.formatDetail, "PLY 1.0 ascii");
+    const PointCloud& cloud = scan.cloud;
+    ASSERT_EQ(cloud.size(), 2u);
+    expectPosition(cloud, 0, 1, 2, 3);
+    expectPosition(cloud, 1, 4.25, -20, -3.5);
+    ASSERT_TRUE(cloud.hasColors());
+    EXPECT_EQ(cloud.colors[0], (Rgba8{10, 20, 30, 255}));
+    EXPECT_EQ(cloud.colors[1], (Rgba8{255, 0, 128, 255}));
+    ASSERT_TRUE(cloud.hasNormals());
+    EXPECT_EQ(cloud.normals[0], glm::vec3(0, 1, 0));
+    EXPECT_EQ(cloud.normals[1], glm::vec3(1, 0, 0));
+    ASSERT_TRUE(cloud.hasIntensities());
+    EXPECT_EQ(cloud.intensities[1], 7.0f);
+    EXPECT_EQ(cloud.bounds.min, glm::dvec3(1, -20, -3.5));
+    EXPECT_EQ(cloud.bounds.max, glm::dvec3(4.25, 2, 3));
+}
+
+/// Writes the same three points in both binary byte orders with mixed scalar types.
+std::string mixedTypesBinary(bool bigEndian) {
+    std::string file = binaryHeader(
+        bigEndian ? "binary_big_endian" : "binary_little_endian",
+        "element vertex 3\nproperty double x\nproperty int16 y\nproperty float z\n"
+        "property ushort red\nproperty ushort green\nproperty ushort blue\n"
+        "property uint8 alpha\nproperty int8 scalar_intensity\n");
+    const double xs[] = {0.125, -1e-3, 1e6};
+    const std::int16_t ys[] = {-32768, 0, 32767};
+    const float zs[] = {1.5f, -2.25f, 3.0f};
+    for (int i = 0; i < 3; ++i) {
+        appendBytes(file, xs[i], bigEndian);
+        appendBytes(file, ys[i], bigEndian);
+        appendBytes(file, zs[i], bigEndian);
+        appendBytes(file, std::uint16_t(65535), bigEndian);
+        appendBytes(file, std::uint16_t(257 * i), bigEndian);
+        appendBytes(file, std::uint16_t(0), bigEndian);
+        appendBytes(file, std::uint8_t(100 + i), bigEndian);
+        appendBytes(file, std::int8_t(-5 + i), bigEndian);
+    }
+    return file;
+}
+
+TEST(PlyReaderTest, BinaryBothByteOrdersAllScalarTypes) {
+    for (const bool bigEndian : {false, true}) {
+        SCOPED_TRACE(bigEndian ? "big endian" : "little endian");
+        const PointCloud cloud = decode(mixedTypesBinary(bigEndian), "mixed.ply").cloud;
+        ASSERT_EQ(cloud.size(), 3u);
+        // x spans 1e6, so float steps relative to the centre are 1/32: compare bounds exactly
+        // (kept in double) and positions with that resolution.
+        EXPECT_EQ(cloud.bounds.min, glm::dvec3(-1e-3, -32768, -2.25));
+        EXPECT_EQ(cloud.bounds.max, glm::dvec3(1e6, 32767, 3.0));
+        EXPECT_NEAR(cloud.fileCoordinates(2).x, 1e6, 0.04);
+        EXPECT_EQ(cloud.fileCoordinates(0).y, -32768.0);
+        EXPECT_EQ(cloud.colors[0], (Rgba8{255, 0, 0, 100}));
+        EXPECT_EQ(cloud.colors[2], (Rgba8{255, 2, 0, 102}));
+        EXPECT_EQ(cloud.intensities[0], -5.0f);
+    }
+}
+
+TEST(PlyReaderTest, FloatAndDiffuseColours) {
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+        "property float z\nproperty float diffuse_red\nproperty float diffuse_green\n"
+        "property float diffuse_blue\nend_header\n0 0 0 1.0 0.5 0\n";
+    const PointCloud cloud = decode(file, "f.ply").cloud;
+    EXPECT_EQ(cloud.colors[0], (Rgba8{255, 128, 0, 255}));
+}
+
+TEST(PlyReaderTest, FacesAreFannedIntoTriangles) {
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 2 2\n3 0 1 2\n5 0 1 2 3 4\n";
+    const PointCloud cloud = decode(file, "mesh.ply").cloud;
+    ASSERT_EQ(cloud.triangles.size(), 4u);
+    EXPECT_EQ(cloud.triangles[0], (Triangle{0, 1, 2}));
+    EXPECT_EQ(cloud.triangles[1], (Triangle{0, 1, 2}));
+    EXPECT_EQ(cloud.triangles[2], (Triangle{0, 2, 3}));
+    EXPECT_EQ(cloud.triangles[3], (Triangle{0, 3, 4}));
+}
+
+TEST(PlyReaderTest, BinaryFacesWithVertexIndexNameAndOtherElementsSkipped) {
+    for (const bool bigEndian : {false, true}) {
+        SCOPED_TRACE(bigEndian ? "big endian" : "little endian");
+        std::string file = binaryHeader(
+            bigEndian ? "binary_big_endian" : "binary_little_endian",
+            "element camera 1\nproperty float fov\nproperty list uchar float extra\n"
+            "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "property list uchar float unused_list\n"
+            "element range_grid 4\nproperty list uchar int vertex_indices\n"
+            "element face 1\nproperty uchar flags\nproperty list uint8 uint32 vertex_index\n");
+        appendBytes(file, 60.0f, bigEndian);
+        appendBytes(file, std::uint8_t(2), bigEndian);
+        appendBytes(file, 1.0f, bigEndian);
+        appendBytes(file, 2.0f, bigEndian);
+        for (int i = 0; i < 3; ++i) {
+            appendBytes(file, float(i), bigEndian);
+            appendBytes(file, 0.0f, bigEndian);
+            appendBytes(file, 0.0f, bigEndian);
+            appendBytes(file, std::uint8_t(i), bigEndian);  // i floats of unused_list
+            for (int k = 0; k < i; ++k) {
+                appendBytes(file, 9.0f, bigEndian);
+            }
+        }
+        for (int i = 0; i < 4; ++i) {  // range_grid: 0 or 1 index per cell
+            appendBytes(file, std::uint8_t(i % 2), bigEndian);
+            if (i % 2) {
+                appendBytes(file, std::int32_t(i), bigEndian);
+            }
+        }
+        appendBytes(file, std::uint8_t(7), bigEndian);
+        appendBytes(file, std::uint8_t(3), bigEndian);
+        for (std::uint32_t v : {2u, 1u, 0u}) {
+            appendBytes(file, v, bigEndian);
+        }
+        const PointCloud cloud = decode(file, "grid.ply").cloud;
+        ASSERT_EQ(cloud.size(), 3u);
+        expectPosition(cloud, 2, 2, 0, 0);
+        ASSERT_EQ(cloud.triangles.size(), 1u);
+        EXPECT_EQ(cloud.triangles[0], (Triangle{2, 1, 0}));
+    }
+}
+
+TEST(PlyReaderTest, StrayByeLinesAndCrLfHeaderAreTolerated) {
+    const std::string file =
+        "ply\r\nformat ascii 1.0\r\nbye\r\nelement vertex 1\r\nproperty float x\r\n"
+        "property float y\r\nproperty float z\r\nbye\r\nend_header\r\n1 2 3\r\n";
+    const PointCloud cloud = decode(file, "bye.ply").cloud;
+    ASSERT_EQ(cloud.size(), 1u);
+    expectPosition(cloud, 0, 1, 2, 3);
+}
+
+TEST(PlyReaderTest, NanVerticesAreDroppedAndFacesRemapped) {
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\nnan 0 0\n1 0 0\n0 1 inf\n3 0 2 2\n3 0 1 2\n";
+    const LoadedScan scan = decode(file, "nan.ply");
+    ASSERT_EQ(scan.cloud.size(), 2u);
+    ASSERT_EQ(scan.cloud.triangles.size(), 1u);
+    EXPECT_EQ(scan.cloud.triangles[0], (Triangle{0, 1, 1}));
+    EXPECT_THAT(scan.warnings, ::testing::Contains(HasSubstr("dropped 2 of 4 points")));
+}
+
+TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
+    const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+    struct Case {
+        const char* name;
+        std::string file;
+        const char* expected;
+    };
+    std::string truncatedBinary =
+        binaryHeader("binary_little_endian", "element vertex 3\n" + xyz);
+    for (int i = 0; i < 7; ++i) {  // 2 vertices and a third of one
+        appendBytes(truncatedBinary, 1.0f);
+    }
+    const Case cases[] = {
+        {"no magic", "plx\nformat ascii 1.0\n", "PLY magic"},
+        {"no end_header", "ply\nformat ascii 1.0\nelement vertex 1\n", "no 'end_header'"},
+        {"no format", "ply\nelement vertex 1\n" + xyz + "end_header\n1 2 3\n", "no 'format'"},
+        {"unknown encoding", "ply\nformat binary_middle_endian 1.0\nend_header\n",
+         "unknown encoding"},
+        {"unknown type", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n",
+         "unknown property type"},
+        {"list position", "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n"
+                          "property float y\nproperty float z\nend_header\n1 1 2 3\n",
+         "'x' is declared as a list"},
+        {"missing z", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float "
+                      "y\nend_header\n1 2\n",
+         "no 'z' property"},
+        {"no vertex element", "ply\nformat ascii 1.0\nelement face 0\nend_header\n",
+         "no 'vertex' element"},
+        {"truncated ascii", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+                                "end_header\n1 2 3\n4 5 6\n7 8",
+         "ends inside vertex 3 of 3"},
+        {"truncated binary", truncatedBinary, "ends inside vertex 3 of 3"},
+        {"count larger than body",
+         binaryHeader("binary_little_endian", "element vertex 1000000000000\n" + xyz),
+         "more than the"},
+        {"non-numeric", "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz + "end_header\n1 two 3\n",
+         "non-numeric value 'two'"},
+        {"face index out of range",
+         "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+             "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+         "vertex index outside 0..2"},
+        {"negative face index",
+         "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+             "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n",
+         "vertex index outside"},
+        {"zero points", "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + "end_header\n",
+         "contains no points"},
+        {"all NaN", "ply\nformat ascii 1.0\nelement vertex 2\n" + xyz +
+                        "end_header\nnan 0 0\n0 inf 0\n",
+         "all 2 points have NaN"},
+        {"bad element count", "ply\nformat ascii 1.0\nelement vertex -4\n",
+         "not a non-negative integer"},
+        {"negative list length",
+         "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n-3 0\n",
+         "invalid list length"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        EXPECT_THAT(decodeError(c.file, "bad.ply"), HasSubstr(c.expected));
+    }
+}
+
+TEST(PlyReaderTest, HugeVertexCountInAsciiDoesNotAllocateOrHang) {
+    // A lying count must end at the body's end, not reserve memory for 4 billion points.
+    const std::string file = "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+                             "property float y\nproperty float z\nend_header\n1 2 3\n";
+    EXPECT_THAT(decodeError(file, "huge.ply"), HasSubstr("ends inside vertex 2 of 4000000000"));
+}
+
+}  // namespace
+}  // namespace subscan
