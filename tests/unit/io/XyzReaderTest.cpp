@@ -1,0 +1,3 @@
+#include <gtest/gtest.h>
+
+TEST(XyzReaderTest, BeingWritten) { GTEST_SKIP() << "the Xyz reader tests are being written"; }
