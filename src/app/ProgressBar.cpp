@@ -1,7 +1,7 @@
 #include "app/ProgressBar.h"
 
-#include <algorithm>
 #include <unistd.h>
+#include <algorithm>
 
 #include <fmt/format.h>
 

@@ -9,7 +9,7 @@ namespace subscan {
 /// A one-line progress bar on stderr, shown only when stderr is a terminal and the work is big
 /// enough to be worth watching; otherwise every call does nothing.
 class ProgressBar {
-public:
+  public:
     ProgressBar(std::string label, bool worthShowing);
     ~ProgressBar();
     ProgressBar(const ProgressBar&) = delete;
@@ -17,7 +17,7 @@ public:
 
     void update(double fraction);
 
-private:
+  private:
     std::string label_;
     bool enabled_;
     int lastPercent_ = -1;

@@ -1,3 +1,5 @@
 #include "app/cli/Commands.h"
 
-int main(int argc, char** argv) { return subscan::cli::run(argc, argv); }
+int main(int argc, char** argv) {
+    return subscan::cli::run(argc, argv);
+}

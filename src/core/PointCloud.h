@@ -47,11 +47,11 @@ struct Bounds {
 struct PointCloud {
     glm::dvec3 origin{0.0};
     std::vector<glm::vec3> positions;
-    std::vector<Rgba8> colors;          // sRGB-encoded
-    std::vector<glm::vec3> normals;     // unit length where the file had them
-    std::vector<float> intensities;     // as stored in the file (no normalisation)
-    std::vector<Triangle> triangles;    // vertex indices; ground-truth meshes only
-    Bounds bounds;                      // exact, in file coordinates
+    std::vector<Rgba8> colors;        // sRGB-encoded
+    std::vector<glm::vec3> normals;   // unit length where the file had them
+    std::vector<float> intensities;   // as stored in the file (no normalisation)
+    std::vector<Triangle> triangles;  // vertex indices; ground-truth meshes only
+    Bounds bounds;                    // exact, in file coordinates
 
     std::size_t size() const { return positions.size(); }
     bool hasColors() const { return !colors.empty(); }
@@ -79,7 +79,7 @@ struct PointRecord {
 /// exact double bounds and stores float positions relative to the first valid point; finish()
 /// then re-centres them on the middle of the bounds.
 class PointCloudBuilder {
-public:
+  public:
     /// `mapVertexIndices`: the file has faces, so remember which file vertex became which point.
     PointCloudBuilder(PointAttributes attributes, std::size_t expectedPoints,
                       bool mapVertexIndices = false);
@@ -119,7 +119,7 @@ public:
     /// Throws subscan::Error when no valid point is left; warns (through `warnings`) about drops.
     PointCloud finish(std::vector<std::string>& warnings);
 
-private:
+  private:
     void dropVertex();
 
     PointAttributes attributes_;

@@ -72,15 +72,27 @@ std::size_t sizeOf(PlyType type) {
     return 0;
 }
 
-bool isInteger(PlyType type) { return type != PlyType::Float32 && type != PlyType::Float64; }
+bool isInteger(PlyType type) {
+    return type != PlyType::Float32 && type != PlyType::Float64;
+}
 
 std::optional<PlyType> parseType(std::string_view name) {
     static constexpr std::array<std::pair<std::string_view, PlyType>, 16> kNames{{
-        {"char", PlyType::Int8},     {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
-        {"uint8", PlyType::UInt8},   {"short", PlyType::Int16},     {"int16", PlyType::Int16},
-        {"ushort", PlyType::UInt16}, {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
-        {"int32", PlyType::Int32},   {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
-        {"float", PlyType::Float32}, {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+        {"char", PlyType::Int8},
+        {"int8", PlyType::Int8},
+        {"uchar", PlyType::UInt8},
+        {"uint8", PlyType::UInt8},
+        {"short", PlyType::Int16},
+        {"int16", PlyType::Int16},
+        {"ushort", PlyType::UInt16},
+        {"uint16", PlyType::UInt16},
+        {"int", PlyType::Int32},
+        {"int32", PlyType::Int32},
+        {"uint", PlyType::UInt32},
+        {"uint32", PlyType::UInt32},
+        {"float", PlyType::Float32},
+        {"float32", PlyType::Float32},
+        {"double", PlyType::Float64},
         {"float64", PlyType::Float64},
     }};
     for (const auto& [typeName, type] : kNames) {
@@ -162,8 +174,9 @@ PlyHeader parseHeader(std::string_view file) {
             } else if (words[1] == "binary_big_endian") {
                 header.encoding = PlyEncoding::BinaryBigEndian;
             } else {
-                fail("names an unknown encoding (expected ascii, binary_little_endian or "
-                     "binary_big_endian)");
+                fail(
+                    "names an unknown encoding (expected ascii, binary_little_endian or "
+                    "binary_big_endian)");
             }
             header.version = std::string(words[2]);
             sawFormat = true;
@@ -236,9 +249,10 @@ VertexLayout findVertexLayout(const PlyElement& vertex) {
     auto scalar = [&](std::string_view name) -> std::optional<std::size_t> {
         const auto index = vertex.find(name);
         if (index && vertex.properties[*index].isList) {
-            throw Error(fmt::format("the PLY vertex property '{}' is declared as a list, but it "
-                                    "must be a single value",
-                                    name));
+            throw Error(
+                fmt::format("the PLY vertex property '{}' is declared as a list, but it "
+                            "must be a single value",
+                            name));
         }
         return index;
     };
@@ -301,17 +315,17 @@ std::optional<std::size_t> findFaceList(const PlyElement& face) {
 
 /// Decodes the body: binary (either byte order) and ascii share everything but value access.
 class PlyBodyReader {
-public:
+  public:
     PlyBodyReader(const PlyHeader& header, std::span<const std::byte> file, ReadContext& context)
         : header_(header), file_(file), context_(context) {}
 
     PointCloud read();
 
-private:
+  private:
     // The decoded values of one item.
     struct ItemValues {
-        std::vector<double> scalar;                 // per property (scalars only)
-        std::vector<std::uint32_t> faceIndices;     // the face list, when reading faces
+        std::vector<double> scalar;              // per property (scalars only)
+        std::vector<std::uint32_t> faceIndices;  // the face list, when reading faces
     };
 
     bool binary() const { return header_.encoding != PlyEncoding::Ascii; }
@@ -355,9 +369,10 @@ double PlyBodyReader::loadBinary(PlyType type, const std::byte* p) const {
 }
 
 void PlyBodyReader::failTruncated(const PlyElement& element, std::uint64_t itemIndex) const {
-    throw Error(fmt::format("the PLY body ends inside {} {} of {} declared in the header (file "
-                            "truncated, or the count is wrong)",
-                            element.name, itemIndex + 1, element.count));
+    throw Error(
+        fmt::format("the PLY body ends inside {} {} of {} declared in the header (file "
+                    "truncated, or the count is wrong)",
+                    element.name, itemIndex + 1, element.count));
 }
 
 double PlyBodyReader::nextAsciiNumber(const PlyElement& element, std::uint64_t itemIndex) {
@@ -429,9 +444,9 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
             if (keep) {
                 for (std::uint64_t i = 0; i < count; ++i) {
                     const double index = loadBinary(property.type, file_.data() + position_);
-                    values.faceIndices.push_back(
-                        index >= 0.0 && index < 4294967295.0 ? static_cast<std::uint32_t>(index)
-                                                             : kInvalidIndex);
+                    values.faceIndices.push_back(index >= 0.0 && index < 4294967295.0
+                                                     ? static_cast<std::uint32_t>(index)
+                                                     : kInvalidIndex);
                     position_ += itemSize;
                 }
             } else {
@@ -441,10 +456,10 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
             for (std::uint64_t i = 0; i < count; ++i) {
                 const double index = nextAsciiNumber(element, itemIndex);
                 if (keep) {
-                    values.faceIndices.push_back(
-                        index >= 0.0 && index < 4294967295.0 && index == std::floor(index)
-                            ? static_cast<std::uint32_t>(index)
-                            : kInvalidIndex);
+                    values.faceIndices.push_back(index >= 0.0 && index < 4294967295.0 &&
+                                                         index == std::floor(index)
+                                                     ? static_cast<std::uint32_t>(index)
+                                                     : kInvalidIndex);
                 }
             }
         }
@@ -488,9 +503,10 @@ PointCloud PlyBodyReader::read() {
         throw Error("the PLY file has no 'vertex' element");
     }
     if (vertex->count > kMaxPoints) {
-        throw Error(fmt::format("the PLY header declares {} vertices, more than the {} points "
-                                "subscan can hold",
-                                vertex->count, kMaxPoints));
+        throw Error(
+            fmt::format("the PLY header declares {} vertices, more than the {} points "
+                        "subscan can hold",
+                        vertex->count, kMaxPoints));
     }
     const VertexLayout layout = findVertexLayout(*vertex);
     std::optional<std::size_t> faceList;
@@ -527,9 +543,9 @@ PointCloud PlyBodyReader::read() {
             record.color = {toColorChannel(value(c[0]), colorType(c[0])),
                             toColorChannel(value(c[1]), colorType(c[1])),
                             toColorChannel(value(c[2]), colorType(c[2])),
-                            layout.alpha ? toColorChannel(value(*layout.alpha),
-                                                          colorType(*layout.alpha))
-                                         : std::uint8_t{255}};
+                            layout.alpha
+                                ? toColorChannel(value(*layout.alpha), colorType(*layout.alpha))
+                                : std::uint8_t{255}};
         }
         if (layout.normal) {
             const auto& n = *layout.normal;
@@ -623,8 +639,8 @@ PointCloud readPly(std::span<const std::byte> file, ReadContext& context) {
     const PlyHeader header = parseHeader(text);
     static constexpr std::array kEncodingNames{"ascii", "binary_little_endian",
                                                "binary_big_endian"};
-    context.formatDetail = fmt::format("PLY {} {}", header.version,
-                                       kEncodingNames[static_cast<int>(header.encoding)]);
+    context.formatDetail =
+        fmt::format("PLY {} {}", header.version, kEncodingNames[static_cast<int>(header.encoding)]);
     PlyBodyReader reader(header, file.subspan(header.bodyOffset), context);
     return reader.read();
 }

@@ -84,8 +84,8 @@ ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::
     if (extension == ".e57") {
         return ScanFormat::E57;
     }
-    if (extension == ".xyz" || extension == ".pts" || extension == ".txt" ||
-        extension == ".csv" || extension == ".asc") {
+    if (extension == ".xyz" || extension == ".pts" || extension == ".txt" || extension == ".csv" ||
+        extension == ".asc") {
         return ScanFormat::Xyz;
     }
     if (looksLikePointText(file)) {
@@ -120,11 +120,13 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
             scan.cloud = readXyz(file, context);
             break;
         case ScanFormat::E57:
-            throw Error("E57 files are not supported yet; convert the scan to PLY, LAS or PCD "
-                        "(e.g. with CloudCompare or PDAL)");
+            throw Error(
+                "E57 files are not supported yet; convert the scan to PLY, LAS or PCD "
+                "(e.g. with CloudCompare or PDAL)");
         case ScanFormat::Unknown:
-            throw Error("its format is unknown: it is not PLY, LAS, PCD, E57 or a text list of "
-                        "coordinates");
+            throw Error(
+                "its format is unknown: it is not PLY, LAS, PCD, E57 or a text list of "
+                "coordinates");
     }
     scan.formatDetail = std::move(context.formatDetail);
     scan.warnings = std::move(context.warnings);
@@ -148,8 +150,7 @@ LoadedScan loadScan(std::string_view source, const std::function<void(double)>& 
         throw Error(fmt::format("{}: {}", source, error.what()));
     }
     scan.loadMilliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count();
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return scan;
 }
 

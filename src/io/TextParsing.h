@@ -9,8 +9,12 @@
 
 namespace subscan {
 
-inline bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
-inline bool isWhitespace(char c) { return isBlank(c) || c == '\n' || c == '\v' || c == '\f'; }
+inline bool isBlank(char c) {
+    return c == ' ' || c == '\t' || c == '\r';
+}
+inline bool isWhitespace(char c) {
+    return isBlank(c) || c == '\n' || c == '\v' || c == '\f';
+}
 
 /// Parses one decimal number (optionally signed; "nan"/"inf" allowed so callers can drop such
 /// points) starting exactly at `first`. Returns the end of the number, or nullptr if there is

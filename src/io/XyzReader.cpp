@@ -11,5 +11,7 @@ PointCloud readXyz(std::span<const std::byte>, ReadContext&) {
 }  // namespace subscan
 
 namespace subscan {
-bool looksLikePointText(std::span<const std::byte>) { return false; }
+bool looksLikePointText(std::span<const std::byte>) {
+    return false;
+}
 }  // namespace subscan

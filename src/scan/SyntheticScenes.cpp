@@ -47,8 +47,8 @@ PointCloud makeSyntheticScene(std::string_view spec) {
         const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), points);
         if (ec != std::errc() || end != value.data() + value.size() || points == 0 ||
             points > 100'000'000) {
-            throw Error(fmt::format("points={} is not a point count between 1 and 100000000",
-                                    value));
+            throw Error(
+                fmt::format("points={} is not a point count between 1 and 100000000", value));
         }
     }
     if (name == "sphere") {

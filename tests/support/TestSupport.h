@@ -17,7 +17,7 @@ namespace subscan::test {
 
 /// A fresh directory under the system temp dir, removed with everything in it on destruction.
 class TempDir {
-public:
+  public:
     TempDir();
     ~TempDir();
     TempDir(const TempDir&) = delete;
@@ -28,7 +28,7 @@ public:
     /// Writes `bytes` to a file in this directory and returns its path.
     std::filesystem::path write(std::string_view name, std::string_view bytes) const;
 
-private:
+  private:
     std::filesystem::path path_;
 };
 
@@ -67,10 +67,10 @@ void appendBytes(std::string& out, T value, bool bigEndian = false) {
 }  // namespace subscan::test
 
 /// Skips the current test with a visible message when the real-scan folder is absent.
-#define SUBSCAN_REQUIRE_TEST_DATA(dirVariable)                                                   \
-    const auto dirVariable##Optional = ::subscan::test::testDataDirectory();                    \
-    if (!dirVariable##Optional) {                                                              \
-        GTEST_SKIP() << "real scans not found: set SUBSCAN_TEST_DATA or put ../shared/data "    \
-                        "beside the checkout";                                                  \
-    }                                                                                          \
+#define SUBSCAN_REQUIRE_TEST_DATA(dirVariable)                                               \
+    const auto dirVariable##Optional = ::subscan::test::testDataDirectory();                 \
+    if (!dirVariable##Optional) {                                                            \
+        GTEST_SKIP() << "real scans not found: set SUBSCAN_TEST_DATA or put ../shared/data " \
+                        "beside the checkout";                                               \
+    }                                                                                        \
     const std::filesystem::path dirVariable = *dirVariable##Optional

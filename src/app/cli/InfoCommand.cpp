@@ -71,8 +71,9 @@ int runInfo(const InfoOptions& options) {
 
 Command addInfoCommand(CLI::App& parent) {
     auto options = std::make_shared<InfoOptions>();
-    CLI::App* info = parent.add_subcommand("info", "What is in a scan: count, bounds, attributes, "
-                                                   "spacing");
+    CLI::App* info = parent.add_subcommand("info",
+                                           "What is in a scan: count, bounds, attributes, "
+                                           "spacing");
     info->add_option("scan", options->source, "Scan file, or synthetic:NAME")->required();
     info->add_flag("--json", options->json, "Machine-readable output");
     return {info, [options] { return runInfo(*options); }};

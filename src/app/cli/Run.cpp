@@ -42,8 +42,9 @@ int run(int argc, char** argv) {
         fmt::print(stderr, "subscan: {}\n", error.what());
         return kExitError;
     } catch (const std::bad_alloc&) {
-        fmt::print(stderr, "subscan: out of memory (the scan or the requested image is too large "
-                           "for this machine)\n");
+        fmt::print(stderr,
+                   "subscan: out of memory (the scan or the requested image is too large "
+                   "for this machine)\n");
         return kExitError;
     } catch (const std::exception& error) {
         fmt::print(stderr, "subscan: internal error: {}\n", error.what());

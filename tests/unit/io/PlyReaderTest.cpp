@@ -59,11 +59,11 @@ TEST(PlyReaderTest, AsciiPositionsAnyPropertyOrderWithColorNormalIntensity) {
 
 /// Writes the same three points in both binary byte orders with mixed scalar types.
 std::string mixedTypesBinary(bool bigEndian) {
-    std::string file = binaryHeader(
-        bigEndian ? "binary_big_endian" : "binary_little_endian",
-        "element vertex 3\nproperty double x\nproperty int16 y\nproperty float z\n"
-        "property ushort red\nproperty ushort green\nproperty ushort blue\n"
-        "property uint8 alpha\nproperty int8 scalar_intensity\n");
+    std::string file =
+        binaryHeader(bigEndian ? "binary_big_endian" : "binary_little_endian",
+                     "element vertex 3\nproperty double x\nproperty int16 y\nproperty float z\n"
+                     "property ushort red\nproperty ushort green\nproperty ushort blue\n"
+                     "property uint8 alpha\nproperty int8 scalar_intensity\n");
     const double xs[] = {0.125, -1e-3, 1e6};
     const std::int16_t ys[] = {-32768, 0, 32767};
     const float zs[] = {1.5f, -2.25f, 3.0f};
@@ -189,8 +189,7 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
         std::string file;
         const char* expected;
     };
-    std::string truncatedBinary =
-        binaryHeader("binary_little_endian", "element vertex 3\n" + xyz);
+    std::string truncatedBinary = binaryHeader("binary_little_endian", "element vertex 3\n" + xyz);
     for (int i = 0; i < 7; ++i) {  // 2 vertices and a third of one
         appendBytes(truncatedBinary, 1.0f);
     }
@@ -202,16 +201,18 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
          "unknown encoding"},
         {"unknown type", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float128 x\n",
          "unknown property type"},
-        {"list position", "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n"
-                          "property float y\nproperty float z\nend_header\n1 1 2 3\n",
+        {"list position",
+         "ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\n"
+         "property float y\nproperty float z\nend_header\n1 1 2 3\n",
          "'x' is declared as a list"},
-        {"missing z", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float "
-                      "y\nend_header\n1 2\n",
+        {"missing z",
+         "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float "
+         "y\nend_header\n1 2\n",
          "no 'z' property"},
         {"no vertex element", "ply\nformat ascii 1.0\nelement face 0\nend_header\n",
          "no 'vertex' element"},
-        {"truncated ascii", "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
-                                "end_header\n1 2 3\n4 5 6\n7 8",
+        {"truncated ascii",
+         "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "end_header\n1 2 3\n4 5 6\n7 8",
          "ends inside vertex 3 of 3"},
         {"truncated binary", truncatedBinary, "ends inside vertex 3 of 3"},
         {"count larger than body",
@@ -231,8 +232,8 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
          "vertex index outside"},
         {"zero points", "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + "end_header\n",
          "contains no points"},
-        {"all NaN", "ply\nformat ascii 1.0\nelement vertex 2\n" + xyz +
-                        "end_header\nnan 0 0\n0 inf 0\n",
+        {"all NaN",
+         "ply\nformat ascii 1.0\nelement vertex 2\n" + xyz + "end_header\nnan 0 0\n0 inf 0\n",
          "all 2 points have NaN"},
         {"bad element count", "ply\nformat ascii 1.0\nelement vertex -4\n",
          "not a non-negative integer"},
@@ -249,8 +250,9 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
 
 TEST(PlyReaderTest, HugeVertexCountInAsciiDoesNotAllocateOrHang) {
     // A lying count must end at the body's end, not reserve memory for 4 billion points.
-    const std::string file = "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
-                             "property float y\nproperty float z\nend_header\n1 2 3\n";
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\n"
+        "property float y\nproperty float z\nend_header\n1 2 3\n";
     EXPECT_THAT(decodeError(file, "huge.ply"), HasSubstr("ends inside vertex 2 of 4000000000"));
 }
 

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, ASan + UBSan) and fuzzes each reader in turn.
+#   scripts/fuzz.sh [--seconds N] [ply|las|pcd|xyz ...]      default: 300 s each, all readers
+# Seeds: tiny files written here, plus small real scans from ../shared/data when present
+# (copied into the build folder only). A finding stops the script with a non-zero exit and
+# leaves the input under build-fuzz/artifacts/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+seconds=300
+readers=()
+while [[ $# -gt 0 ]]; do
+    case "$1" in
+        --seconds) seconds="$2"; shift 2 ;;
+        ply|las|pcd|xyz) readers+=("$1"); shift ;;
+        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|pcd|xyz ...]" >&2; exit 2 ;;
+    esac
+done
+[[ ${#readers[@]} -gt 0 ]] || readers=(ply las pcd xyz)
+
+scripts/setup-deps.sh
+build=build-fuzz
+CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DSUBSCAN_FUZZ=ON \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$build" --target "${readers[@]/#/fuzz_}"
+
+# Little-endian integers for the hand-made LAS seed.
+le() {  # value bytes
+    local value=$1 bytes=$2 i
+    for ((i = 0; i < bytes; i++)); do
+        printf "\\x$(printf %02x $(((value >> (8 * i)) & 255)))"
+    done
+}
+write_seeds() {  # reader directory
+    local reader=$1 dir=$2
+    case "$reader" in
+        ply)
+            printf 'ply\nformat ascii 1.0\ncomment seed\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2\n' >"$dir/ascii.ply"
+            { printf 'ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty list uchar float extra\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n'
+              printf '\x00\x00\x80\x3f\x00\x00\x00\x40\x00\x00\x40\x40\x01\x00\x00\x80\x3f'
+              printf '\x00\x00\x80\x3f\x00\x00\x00\x40\x00\x00\x40\x40\x00'
+              printf '\x03\x00\x00\x00\x00\x01\x00\x00\x00\x01\x00\x00\x00'; } >"$dir/binary.ply"
+            ;;
+        pcd)
+            printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\nWIDTH 2\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n1 2 3 16711680\nnan nan nan 0\n' >"$dir/ascii.pcd"
+            ;;
+        xyz)
+            printf 'x,y,z,r,g,b\n1,2,3,255,0,0\n4,5,6,0,255,0\n' >"$dir/header.csv"
+            printf '2\n1 2 3 -100 10 20 30\n4 5 6 200 40 50 60\n' >"$dir/scan.pts"
+            printf '1.5 2.5 3.5\n-1e3 +2 nan\n' >"$dir/plain.xyz"
+            ;;
+        las)
+            {   # LAS 1.2, point format 2 (26 bytes), two points, 227-byte header, no VLRs
+                printf 'LASF'; le 0 4; printf '%16s' '' | tr ' ' '\0'; le 1 1; le 2 1
+                printf '%64s' '' | tr ' ' '\0'; le 1 2; le 2024 2; le 227 2; le 227 4; le 0 4
+                le 2 1; le 26 2; le 2 4; le 2 4; le 0 16
+                local scale=$((0x3F847AE147AE147B))  # the double 0.01
+                le $scale 8; le $scale 8; le $scale 8; le 0 24  # scale, then offset 0
+                le 0 48                                          # bounds (not checked here)
+                for p in 1 2; do le $p 4; le $((p * 2)) 4; le $((p * 3)) 4; le 100 2; le 0 6
+                    le 65535 2; le 0 2; le 255 2; done; } >"$dir/format2.las"
+            ;;
+    esac
+    local data=../shared/data
+    if [[ -d "$data" ]]; then
+        case "$reader" in
+            ply) cp "$data/bun_zipper_res4.ply" "$dir/" ;;
+            las) cp "$data/simple.las" "$dir/" ;;
+            pcd) cp "$data/pcl_bunny_ascii.pcd" "$data/autzen_utm_binary.pcd" "$dir/" ;;
+        esac
+    fi
+}
+
+mkdir -p "$build/artifacts"
+for reader in "${readers[@]}"; do
+    corpus="$build/corpus/$reader"
+    seeds="$build/seeds/$reader"
+    mkdir -p "$corpus" "$seeds"
+    write_seeds "$reader" "$seeds"
+    log="$build/fuzz-$reader.log"
+    echo "fuzz: $reader for ${seconds}s (log: $log)"
+    # -rss_limit_mb/-malloc_limit_mb turn allocation bombs from lying headers into findings.
+    if ! "$build/tests/fuzz/fuzz_$reader" -max_total_time="$seconds" -timeout=10 \
+        -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 \
+        -artifact_prefix="$build/artifacts/$reader-" "$corpus" "$seeds" >"$log" 2>&1; then
+        tail -n 40 "$log" >&2
+        echo "fuzz: $reader found a problem; the input is in $build/artifacts/" >&2
+        exit 1
+    fi
+    executions=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
+    echo "fuzz: $reader ok, $executions executions"
+done

@@ -1,0 +1,68 @@
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::runSubscan;
+using ::testing::HasSubstr;
+
+TEST(CliTest, UsageErrorsExitWithTwo) {
+    EXPECT_EQ(runSubscan({}).exitCode, 2);
+    EXPECT_EQ(runSubscan({"info"}).exitCode, 2);
+    EXPECT_EQ(runSubscan({"frobnicate"}).exitCode, 2);
+    EXPECT_EQ(runSubscan({"info", "synthetic:sphere", "--no-such-option"}).exitCode, 2);
+    EXPECT_EQ(runSubscan({"--help"}).exitCode, 0);
+}
+
+TEST(CliTest, InfoJsonHasExactlyTheDocumentedKeys) {
+    const test::CommandResult result = runSubscan({"info", "synthetic:sphere", "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const nlohmann::json info = nlohmann::json::parse(result.out);
+    std::vector<std::string> keys;
+    for (const auto& [key, value] : info.items()) {
+        keys.push_back(key);
+    }
+    EXPECT_THAT(keys,
+                ::testing::UnorderedElementsAre("format", "points", "bounds_min", "bounds_max",
+                                                "attributes", "faces", "spacing", "load_ms"));
+    EXPECT_EQ(info["format"], "synthetic");
+    EXPECT_EQ(info["points"], 4000);
+    EXPECT_EQ(info["attributes"], nlohmann::json({"position", "normal"}));
+    EXPECT_EQ(info["faces"], 0);
+    // 4000 points on the unit sphere: area 4*pi, so about sqrt(4*pi/4000) = 0.056 apart.
+    EXPECT_NEAR(info["spacing"].get<double>(), 0.056, 0.006);
+    EXPECT_GE(info["load_ms"].get<double>(), 0.0);
+}
+
+TEST(CliTest, ErrorsAreOneLineNamingTheFile) {
+    const test::TempDir dir;
+    const auto truncated = dir.write("cut.ply",
+                                     "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                     "property float y\nproperty float z\nend_header\n1 2 3\n");
+    const test::CommandResult result = runSubscan({"info", truncated.string()});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_TRUE(result.out.empty());
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("cut.ply: the PLY body ends inside vertex 2 of 2"));
+}
+
+TEST(CliTest, WarningsGoToStderrAndTheCommandSucceeds) {
+    const test::TempDir dir;
+    const auto withNan =
+        dir.write("nan.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                  "property float y\nproperty float z\nend_header\n1 2 3\nnan 0 0\n");
+    const test::CommandResult result = runSubscan({"info", withNan.string(), "--json"});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_THAT(result.err, HasSubstr("warning: " + withNan.string() + ": dropped 1 of 2"));
+    EXPECT_EQ(nlohmann::json::parse(result.out)["points"], 1);
+}
+
+}  // namespace
+}  // namespace subscan

@@ -1,0 +1,109 @@
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/Error.h"
+#include "core/PointCloud.h"
+
+namespace subscan {
+namespace {
+
+using ::testing::HasSubstr;
+
+PointRecord at(double x, double y, double z) {
+    PointRecord record;
+    record.position = {x, y, z};
+    return record;
+}
+
+TEST(PointCloudTest, RecentresOnBoundsAndKeepsUtmPrecision) {
+    // A 100 m wide scan at UTM northing 5.4e6: a float holding the absolute coordinate would
+    // step by 0.5 m; relative to the centre it must step by about 4 micrometres.
+    PointCloudBuilder builder({}, 3);
+    builder.add(at(500000.001, 5400000.002, 10.0));
+    builder.add(at(500100.003, 5400050.004, 12.5));
+    builder.add(at(500050.0, 5400025.0, 11.0));
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    EXPECT_TRUE(warnings.empty());
+    EXPECT_EQ(cloud.origin, cloud.bounds.center());
+    EXPECT_EQ(cloud.bounds.min, glm::dvec3(500000.001, 5400000.002, 10.0));
+    EXPECT_EQ(cloud.bounds.max, glm::dvec3(500100.003, 5400050.004, 12.5));
+    // Float spacing near 50 (the largest offset from the centre) is 2^-18 = 3.8e-6.
+    EXPECT_NEAR(cloud.fileCoordinates(0).x, 500000.001, 4e-6);
+    EXPECT_NEAR(cloud.fileCoordinates(1).y, 5400050.004, 4e-6);
+    EXPECT_NEAR(cloud.fileCoordinates(2).z, 11.0, 4e-6);
+}
+
+TEST(PointCloudTest, DropsNonFinitePointsWithTheirAttributes) {
+    PointCloudBuilder builder({.color = true, .intensity = true}, 4);
+    PointRecord a = at(1, 2, 3);
+    a.color = {1, 2, 3, 4};
+    a.intensity = 5;
+    PointRecord bad = at(NAN, 0, 0);
+    bad.color = {9, 9, 9, 9};
+    PointRecord b = at(4, 5, 6);
+    b.color = {7, 8, 9, 10};
+    b.intensity = 11;
+    builder.add(a);
+    builder.add(bad);
+    builder.add(at(0, INFINITY, 0));
+    builder.add(b);
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    ASSERT_EQ(cloud.size(), 2u);
+    EXPECT_EQ(cloud.colors, (std::vector<Rgba8>{{1, 2, 3, 4}, {7, 8, 9, 10}}));
+    EXPECT_EQ(cloud.intensities, (std::vector<float>{5, 11}));
+    EXPECT_TRUE(cloud.normals.empty());
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_THAT(warnings[0], HasSubstr("dropped 2 of 4 points"));
+}
+
+TEST(PointCloudTest, TrianglesFollowKeptVerticesAndLoseDroppedOnes) {
+    PointCloudBuilder builder({}, 5, /*mapVertexIndices=*/true);
+    builder.add(at(0, 0, 0));
+    builder.add(at(NAN, 0, 0));  // file vertex 1 is dropped
+    builder.add(at(1, 0, 0));
+    builder.add(at(0, 1, 0));
+    builder.addTriangle({0, 2, 3});
+    builder.addTriangle({1, 2, 3});
+    builder.addTriangle({3, 2, 0});
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    EXPECT_EQ(cloud.triangles, (std::vector<Triangle>{{0, 1, 2}, {2, 1, 0}}));
+    EXPECT_THAT(warnings, ::testing::Contains(HasSubstr("dropped 1 faces")));
+}
+
+TEST(PointCloudTest, EmptyAndAllInvalidCloudsAreErrors) {
+    std::vector<std::string> warnings;
+    PointCloudBuilder empty({}, 0);
+    EXPECT_THROW(
+        {
+            try {
+                empty.finish(warnings);
+            } catch (const Error& error) {
+                EXPECT_THAT(error.what(), HasSubstr("contains no points"));
+                throw;
+            }
+        },
+        Error);
+    PointCloudBuilder invalid({}, 2);
+    invalid.add(at(NAN, NAN, NAN));
+    invalid.add(at(-INFINITY, 0, 0));
+    EXPECT_THROW(
+        {
+            try {
+                invalid.finish(warnings);
+            } catch (const Error& error) {
+                EXPECT_THAT(error.what(), HasSubstr("all 2 points have NaN or infinite"));
+                throw;
+            }
+        },
+        Error);
+}
+
+}  // namespace
+}  // namespace subscan

@@ -1,0 +1,79 @@
+#include <filesystem>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+#include "io/ScanLoader.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::asBytes;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+std::string loadError(const std::string& source) {
+    try {
+        loadScan(source);
+    } catch (const Error& error) {
+        return error.what();
+    }
+    ADD_FAILURE() << "loading " << source << " did not throw";
+    return {};
+}
+
+TEST(ScanLoaderTest, ContentWinsOverExtension) {
+    EXPECT_EQ(detectFormat(asBytes("ply\nformat ascii 1.0\n"), "scan.las"), ScanFormat::Ply);
+    EXPECT_EQ(detectFormat(asBytes(std::string_view("LASF\0\0", 6)), "scan.ply"), ScanFormat::Las);
+    EXPECT_EQ(detectFormat(asBytes("ASTM-E57"), "scan.xyz"), ScanFormat::E57);
+    EXPECT_EQ(detectFormat(asBytes("# .PCD v.7 - Point Cloud Data\nVERSION .7\n"), "a.txt"),
+              ScanFormat::Pcd);
+    EXPECT_EQ(detectFormat(asBytes("VERSION 0.7\nFIELDS x y z\n"), "noext"), ScanFormat::Pcd);
+}
+
+TEST(ScanLoaderTest, ExtensionDecidesWhenContentIsUnclear) {
+    EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.PLY"), ScanFormat::Ply);
+    EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.laz"), ScanFormat::Las);
+    EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.pcd"), ScanFormat::Pcd);
+    EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.e57"), ScanFormat::E57);
+    for (const char* name : {"a.xyz", "a.pts", "a.txt", "a.csv", "a.asc"}) {
+        EXPECT_EQ(detectFormat(asBytes("garbage"), name), ScanFormat::Xyz) << name;
+    }
+    EXPECT_EQ(detectFormat(asBytes("garbage\x01\x02"), "scan.bin"), ScanFormat::Unknown);
+}
+
+TEST(ScanLoaderTest, ErrorsNameTheFile) {
+    const test::TempDir dir;
+    const auto empty = dir.write("empty.ply", "");
+    EXPECT_EQ(loadError(empty.string()), empty.string() + ": the file is empty");
+    const auto unknown = dir.write("scan.bin", std::string("\x7f\x01\x02garbage", 10));
+    EXPECT_THAT(loadError(unknown.string()),
+                AllOf(StartsWith(unknown.string() + ": "), HasSubstr("format is unknown")));
+    const auto e57 = dir.write("scan.e57", "ASTM-E57 and more");
+    EXPECT_THAT(loadError(e57.string()), HasSubstr("E57 files are not supported yet"));
+    EXPECT_THAT(loadError((dir / "missing.ply").string()),
+                HasSubstr("missing.ply: cannot open the file: No such file"));
+    EXPECT_THAT(loadError(dir.path().string()), HasSubstr("is a directory"));
+}
+
+TEST(ScanLoaderTest, SyntheticScenes) {
+    const LoadedScan sphere = loadScan("synthetic:sphere?points=500");
+    EXPECT_EQ(sphere.format, "synthetic");
+    ASSERT_EQ(sphere.cloud.size(), 500u);
+    for (std::size_t i = 0; i < sphere.cloud.size(); ++i) {
+        // Points are generated in double and stored as float: 1e-6 covers float rounding.
+        EXPECT_NEAR(glm::length(sphere.cloud.fileCoordinates(i)), 1.0, 1e-6);
+    }
+    EXPECT_THAT(loadError("synthetic:teapot"), HasSubstr("no built-in scene 'teapot'"));
+    EXPECT_THAT(loadError("synthetic:sphere?points=0"), HasSubstr("not a point count"));
+    EXPECT_THAT(loadError("synthetic:sphere?points=12x"), HasSubstr("not a point count"));
+    EXPECT_THAT(loadError("synthetic:sphere?size=3"),
+                HasSubstr("unknown synthetic scene parameter"));
+}
+
+}  // namespace
+}  // namespace subscan
