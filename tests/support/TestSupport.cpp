@@ -75,7 +75,8 @@ std::string readWhole(const std::filesystem::path& file) {
 
 }  // namespace
 
-CommandResult runSubscan(const std::vector<std::string>& arguments) {
+CommandResult runSubscan(const std::vector<std::string>& arguments,
+                         const std::vector<std::string>& environment) {
     const TempDir capture;
     const std::string outPath = (capture / "stdout").string();
     const std::string errPath = (capture / "stderr").string();
@@ -94,9 +95,26 @@ CommandResult runSubscan(const std::vector<std::string>& arguments) {
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, errPath.c_str(),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    std::vector<std::string> variables = environment;
+    for (char** entry = environ; *entry != nullptr; ++entry) {
+        const std::string_view existing(*entry);
+        const std::string_view name = existing.substr(0, existing.find('='));
+        const bool overridden = std::any_of(
+            environment.begin(), environment.end(),
+            [&](const std::string& added) { return added.starts_with(std::string(name) + "="); });
+        if (!overridden) {
+            variables.emplace_back(existing);
+        }
+    }
+    std::vector<char*> environmentPointers;
+    for (std::string& variable : variables) {
+        environmentPointers.push_back(variable.data());
+    }
+    environmentPointers.push_back(nullptr);
+
     pid_t pid = 0;
-    const int spawnError =
-        posix_spawn(&pid, argvPointers[0], &actions, nullptr, argvPointers.data(), environ);
+    const int spawnError = posix_spawn(&pid, argvPointers[0], &actions, nullptr,
+                                       argvPointers.data(), environmentPointers.data());
     posix_spawn_file_actions_destroy(&actions);
     if (spawnError != 0) {
         throw std::runtime_error(std::string("cannot start ") + SUBSCAN_EXECUTABLE);

@@ -47,7 +47,9 @@ struct CommandResult {
 };
 
 /// Runs the subscan executable built with this test, with `arguments`; never through a shell.
-CommandResult runSubscan(const std::vector<std::string>& arguments);
+/// `environment` entries ("NAME=value") are added to (or override) the test's environment.
+CommandResult runSubscan(const std::vector<std::string>& arguments,
+                         const std::vector<std::string>& environment = {});
 
 /// The shared real-scan folder ($SUBSCAN_TEST_DATA, else ../shared/data beside the checkout),
 /// or nullopt when it is absent (tests then GTEST_SKIP with a visible message).

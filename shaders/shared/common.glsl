@@ -1,0 +1,37 @@
+// Helpers shared by the passes. Include after #version.
+#include "shared/bindings.h"
+
+layout(std140, binding = SUBSCAN_UBO_FRAME) uniform FrameBlock {
+    FrameParams frame;
+};
+
+const float kInfinity = uintBitsToFloat(0x7F800000u);
+
+ivec2 imageSizeOfFrame() { return ivec2(frame.viewport.xy); }
+
+/// sRGB-encoded 0..1 -> linear (IEC 61966-2-1).
+vec3 srgbToLinear(vec3 c) {
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), greaterThan(c, vec3(0.04045)));
+}
+
+/// linear 0..1 -> sRGB-encoded.
+vec3 linearToSrgb(vec3 c) {
+    c = clamp(c, 0.0, 1.0);
+    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
+}
+
+/// Projects a view-space point to the pixel containing it (row 0 at the top) and its linear
+/// depth; false when it falls outside the image or the near/far range.
+bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
+    depth = -viewPosition.z;
+    if (!(depth >= frame.depthRange.x && depth <= frame.depthRange.y)) {
+        return false;
+    }
+    vec4 clip = frame.projection * vec4(viewPosition, 1.0);
+    vec2 ndc = clip.xy / clip.w;
+    vec2 window = vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
+    pixel = ivec2(floor(window));
+    return all(greaterThanEqual(pixel, ivec2(0))) && all(lessThan(pixel, imageSizeOfFrame()));
+}
+
+vec3 unpackColor(uint rgba8) { return srgbToLinear(unpackUnorm4x8(rgba8).rgb); }

@@ -1,0 +1,239 @@
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "app/cli/CommandSupport.h"
+#include "app/cli/Commands.h"
+#include "core/Error.h"
+#include "gpu/GlContext.h"
+#include "io/CameraJson.h"
+#include "io/Image.h"
+#include "render/Renderer.h"
+
+namespace subscan::cli {
+
+namespace {
+
+struct RenderOptions {
+    std::string source;
+    std::string output;
+    int width = 1280;
+    int height = 720;
+    std::string mode = "points";
+    std::optional<float> pointSize;
+    double yaw = 30.0;
+    double pitch = 20.0;
+    std::optional<double> distance;
+    std::string up = "auto";
+    double fovy = 45.0;
+    std::string cameraFile;
+    std::string background;
+    std::string exportDirectory;
+    std::string raster;
+    std::string settingsFile;
+    bool timings = false;
+    bool verbose = false;
+    bool software = false;
+};
+
+/// "R,G,B" with sRGB components in 0..1, or "#rrggbb".
+glm::vec3 parseBackground(const std::string& text) {
+    if (text.size() == 7 && text[0] == '#') {
+        const unsigned long value = std::stoul(text.substr(1), nullptr, 16);
+        return glm::vec3((value >> 16) & 255, (value >> 8) & 255, value & 255) / 255.0f;
+    }
+    glm::vec3 color;
+    char comma1 = 0, comma2 = 0;
+    std::istringstream stream(text);
+    stream >> color.r >> comma1 >> color.g >> comma2 >> color.b;
+    if (!stream || comma1 != ',' || comma2 != ',' || !stream.eof() ||
+        glm::any(glm::lessThan(color, glm::vec3(0.0f))) ||
+        glm::any(glm::greaterThan(color, glm::vec3(1.0f)))) {
+        throw Error(
+            fmt::format("--background '{}' is not R,G,B with values in 0..1 or #rrggbb", text));
+    }
+    return color;
+}
+
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ignored;
+    return std::filesystem::equivalent(a, b, ignored);
+}
+
+/// Per-pass median over `timed` frames after one warm-up (llvmpipe compiles shaders lazily and
+/// buffers are allocated on the first frame).
+std::vector<PassTiming> medianTimings(Renderer& renderer, const Camera& camera,
+                                      const RasterSettings& settings, int timed) {
+    renderer.render(camera, settings);
+    std::vector<std::vector<PassTiming>> frames;
+    for (int i = 0; i < timed; ++i) {
+        frames.push_back(renderer.render(camera, settings).passes);
+    }
+    std::vector<PassTiming> medians = frames.front();
+    for (std::size_t pass = 0; pass < medians.size(); ++pass) {
+        std::vector<double> values;
+        for (const auto& frame : frames) {
+            values.push_back(frame[pass].milliseconds);
+        }
+        std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+        medians[pass].milliseconds = values[values.size() / 2];
+    }
+    return medians;
+}
+
+void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
+                   const Camera& camera) {
+    std::error_code error;
+    std::filesystem::create_directories(directory, error);
+    if (error) {
+        throw Error(fmt::format("{}: cannot create the directory: {}", directory.string(),
+                                error.message()));
+    }
+    writeCameraFile(directory / "camera.json", camera);
+    const Texture& depthTexture = renderer.resources().texture("depth");
+    const std::vector<float> depth = depthTexture.readFloats();
+    writePfm(directory / "depth.pfm", {camera.width, camera.height, 1, depth});
+
+    // color.png: the rasterized colour, sRGB, alpha 0 where no point landed.
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
+    Image8 png{camera.width, camera.height, 4, {}};
+    png.pixels.resize(color.size());
+    for (std::size_t pixel = 0; pixel < depth.size(); ++pixel) {
+        for (int c = 0; c < 3; ++c) {
+            const float linear =
+                std::clamp(color[4 * pixel + static_cast<std::size_t>(c)], 0.0f, 1.0f);
+            const float encoded = linear <= 0.0031308f
+                                      ? 12.92f * linear
+                                      : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+            png.pixels[4 * pixel + static_cast<std::size_t>(c)] =
+                static_cast<std::uint8_t>(std::lround(encoded * 255.0f));
+        }
+        png.pixels[4 * pixel + 3] = std::isinf(depth[pixel]) ? 0 : 255;
+    }
+    writePng(directory / "color.png", png);
+}
+
+int runRender(const RenderOptions& options) {
+    const std::filesystem::path output = options.output;
+    if (!options.source.starts_with("synthetic:") && sameFile(output, options.source)) {
+        throw Error(
+            fmt::format("{}: refusing to write the image over the input scan", options.output));
+    }
+
+    RasterSettings settings;
+    if (!options.settingsFile.empty()) {
+        std::ifstream stream(options.settingsFile);
+        if (!stream) {
+            throw Error(fmt::format("{}: cannot open the settings file", options.settingsFile));
+        }
+        try {
+            const nlohmann::json json = nlohmann::json::parse(stream);
+            settings = json.value("raster", nlohmann::json::object()).get<RasterSettings>();
+        } catch (const nlohmann::json::exception& error) {
+            throw Error(
+                fmt::format("{}: invalid settings: {}", options.settingsFile, error.what()));
+        } catch (const Error& error) {
+            throw Error(fmt::format("{}: {}", options.settingsFile, error.what()));
+        }
+    }
+    settings.mode = parseRenderMode(options.mode);
+    if (options.pointSize) {
+        settings.pointSize = *options.pointSize;
+    }
+    if (!options.raster.empty()) {
+        settings.path = parseRasterPath(options.raster);
+    }
+    if (!options.background.empty()) {
+        settings.backgroundSrgb = parseBackground(options.background);
+    }
+
+    const LoadedScan scan = loadScanForCommand(options.source);
+    Camera camera;
+    if (!options.cameraFile.empty()) {
+        camera = readCameraFile(options.cameraFile);
+    } else {
+        OrbitView orbit;
+        orbit.yawDegrees = options.yaw;
+        orbit.pitchDegrees = options.pitch;
+        orbit.distance = options.distance;
+        orbit.up = options.up == "z" || (options.up == "auto" && scan.format == "las") ? UpAxis::Z
+                                                                                       : UpAxis::Y;
+        camera = orbitCamera(scan.cloud.bounds, orbit, options.width, options.height, options.fovy);
+    }
+
+    HeadlessContextOptions contextOptions;
+    contextOptions.preferHardware = !options.software;
+    const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
+    if (options.verbose) {
+        const GlCapabilities& caps = context->capabilities();
+        fmt::print(stderr, "subscan: OpenGL {} | {} | {}\n", caps.version, caps.vendor,
+                   caps.renderer);
+    }
+    Renderer renderer(*context, scan.cloud);
+    if (options.timings) {
+        const std::vector<PassTiming> timings = medianTimings(renderer, camera, settings, 3);
+        double total = 0.0;
+        for (const PassTiming& timing : timings) {
+            fmt::print("{:<20} {:9.3f} ms\n", timing.pass, timing.milliseconds);
+            total += timing.milliseconds;
+        }
+        fmt::print("{:<20} {:9.3f} ms\n", "total", total);
+    } else {
+        renderer.render(camera, settings);
+    }
+
+    if (!options.exportDirectory.empty()) {
+        exportBuffers(options.exportDirectory, renderer, camera);
+    }
+    writePng(output, {camera.width, camera.height, 4, renderer.readImage()});
+    return 0;
+}
+
+}  // namespace
+
+Command addRenderCommand(CLI::App& parent) {
+    auto options = std::make_shared<RenderOptions>();
+    CLI::App* render = parent.add_subcommand("render", "Render one image headless (EGL)");
+    render->add_option("scan", options->source, "Scan file, or synthetic:NAME")->required();
+    render->add_option("-o,--output", options->output, "PNG to write")->required();
+    render->add_option("--width", options->width, "Image width in pixels")
+        ->check(CLI::Range(1, 65536));
+    render->add_option("--height", options->height, "Image height in pixels")
+        ->check(CLI::Range(1, 65536));
+    render->add_option("--mode", options->mode, "points | points-gl | splats")
+        ->check(CLI::IsMember({"points", "points-gl", "splats"}));
+    render->add_option("--point-size", options->pointSize, "Splat size in pixels (splats mode)")
+        ->check(CLI::Range(1.0f, 64.0f));
+    render->add_option("--yaw", options->yaw, "Orbit angle around the up axis, degrees");
+    render->add_option("--pitch", options->pitch, "Orbit elevation, degrees")
+        ->check(CLI::Range(-90.0, 90.0));
+    render
+        ->add_option("--distance", options->distance,
+                     "Eye distance from the centre (scene units); default frames the bounds")
+        ->check(CLI::PositiveNumber);
+    render->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
+        ->check(CLI::IsMember({"auto", "y", "z"}));
+    render->add_option("--fovy", options->fovy, "Vertical field of view, degrees")
+        ->check(CLI::Range(1.0, 170.0));
+    render->add_option("--camera", options->cameraFile, "camera.json to render from")
+        ->check(CLI::ExistingFile);
+    render->add_option("--background", options->background, "R,G,B (sRGB 0..1) or #rrggbb");
+    render->add_option("--export-buffers", options->exportDirectory,
+                       "Directory for camera.json, depth.pfm, color.png");
+    render->add_option("--raster", options->raster, "Compute rasterizer: auto | int64 | two-pass")
+        ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
+    render->add_option("--settings", options->settingsFile, "Settings JSON (its \"raster\" part)");
+    render->add_flag("--timings", options->timings, "Print per-pass milliseconds");
+    render->add_flag("-v,--verbose", options->verbose, "Print the OpenGL renderer");
+    render->add_flag("--software", options->software,
+                     "Use Mesa's software rasterizer even when a GPU exists");
+    return {render, [options] { return runRender(*options); }};
+}
+
+}  // namespace subscan::cli

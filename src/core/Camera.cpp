@@ -1,0 +1,74 @@
+#include "core/Camera.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+namespace subscan {
+
+glm::dmat4 Camera::projection() const {
+    return glm::perspective(glm::radians(fovyDegrees),
+                            static_cast<double>(width) / static_cast<double>(height), nearPlane,
+                            farPlane);
+}
+
+double Camera::focalLengthPixels() const {
+    return 0.5 * static_cast<double>(height) / std::tan(0.5 * glm::radians(fovyDegrees));
+}
+
+glm::dvec3 Camera::eye() const {
+    return glm::dvec3(glm::inverse(view) * glm::dvec4(0, 0, 0, 1));
+}
+
+glm::dmat4 Camera::translation(const glm::dvec3& offset) {
+    return glm::translate(glm::dmat4(1.0), offset);
+}
+
+Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int height,
+                   double fovyDegrees) {
+    Camera camera;
+    camera.width = width;
+    camera.height = height;
+    camera.fovyDegrees = fovyDegrees;
+
+    const glm::dvec3 center = bounds.center();
+    // A flat or single-point cloud still needs a finite radius to frame.
+    const double radius =
+        std::max(0.5 * glm::length(bounds.extent()), 1e-9 * (1.0 + glm::length(center)));
+    const double halfFovy = 0.5 * glm::radians(fovyDegrees);
+    const double halfFovx =
+        std::atan(std::tan(halfFovy) * static_cast<double>(width) / static_cast<double>(height));
+    constexpr double kMargin = 1.05;
+    const double distance =
+        orbit.distance.value_or(kMargin * radius / std::sin(std::min(halfFovy, halfFovx)));
+
+    const double yaw = glm::radians(orbit.yawDegrees);
+    const double pitch = glm::radians(orbit.pitchDegrees);
+    glm::dvec3 direction;  // from the centre towards the eye
+    glm::dvec3 up;
+    if (orbit.up == UpAxis::Y) {
+        direction = {std::sin(yaw) * std::cos(pitch), std::sin(pitch),
+                     std::cos(yaw) * std::cos(pitch)};
+        up = {0, 1, 0};
+    } else {
+        direction = {std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch),
+                     std::sin(pitch)};
+        up = {0, 0, 1};
+    }
+    // Looking straight down the up axis leaves lookAt without a horizon: tilt the up vector.
+    if (std::abs(glm::dot(direction, up)) > 0.9999) {
+        up = orbit.up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+    }
+    camera.view = glm::lookAt(center + distance * direction, center, up);
+
+    const double margin = 0.02 * radius;
+    camera.farPlane = distance + radius + margin;
+    camera.nearPlane = std::max(distance - radius - margin, 1e-4 * camera.farPlane);
+    return camera;
+}
+
+}  // namespace subscan

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <optional>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "core/PointCloud.h"
+
+namespace subscan {
+
+/// A pinhole camera in the conventions of DESIGN.md §4: right-handed, looking down -Z in view
+/// space, Y up, OpenGL clip space. `view` maps the file's own coordinates to view space, in
+/// double so that UTM-sized coordinates lose nothing before the cloud's origin is folded in.
+struct Camera {
+    int width = 1280;
+    int height = 720;
+    double fovyDegrees = 45.0;
+    double nearPlane = 0.01;
+    double farPlane = 100.0;
+    glm::dmat4 view{1.0};
+
+    glm::dmat4 projection() const;
+    /// Pixels per unit of (view-space x or y) / depth: f = height / (2 tan(fovy / 2)).
+    double focalLengthPixels() const;
+    /// Eye position in file coordinates.
+    glm::dvec3 eye() const;
+    /// view * translate(origin): maps cloud-relative positions straight to view space.
+    glm::dmat4 viewFromCloud(const glm::dvec3& cloudOrigin) const {
+        return view * translation(cloudOrigin);
+    }
+
+    static glm::dmat4 translation(const glm::dvec3& offset);
+};
+
+enum class UpAxis { Y, Z };
+
+/// A camera orbiting the middle of `bounds`: yaw turns around the up axis, pitch raises the eye.
+/// Yaw 0, pitch 0 looks at the front: from +Z for Y-up data, from -Y for Z-up data (LiDAR).
+struct OrbitView {
+    double yawDegrees = 30.0;
+    double pitchDegrees = 20.0;
+    /// Eye distance from the centre; by default the bounds' sphere fills the view with a margin.
+    std::optional<double> distance;
+    UpAxis up = UpAxis::Y;
+};
+
+/// Frames `bounds` as `orbit` says; near and far hug the bounding sphere.
+Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int height,
+                   double fovyDegrees);
+
+}  // namespace subscan

@@ -1,0 +1,204 @@
+#pragma once
+
+// Move-only RAII wrappers over OpenGL 4.5 objects, created and used through direct state access
+// (no bind-to-edit). Each object carries a debug label so GPU debuggers show names.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+namespace subscan {
+
+class ShaderSources;
+
+/// Owns one GL object name; `Traits::destroy(GLuint)` deletes it.
+template <class Traits>
+class GlName {
+  public:
+    GlName() = default;
+    explicit GlName(GLuint id) : id_(id) {}
+    ~GlName() {
+        if (id_ != 0) {
+            Traits::destroy(id_);
+        }
+    }
+    GlName(GlName&& other) noexcept : id_(std::exchange(other.id_, 0)) {}
+    GlName& operator=(GlName&& other) noexcept {
+        if (this != &other) {
+            if (id_ != 0) {
+                Traits::destroy(id_);
+            }
+            id_ = std::exchange(other.id_, 0);
+        }
+        return *this;
+    }
+    GlName(const GlName&) = delete;
+    GlName& operator=(const GlName&) = delete;
+
+    GLuint id() const { return id_; }
+    explicit operator bool() const { return id_ != 0; }
+
+  private:
+    GLuint id_ = 0;
+};
+
+struct BufferTraits {
+    static void destroy(GLuint id) { glDeleteBuffers(1, &id); }
+};
+struct TextureTraits {
+    static void destroy(GLuint id) { glDeleteTextures(1, &id); }
+};
+struct ProgramTraits {
+    static void destroy(GLuint id) { glDeleteProgram(id); }
+};
+struct FramebufferTraits {
+    static void destroy(GLuint id) { glDeleteFramebuffers(1, &id); }
+};
+struct VertexArrayTraits {
+    static void destroy(GLuint id) { glDeleteVertexArrays(1, &id); }
+};
+struct QueryTraits {
+    static void destroy(GLuint id) { glDeleteQueries(1, &id); }
+};
+
+/// Immutable-storage buffer (glNamedBufferStorage) that can be updated and read back.
+class Buffer {
+  public:
+    Buffer() = default;
+    /// `data` may be null (contents undefined until written). Throws subscan::Error when the
+    /// driver cannot allocate it.
+    Buffer(std::size_t bytes, const void* data, std::string_view label);
+
+    template <class T>
+    static Buffer fromSpan(std::span<const T> values, std::string_view label) {
+        return Buffer(values.size_bytes(), values.data(), label);
+    }
+
+    GLuint id() const { return name_.id(); }
+    std::size_t size() const { return size_; }
+
+    void upload(std::size_t offset, std::size_t bytes, const void* data);
+    void download(std::size_t offset, std::size_t bytes, void* data) const;
+    /// Fills every 32-bit word with `value`.
+    void fill(std::uint32_t value);
+
+    void bindStorage(GLuint binding) const;
+    void bindUniform(GLuint binding) const;
+
+    template <class T>
+    std::vector<T> read() const {
+        std::vector<T> values(size_ / sizeof(T));
+        download(0, values.size() * sizeof(T), values.data());
+        return values;
+    }
+
+  private:
+    GlName<BufferTraits> name_;
+    std::size_t size_ = 0;
+};
+
+/// A uniform buffer holding exactly one T (a struct from shaders/shared/bindings.h).
+template <class T>
+class UniformBlock {
+  public:
+    explicit UniformBlock(std::string_view label) : buffer_(sizeof(T), nullptr, label) {}
+    void set(const T& value) { buffer_.upload(0, sizeof(T), &value); }
+    void bind(GLuint binding) const { buffer_.bindUniform(binding); }
+
+  private:
+    Buffer buffer_;
+};
+
+enum class TextureFormat { R32F, RG32F, RGBA16F, RGBA32F, RGBA8, R32UI, R8, Depth32F };
+
+/// 2-D texture with immutable storage and `levels` mip levels.
+class Texture {
+  public:
+    Texture() = default;
+    Texture(TextureFormat format, int width, int height, int levels, std::string_view label);
+
+    GLuint id() const { return name_.id(); }
+    TextureFormat format() const { return format_; }
+    int width(int level = 0) const;
+    int height(int level = 0) const;
+    int levels() const { return levels_; }
+    int channels() const;
+
+    void bindImage(GLuint unit, int level, GLenum access) const;
+    void bindSampler(GLuint unit) const;
+    /// Sets every texel of `level` to `value` (as many components as the format has).
+    void clear(int level, const float value[4]);
+    void clearUint(int level, std::uint32_t value);
+
+    /// Texel values of `level`, row 0 first, `channels()` floats per texel (float formats; RGBA8
+    /// and R8 come back normalised to 0..1).
+    std::vector<float> readFloats(int level = 0) const;
+    std::vector<std::uint32_t> readUints(int level = 0) const;
+    std::vector<std::uint8_t> readRgba8(int level = 0) const;
+    void uploadFloats(int level, std::span<const float> values);
+
+  private:
+    GlName<TextureTraits> name_;
+    TextureFormat format_ = TextureFormat::RGBA8;
+    int width_ = 0;
+    int height_ = 0;
+    int levels_ = 0;
+};
+
+/// A linked shader program built from embedded sources.
+class Program {
+  public:
+    Program() = default;
+    static Program compute(const ShaderSources& sources, std::string_view path,
+                           std::string_view defines = {});
+    static Program graphics(const ShaderSources& sources, std::string_view vertexPath,
+                            std::string_view fragmentPath, std::string_view defines = {});
+
+    GLuint id() const { return name_.id(); }
+    void use() const { glUseProgram(name_.id()); }
+    /// glDispatchCompute with enough groups of `groupSize` to cover `count` threads along x.
+    static void dispatch1D(std::uint64_t count, std::uint32_t groupSize);
+    static void dispatch2D(int width, int height, int groupSizeX, int groupSizeY);
+
+  private:
+    explicit Program(GLuint id) : name_(id) {}
+    GlName<ProgramTraits> name_;
+};
+
+class Framebuffer {
+  public:
+    Framebuffer() = default;
+    /// Colour attachments in order, plus an optional depth texture; checks completeness.
+    Framebuffer(std::span<const Texture* const> colors, const Texture* depth,
+                std::string_view label);
+    GLuint id() const { return name_.id(); }
+
+  private:
+    GlName<FramebufferTraits> name_;
+};
+
+class VertexArray {
+  public:
+    VertexArray();
+    GLuint id() const { return name_.id(); }
+
+  private:
+    GlName<VertexArrayTraits> name_;
+};
+
+/// GL_TIME_ELAPSED query.
+class TimerQuery {
+  public:
+    TimerQuery();
+    GLuint id() const { return name_.id(); }
+
+  private:
+    GlName<QueryTraits> name_;
+};
+
+}  // namespace subscan

@@ -1,0 +1,110 @@
+#include "io/CameraJson.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "io/AtomicFile.h"
+
+namespace subscan {
+
+namespace {
+
+nlohmann::json rowMajor(const glm::dmat4& matrix) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (int row = 0; row < 4; ++row) {
+        rows.push_back({matrix[0][row], matrix[1][row], matrix[2][row], matrix[3][row]});
+    }
+    return rows;
+}
+
+template <class T>
+T required(const nlohmann::json& json, const char* key) {
+    if (!json.contains(key)) {
+        throw Error(fmt::format("the camera has no '{}'", key));
+    }
+    try {
+        return json.at(key).get<T>();
+    } catch (const nlohmann::json::exception&) {
+        throw Error(fmt::format("the camera's '{}' has the wrong type", key));
+    }
+}
+
+}  // namespace
+
+nlohmann::json cameraToJson(const Camera& camera) {
+    return {
+        {"width", camera.width},
+        {"height", camera.height},
+        {"fovy_deg", camera.fovyDegrees},
+        {"near", camera.nearPlane},
+        {"far", camera.farPlane},
+        {"view", rowMajor(camera.view)},
+        {"projection", rowMajor(camera.projection())},
+    };
+}
+
+Camera cameraFromJson(const nlohmann::json& json) {
+    if (!json.is_object()) {
+        throw Error("the camera is not a JSON object");
+    }
+    Camera camera;
+    camera.width = required<int>(json, "width");
+    camera.height = required<int>(json, "height");
+    camera.fovyDegrees = required<double>(json, "fovy_deg");
+    camera.nearPlane = required<double>(json, "near");
+    camera.farPlane = required<double>(json, "far");
+    if (camera.width < 1 || camera.height < 1 || camera.width > 65536 || camera.height > 65536) {
+        throw Error(
+            fmt::format("the camera size {}x{} is outside 1..65536", camera.width, camera.height));
+    }
+    if (!(camera.fovyDegrees > 0.0 && camera.fovyDegrees < 180.0)) {
+        throw Error(
+            fmt::format("the camera's fovy_deg {} is outside (0, 180)", camera.fovyDegrees));
+    }
+    if (!(camera.nearPlane > 0.0 && camera.farPlane > camera.nearPlane &&
+          std::isfinite(camera.farPlane))) {
+        throw Error("the camera needs 0 < near < far (finite)");
+    }
+    const auto rows = required<std::vector<std::vector<double>>>(json, "view");
+    if (rows.size() != 4) {
+        throw Error("the camera's 'view' needs 4 rows of 4 numbers");
+    }
+    for (int row = 0; row < 4; ++row) {
+        if (rows[static_cast<std::size_t>(row)].size() != 4) {
+            throw Error("the camera's 'view' needs 4 rows of 4 numbers");
+        }
+        for (int column = 0; column < 4; ++column) {
+            const double value =
+                rows[static_cast<std::size_t>(row)][static_cast<std::size_t>(column)];
+            if (!std::isfinite(value)) {
+                throw Error("the camera's 'view' holds a non-finite number");
+            }
+            camera.view[column][row] = value;
+        }
+    }
+    return camera;
+}
+
+void writeCameraFile(const std::filesystem::path& path, const Camera& camera) {
+    writeFileAtomically(path, cameraToJson(camera).dump(2) + "\n");
+}
+
+Camera readCameraFile(const std::filesystem::path& path) {
+    std::ifstream stream(path);
+    if (!stream) {
+        throw Error(fmt::format("{}: cannot open the camera file", path.string()));
+    }
+    try {
+        return cameraFromJson(nlohmann::json::parse(stream));
+    } catch (const nlohmann::json::parse_error& error) {
+        throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), error.byte));
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", path.string(), error.what()));
+    }
+}
+
+}  // namespace subscan

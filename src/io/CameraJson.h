@@ -1,0 +1,21 @@
+#pragma once
+
+#include <filesystem>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/Camera.h"
+
+namespace subscan {
+
+/// camera.json (DESIGN.md §4): width, height, fovy_deg, near, far, `view` (file coordinates ->
+/// view space) and `projection` (view -> clip), both as 4 rows of 4 numbers (row-major).
+nlohmann::json cameraToJson(const Camera& camera);
+/// Validates every field; `projection` is not read back (it follows from fovy, near, far and
+/// the image size). Throws subscan::Error naming the field.
+Camera cameraFromJson(const nlohmann::json& json);
+
+void writeCameraFile(const std::filesystem::path& path, const Camera& camera);
+Camera readCameraFile(const std::filesystem::path& path);
+
+}  // namespace subscan

@@ -1,0 +1,84 @@
+#include "render/GpuPointCloud.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+#include "shared/bindings.h"
+
+namespace subscan {
+
+namespace {
+
+std::uint32_t pack(Rgba8 color) {
+    return static_cast<std::uint32_t>(color.r) | static_cast<std::uint32_t>(color.g) << 8 |
+           static_cast<std::uint32_t>(color.b) << 16 | static_cast<std::uint32_t>(color.a) << 24;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> displayColors(const PointCloud& cloud) {
+    std::vector<std::uint32_t> packed(cloud.size());
+    if (cloud.hasColors()) {
+        std::transform(cloud.colors.begin(), cloud.colors.end(), packed.begin(), pack);
+        return packed;
+    }
+    constexpr std::uint8_t kNeutral = 200;
+    if (!cloud.hasIntensities()) {
+        std::fill(packed.begin(), packed.end(), pack({kNeutral, kNeutral, kNeutral, 255}));
+        return packed;
+    }
+    // Percentiles from a sample: intensity ranges differ wildly between scanners.
+    std::vector<float> sample;
+    const std::size_t step = std::max<std::size_t>(1, cloud.size() / 100000);
+    for (std::size_t i = 0; i < cloud.size(); i += step) {
+        sample.push_back(cloud.intensities[i]);
+    }
+    std::sort(sample.begin(), sample.end());
+    const float low = sample[sample.size() / 100];
+    const float high = sample[sample.size() - 1 - sample.size() / 100];
+    const float range = high > low ? high - low : 1.0f;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const float t = std::clamp((cloud.intensities[i] - low) / range, 0.0f, 1.0f);
+        const auto grey = static_cast<std::uint8_t>(std::lround(40.0f + 215.0f * t));
+        packed[i] = pack({grey, grey, grey, 255});
+    }
+    return packed;
+}
+
+GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
+                             std::size_t maxChunkPoints)
+    : size_(cloud.size()), origin_(cloud.origin) {
+    // A chunk must fit one storage binding (positions are the larger array) and one dispatch.
+    const std::size_t byBinding = capabilities.maxStorageBlockBytes / (3 * sizeof(float));
+    const std::size_t byDispatch =
+        static_cast<std::size_t>(capabilities.maxComputeWorkGroupsX) * SUBSCAN_POINTS_GROUP_SIZE;
+    std::size_t chunkPoints = std::min({byBinding, byDispatch, std::size_t{1} << 26});
+    if (maxChunkPoints > 0) {
+        chunkPoints = std::min(chunkPoints, maxChunkPoints);
+    }
+    if (chunkPoints == 0) {
+        throw Error("the OpenGL driver reports no room for shader storage buffers");
+    }
+    const std::vector<std::uint32_t> colors = displayColors(cloud);
+    for (std::size_t first = 0; first < size_; first += chunkPoints) {
+        Chunk chunk;
+        chunk.firstPoint = static_cast<std::uint32_t>(first);
+        chunk.pointCount = static_cast<std::uint32_t>(std::min(chunkPoints, size_ - first));
+        try {
+            chunk.positions = Buffer(chunk.pointCount * 3 * sizeof(float), &cloud.positions[first],
+                                     "points.positions");
+            chunk.colors =
+                Buffer(chunk.pointCount * sizeof(std::uint32_t), &colors[first], "points.colors");
+        } catch (const Error& error) {
+            throw Error(fmt::format("the GPU cannot hold the {} points ({:.0f} MB): {}", size_,
+                                    static_cast<double>(bytes()) / 1e6, error.what()));
+        }
+        chunks_.push_back(std::move(chunk));
+    }
+}
+
+}  // namespace subscan

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/PointCloud.h"
+#include "gpu/GlContext.h"
+#include "gpu/GlObjects.h"
+
+namespace subscan {
+
+/// A point cloud on the GPU, split into chunks that each fit one shader storage binding and one
+/// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8.
+class GpuPointCloud {
+  public:
+    struct Chunk {
+        std::uint32_t firstPoint = 0;
+        std::uint32_t pointCount = 0;
+        Buffer positions;
+        Buffer colors;
+    };
+
+    /// `maxChunkPoints` 0 = as large as the driver allows; tests pass small values to exercise
+    /// chunking. Throws subscan::Error when the GPU cannot hold the cloud.
+    GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
+                  std::size_t maxChunkPoints = 0);
+
+    const std::vector<Chunk>& chunks() const { return chunks_; }
+    std::size_t size() const { return size_; }
+    const glm::dvec3& origin() const { return origin_; }
+    std::size_t bytes() const { return size_ * (3 * sizeof(float) + sizeof(std::uint32_t)); }
+
+  private:
+    std::vector<Chunk> chunks_;
+    std::size_t size_ = 0;
+    glm::dvec3 origin_{0.0};
+};
+
+/// The colour each point is drawn with: its own, else its intensity as grey (stretched between
+/// the 1st and 99th percentile), else a neutral light grey. Packed sRGB RGBA8.
+std::vector<std::uint32_t> displayColors(const PointCloud& cloud);
+
+}  // namespace subscan

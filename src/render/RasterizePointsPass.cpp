@@ -1,0 +1,127 @@
+#include "render/RasterizePointsPass.h"
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+
+namespace subscan {
+
+namespace {
+
+std::string stageDefines(bool depth, bool index, bool int64, bool resolve, bool useInt64) {
+    return fmt::format(
+        "#define STAGE_DEPTH {}\n#define STAGE_INDEX {}\n#define STAGE_INT64 {}\n"
+        "#define STAGE_RESOLVE {}\n#define USE_INT64 {}\n",
+        int(depth), int(index), int(int64), int(resolve), int(useInt64));
+}
+
+constexpr std::uint32_t kEmptyIndex = 0xFFFFFFFFu;
+constexpr std::uint32_t kInfinityBits = 0x7F800000u;
+
+}  // namespace
+
+RasterizePointsPass::RasterizePointsPass(const ShaderSources& sources,
+                                         const GlCapabilities& capabilities) {
+    constexpr std::string_view kShader = "render/RasterizePoints.comp";
+    depthStage_ =
+        Program::compute(sources, kShader, stageDefines(true, false, false, false, false));
+    indexStage_ =
+        Program::compute(sources, kShader, stageDefines(false, true, false, false, false));
+    resolve32_ = Program::compute(sources, kShader, stageDefines(false, false, false, true, false));
+    if (capabilities.int64Atomics) {
+        int64Stage_ =
+            Program::compute(sources, kShader, stageDefines(false, false, true, false, true));
+        resolve64_ =
+            Program::compute(sources, kShader, stageDefines(false, false, false, true, true));
+    }
+}
+
+RasterPath RasterizePointsPass::resolvePath(RasterPath requested,
+                                            const GlCapabilities& capabilities) {
+    if (requested == RasterPath::Int64 && !capabilities.int64Atomics) {
+        throw Error(
+            fmt::format("the 64-bit rasterizer needs GL_NV_shader_atomic_int64, which {} "
+                        "does not offer (use --raster two-pass or auto)",
+                        capabilities.renderer));
+    }
+    if (requested == RasterPath::Auto) {
+        return capabilities.int64Atomics ? RasterPath::Int64 : RasterPath::TwoPass32;
+    }
+    return requested;
+}
+
+void RasterizePointsPass::ensurePixelBuffers(std::size_t pixels, bool int64) {
+    if (int64) {
+        if (depthIndex_.size() != pixels * sizeof(std::uint64_t)) {
+            depthIndex_ = Buffer(pixels * sizeof(std::uint64_t), nullptr, "RasterizePoints.key");
+        }
+        return;
+    }
+    if (depthBits_.size() != pixels * sizeof(std::uint32_t)) {
+        depthBits_ = Buffer(pixels * sizeof(std::uint32_t), nullptr, "RasterizePoints.depth");
+        pointIndex_ = Buffer(pixels * sizeof(std::uint32_t), nullptr, "RasterizePoints.index");
+    }
+}
+
+void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& frame, bool perPixel) {
+    program.use();
+    const std::size_t pixels = static_cast<std::size_t>(frame.camera.width) *
+                               static_cast<std::size_t>(frame.camera.height);
+    for (const GpuPointCloud::Chunk& chunk : frame.cloud.chunks()) {
+        params_.set({chunk.firstPoint, chunk.pointCount, static_cast<std::uint32_t>(pixels), 0});
+        params_.bind(SUBSCAN_UBO_PASS);
+        chunk.positions.bindStorage(SUBSCAN_SSBO_POSITIONS);
+        chunk.colors.bindStorage(SUBSCAN_SSBO_COLORS);
+        if (perPixel) {
+            Program::dispatch2D(frame.camera.width, frame.camera.height, SUBSCAN_IMAGE_GROUP_SIZE,
+                                SUBSCAN_IMAGE_GROUP_SIZE);
+        } else {
+            Program::dispatch1D(chunk.pointCount, SUBSCAN_POINTS_GROUP_SIZE);
+        }
+    }
+}
+
+std::vector<std::uint32_t> RasterizePointsPass::readWinners() const {
+    if (!lastFrameInt64_) {
+        return pointIndex_.read<std::uint32_t>();
+    }
+    const std::vector<std::uint64_t> keys = depthIndex_.read<std::uint64_t>();
+    std::vector<std::uint32_t> winners(keys.size());
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        winners[i] = static_cast<std::uint32_t>(keys[i] & 0xFFFFFFFFu);
+    }
+    return winners;
+}
+
+void RasterizePointsPass::execute(FrameContext& frame) {
+    const int width = frame.camera.width;
+    const int height = frame.camera.height;
+    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    const bool int64 = resolvePath(frame.raster.path, frame.capabilities) == RasterPath::Int64;
+    lastFrameInt64_ = int64;
+    ensurePixelBuffers(pixels, int64);
+    Texture& depth = frame.resources.ensureTexture("depth", TextureFormat::R32F, width, height);
+    Texture& color = frame.resources.ensureTexture("color", TextureFormat::RGBA16F, width, height);
+
+    if (int64) {
+        depthIndex_.fill(kEmptyIndex);  // both halves all ones: no depth, no point
+        depthIndex_.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
+        runPerChunk(int64Stage_, frame, false);
+    } else {
+        depthBits_.fill(kInfinityBits);
+        pointIndex_.fill(kEmptyIndex);
+        depthBits_.bindStorage(SUBSCAN_SSBO_DEPTH_BITS);
+        pointIndex_.bindStorage(SUBSCAN_SSBO_POINT_INDEX);
+        runPerChunk(depthStage_, frame, false);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        runPerChunk(indexStage_, frame, false);
+    }
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    depth.bindImage(SUBSCAN_IMAGE_OUT0, 0, GL_WRITE_ONLY);
+    color.bindImage(SUBSCAN_IMAGE_OUT1, 0, GL_WRITE_ONLY);
+    runPerChunk(int64 ? resolve64_ : resolve32_, frame, true);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+}  // namespace subscan

@@ -1,0 +1,47 @@
+#pragma once
+
+#include "gpu/GlObjects.h"
+#include "gpu/ShaderSources.h"
+#include "render/RenderPass.h"
+#include "shared/bindings.h"
+
+namespace subscan {
+
+/// Compute rasterization of 1-pixel points (DESIGN.md §5.1): per pixel the nearest point,
+/// ties to the smaller index. Writes "depth" (R32F linear depth, +inf where empty) and "color"
+/// (RGBA16F linear). One 64-bit atomicMin pass where the driver has 64-bit atomics, else two
+/// 32-bit passes (depth, then index among points at that depth); both give the same winner.
+class RasterizePointsPass final : public RenderPass {
+  public:
+    RasterizePointsPass(const ShaderSources& sources, const GlCapabilities& capabilities);
+
+    std::string_view name() const override { return "RasterizePoints"; }
+    std::vector<std::string_view> inputs() const override { return {}; }
+    std::vector<std::string_view> outputs() const override { return {"depth", "color"}; }
+    void execute(FrameContext& frame) override;
+
+    /// The path `requested` resolves to on this driver; throws subscan::Error when Int64 is
+    /// forced without 64-bit atomics.
+    static RasterPath resolvePath(RasterPath requested, const GlCapabilities& capabilities);
+
+    /// The winning point index per pixel of the last frame (0xFFFFFFFF where empty), row 0 at
+    /// the top: for checking the rasterizer against a CPU reference.
+    std::vector<std::uint32_t> readWinners() const;
+
+  private:
+    void ensurePixelBuffers(std::size_t pixels, bool int64);
+    void runPerChunk(const Program& program, FrameContext& frame, bool perPixel);
+
+    Program depthStage_;
+    Program indexStage_;
+    Program resolve32_;
+    Program int64Stage_;  // only where 64-bit atomics exist
+    Program resolve64_;
+    UniformBlock<gpu::RasterParams> params_{"RasterizePoints.params"};
+    Buffer depthBits_;
+    Buffer pointIndex_;
+    Buffer depthIndex_;
+    bool lastFrameInt64_ = false;
+};
+
+}  // namespace subscan

@@ -1,0 +1,248 @@
+// The compute rasterizer (both paths), the GL_POINTS baseline and Present against a CPU
+// reference of the same rule: per pixel the nearest point, ties to the smaller index.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/matrix.hpp>
+
+#include "core/Camera.h"
+#include "core/Error.h"
+#include "render/Renderer.h"
+#include "support/GlTestSupport.h"
+
+namespace subscan {
+namespace {
+
+constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
+
+Camera smallCamera() {
+    Camera camera;
+    camera.width = 37;  // odd sizes catch row/column mix-ups
+    camera.height = 23;
+    camera.fovyDegrees = 50.0;
+    camera.nearPlane = 0.5;
+    camera.farPlane = 20.0;
+    camera.view = glm::lookAt(glm::dvec3(0.3, -0.2, 5.0), glm::dvec3(0.0), glm::dvec3(0, 1, 0));
+    return camera;
+}
+
+/// A point in file coordinates that projects inside pixel (x, y) (row 0 at the top), away from
+/// its edges by at least 0.2 px, at linear depth `depth`.
+glm::dvec3 pointAtPixel(const Camera& camera, double x, double y, double depth) {
+    const double tanHalf = std::tan(0.5 * glm::radians(camera.fovyDegrees));
+    const double aspect = static_cast<double>(camera.width) / camera.height;
+    const double ndcX = 2.0 * x / camera.width - 1.0;
+    const double ndcY = 1.0 - 2.0 * y / camera.height;
+    const glm::dvec4 view(ndcX * depth * tanHalf * aspect, ndcY * depth * tanHalf, -depth, 1.0);
+    return glm::dvec3(glm::inverse(camera.view) * view);
+}
+
+struct Reference {
+    std::vector<std::uint32_t> winner;  // per pixel
+    std::vector<double> depth;
+};
+
+/// The CPU reference: projects the stored (float, cloud-relative) positions in double with the
+/// README's pixel convention.
+Reference rasterizeOnCpu(const PointCloud& cloud, const Camera& camera) {
+    const std::size_t pixels = static_cast<std::size_t>(camera.width * camera.height);
+    Reference reference{std::vector<std::uint32_t>(pixels, kEmpty),
+                        std::vector<double>(pixels, std::numeric_limits<double>::infinity())};
+    const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
+    const glm::dmat4 projection = camera.projection();
+    for (std::uint32_t i = 0; i < cloud.size(); ++i) {
+        const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(cloud.positions[i]), 1.0);
+        const double depth = -view.z;
+        if (depth < camera.nearPlane || depth > camera.farPlane) {
+            continue;
+        }
+        const glm::dvec4 clip = projection * view;
+        const double x = std::floor((clip.x / clip.w + 1.0) * 0.5 * camera.width);
+        const double y = std::floor((1.0 - clip.y / clip.w) * 0.5 * camera.height);
+        if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
+            continue;
+        }
+        const std::size_t pixel =
+            static_cast<std::size_t>(y) * camera.width + static_cast<std::size_t>(x);
+        if (depth < reference.depth[pixel]) {  // equal depth keeps the earlier (smaller) index
+            reference.depth[pixel] = depth;
+            reference.winner[pixel] = i;
+        }
+    }
+    return reference;
+}
+
+/// ~4 points per covered pixel at well-separated depths, exact duplicates (depth ties), and
+/// points outside the image and outside near/far.
+PointCloud testCloud(const Camera& camera, std::uint32_t seed) {
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> jitter(0.2, 0.8);
+    // Every point its own depth on a 1.5 mm grid: distinct depths differ far beyond float
+    // rounding (~1e-6), so only the deliberate duplicates below tie.
+    std::vector<int> depthSteps(3000);
+    std::iota(depthSteps.begin(), depthSteps.end(), 0);
+    std::shuffle(depthSteps.begin(), depthSteps.end(), random);
+    PointCloudBuilder builder({.color = true}, 4000);
+    auto add = [&](const glm::dvec3& position) {
+        PointRecord record;
+        record.position = position;
+        const auto value = static_cast<std::uint32_t>(random());
+        record.color = {static_cast<std::uint8_t>(value), static_cast<std::uint8_t>(value >> 8),
+                        static_cast<std::uint8_t>(value >> 16), 255};
+        builder.add(record);
+    };
+    for (int i = 0; i < 3000; ++i) {
+        const int x = static_cast<int>(random() % camera.width);
+        const int y = static_cast<int>(random() % camera.height);
+        const double depth = 1.0 + 0.0015 * depthSteps[static_cast<std::size_t>(i)];
+        const glm::dvec3 p = pointAtPixel(camera, x + jitter(random), y + jitter(random), depth);
+        add(p);
+        if (i % 7 == 0) {
+            add(p);  // an exact duplicate: same depth bits, the smaller index must win
+        }
+    }
+    add(pointAtPixel(camera, -3.5, 4.5, 3.0));                  // left of the image
+    add(pointAtPixel(camera, 10.5, camera.height + 2.5, 3.0));  // below it
+    add(pointAtPixel(camera, 5.5, 5.5, 0.3));                   // nearer than near
+    add(pointAtPixel(camera, 6.5, 6.5, 25.0));                  // beyond far
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
+void expectMatchesReference(Renderer& renderer, const PointCloud& cloud, const Camera& camera,
+                            const Reference& reference) {
+    const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners();
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
+    std::size_t covered = 0;
+    for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
+        ASSERT_EQ(winners[pixel], reference.winner[pixel]) << "pixel " << pixel;
+        if (reference.winner[pixel] == kEmpty) {
+            EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+            continue;
+        }
+        ++covered;
+        // The GPU transforms in float: a few ulp of a depth around 5 is ~1e-6.
+        EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel]);
+        const Rgba8 expected = cloud.colors[reference.winner[pixel]];
+        const std::uint8_t channels[3] = {expected.r, expected.g, expected.b};
+        for (int c = 0; c < 3; ++c) {
+            // RGBA16F keeps 11 significant bits: 1e-3 relative, plus the sRGB curve's rounding.
+            EXPECT_NEAR(color[4 * pixel + c], srgbToLinear(channels[c] / 255.0f), 2e-3);
+        }
+    }
+    EXPECT_GT(covered, reference.winner.size() / 2);  // the test cloud covers most pixels
+}
+
+TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
+    GlContext& context = test::glTestContext();
+    const Camera camera = smallCamera();
+    const PointCloud cloud = testCloud(camera, 1);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+
+    std::vector<RasterPath> paths{RasterPath::TwoPass32};
+    if (context.capabilities().int64Atomics) {
+        paths.push_back(RasterPath::Int64);
+    } else {
+        std::printf("note: %s has no 64-bit atomics; the int64 path is tested where it does\n",
+                    context.capabilities().renderer.c_str());
+    }
+    for (const RasterPath path : paths) {
+        for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
+            SCOPED_TRACE(toString(path) + (chunk ? ", chunks of 97" : ", one chunk"));
+            Renderer renderer(context, cloud, chunk);
+            RasterSettings settings;
+            settings.path = path;
+            renderer.render(camera, settings);
+            expectMatchesReference(renderer, cloud, camera, reference);
+        }
+    }
+}
+
+TEST(RasterizePointsGLTest, ForcingInt64WithoutSupportIsAClearError) {
+    GlContext& context = test::glTestContext();
+    if (context.capabilities().int64Atomics) {
+        GTEST_SKIP() << "this driver has 64-bit atomics";
+    }
+    const Camera camera = smallCamera();
+    Renderer renderer(context, testCloud(camera, 2));
+    RasterSettings settings;
+    settings.path = RasterPath::Int64;
+    EXPECT_THROW(renderer.render(camera, settings), Error);
+}
+
+TEST(RasterizePointsGLTest, GlPointsBaselineSeesTheSameNearestPoints) {
+    GlContext& context = test::glTestContext();
+    const Camera camera = smallCamera();
+    const PointCloud cloud = testCloud(camera, 3);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+    Renderer renderer(context, cloud, 500);
+    RasterSettings settings;
+    settings.mode = RenderMode::PointsGl;
+    renderer.render(camera, settings);
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    for (std::size_t pixel = 0; pixel < reference.depth.size(); ++pixel) {
+        if (std::isinf(reference.depth[pixel])) {
+            EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+        } else {
+            // Same float transform as the compute path: ~1e-6 relative.
+            EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel])
+                << "pixel " << pixel;
+        }
+    }
+}
+
+TEST(RasterizePointsGLTest, SplatsCoverTheirSquare) {
+    GlContext& context = test::glTestContext();
+    Camera camera = smallCamera();
+    PointCloudBuilder builder({}, 1);
+    builder.add({pointAtPixel(camera, 18.5, 11.5, 4.0)});
+    std::vector<std::string> warnings;
+    Renderer renderer(context, builder.finish(warnings));
+    RasterSettings settings;
+    settings.mode = RenderMode::Splats;
+    settings.pointSize = 5.0f;
+    renderer.render(camera, settings);
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    for (int y = 0; y < camera.height; ++y) {
+        for (int x = 0; x < camera.width; ++x) {
+            const bool inside = std::abs(x - 18) <= 2 && std::abs(y - 11) <= 2;
+            EXPECT_EQ(std::isfinite(depth[y * camera.width + x]), inside) << x << "," << y;
+        }
+    }
+}
+
+TEST(RasterizePointsGLTest, PresentEncodesSrgbAndFillsTheBackground) {
+    GlContext& context = test::glTestContext();
+    const Camera camera = smallCamera();
+    const PointCloud cloud = testCloud(camera, 4);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+    Renderer renderer(context, cloud);
+    RasterSettings settings;
+    settings.backgroundSrgb = {0.2f, 0.4f, 0.6f};
+    renderer.render(camera, settings);
+    const std::vector<std::uint8_t> image = renderer.readImage();
+    for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
+        std::uint8_t expected[3] = {51, 102, 153};  // the background, 0.2/0.4/0.6 of 255
+        if (reference.winner[pixel] != kEmpty) {
+            const Rgba8 c = cloud.colors[reference.winner[pixel]];
+            expected[0] = c.r;
+            expected[1] = c.g;
+            expected[2] = c.b;
+        }
+        for (int c = 0; c < 3; ++c) {
+            // sRGB -> linear half float -> sRGB round-trips within one 8-bit step.
+            EXPECT_NEAR(image[4 * pixel + c], expected[c], 1) << "pixel " << pixel;
+        }
+        EXPECT_EQ(image[4 * pixel + 3], 255);
+    }
+}
+
+}  // namespace
+}  // namespace subscan

@@ -1,0 +1,265 @@
+// `subscan render` end to end: the exported buffers can be reproduced from the scan and
+// camera.json alone, far-from-origin clouds render without quantisation, and bad requests fail
+// with one sentence and no output file.
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/matrix.hpp>
+#include <nlohmann/json.hpp>
+
+#include "io/Image.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::runSubscan;
+using ::testing::HasSubstr;
+
+constexpr int kWidth = 61;
+constexpr int kHeight = 47;
+
+/// A camera for the test, written as camera.json by hand (row-major rows).
+nlohmann::json cameraJson(const glm::dmat4& view) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (int r = 0; r < 4; ++r) {
+        rows.push_back({view[0][r], view[1][r], view[2][r], view[3][r]});
+    }
+    return {{"width", kWidth}, {"height", kHeight}, {"fovy_deg", 40.0},
+            {"near", 0.5},     {"far", 30.0},       {"view", rows}};
+}
+
+glm::dmat4 rowsToMatrix(const nlohmann::json& rows) {
+    glm::dmat4 m(0.0);
+    for (int r = 0; r < 4; ++r) {
+        for (int c = 0; c < 4; ++c) {
+            m[c][r] = rows.at(r).at(c).get<double>();
+        }
+    }
+    return m;
+}
+
+/// Points in front of the camera `view` that land inside pixels (0.2..0.8 of the way across),
+/// all at distinct depths.
+std::vector<glm::dvec3> makePoints(const glm::dmat4& view) {
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> within(0.2, 0.8);
+    const double tanHalf = std::tan(glm::radians(20.0));
+    const double aspect = static_cast<double>(kWidth) / kHeight;
+    const glm::dmat4 toWorld = glm::inverse(view);
+    std::vector<glm::dvec3> points;
+    for (int i = 0; i < 2500; ++i) {
+        const double x = (random() % kWidth) + within(random);
+        const double y = (random() % kHeight) + within(random);
+        const double depth = 4.0 + 0.002 * i;
+        const double ndcX = 2.0 * x / kWidth - 1.0;
+        const double ndcY = 1.0 - 2.0 * y / kHeight;
+        const glm::dvec4 v(ndcX * depth * tanHalf * aspect, ndcY * depth * tanHalf, -depth, 1);
+        points.push_back(glm::dvec3(toWorld * v));
+    }
+    return points;
+}
+
+/// An ascii PLY with 17 significant digits, so the file holds the doubles exactly.
+std::string asciiPly(const std::vector<glm::dvec3>& points) {
+    std::ostringstream ply;
+    ply.precision(17);
+    ply << "ply\nformat ascii 1.0\nelement vertex " << points.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\nend_header\n";
+    for (const glm::dvec3& p : points) {
+        ply << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    }
+    return ply.str();
+}
+
+/// A PFM reader written here, independent of subscan's, as an outside tool would.
+std::string fileBytes(const std::filesystem::path& path) {
+    std::ifstream stream(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(stream), {}};
+}
+
+std::vector<float> readDepthPfm(const std::filesystem::path& path, int& width, int& height) {
+    std::ifstream stream(path, std::ios::binary);
+    std::string magic;
+    double scale = 0;
+    stream >> magic >> width >> height >> scale;
+    stream.get();
+    EXPECT_EQ(magic, "Pf");
+    EXPECT_LT(scale, 0.0);  // little-endian
+    std::vector<float> bottomUp(static_cast<std::size_t>(width * height));
+    stream.read(reinterpret_cast<char*>(bottomUp.data()),
+                static_cast<std::streamsize>(bottomUp.size() * sizeof(float)));
+    std::vector<float> topDown(bottomUp.size());
+    for (int y = 0; y < height; ++y) {
+        std::memcpy(&topDown[static_cast<std::size_t>(y * width)],
+                    &bottomUp[static_cast<std::size_t>((height - 1 - y) * width)],
+                    static_cast<std::size_t>(width) * sizeof(float));
+    }
+    return topDown;
+}
+
+TEST(RenderCommandGLTest, DepthPfmIsReproducibleFromTheScanAndCameraJson) {
+    const test::TempDir dir;
+    // UTM-sized coordinates: the check also covers the double-precision path.
+    const glm::dvec3 offset(500000.0, 5400000.0, 120.0);
+    const glm::dmat4 view = glm::lookAt(offset + glm::dvec3(1, 2, 8), offset, glm::dvec3(0, 1, 0));
+    const std::vector<glm::dvec3> points = makePoints(view);
+    const auto scan = dir.write("scan.ply", asciiPly(points));
+    const auto camera = dir.write("camera.json", cameraJson(view).dump());
+    const auto exported = dir / "buffers";
+
+    const auto result =
+        runSubscan({"render", scan.string(), "-o", (dir / "out.png").string(), "--camera",
+                    camera.string(), "--export-buffers", exported.string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+
+    // From here on only the scan, camera.json and the README's pixel convention are used.
+    std::ifstream cameraStream(exported / "camera.json");
+    const nlohmann::json exportedCamera = nlohmann::json::parse(cameraStream);
+    EXPECT_EQ(exportedCamera["width"], kWidth);
+    EXPECT_EQ(exportedCamera["height"], kHeight);
+    const glm::dmat4 exportedView = rowsToMatrix(exportedCamera["view"]);
+    const glm::dmat4 projection = rowsToMatrix(exportedCamera["projection"]);
+    const double nearPlane = exportedCamera["near"];
+    const double farPlane = exportedCamera["far"];
+
+    std::vector<double> expected(kWidth * kHeight, std::numeric_limits<double>::infinity());
+    for (const glm::dvec3& p : points) {
+        const glm::dvec4 v = exportedView * glm::dvec4(p, 1.0);
+        const glm::dvec4 clip = projection * v;
+        const double depth = -v.z;
+        // Pixel (x, y), y from the top, covers NDC x in [2x/W-1, 2(x+1)/W-1] and
+        // NDC y in [1-2(y+1)/H, 1-2y/H].
+        const int x = static_cast<int>(std::floor((clip.x / clip.w + 1.0) * 0.5 * kWidth));
+        const int y = static_cast<int>(std::floor((1.0 - clip.y / clip.w) * 0.5 * kHeight));
+        if (depth < nearPlane || depth > farPlane || x < 0 || y < 0 || x >= kWidth ||
+            y >= kHeight) {
+            continue;
+        }
+        double& nearest = expected[static_cast<std::size_t>(y * kWidth + x)];
+        nearest = std::min(nearest, depth);
+    }
+
+    int width = 0, height = 0;
+    const std::vector<float> depth = readDepthPfm(exported / "depth.pfm", width, height);
+    ASSERT_EQ(width, kWidth);
+    ASSERT_EQ(height, kHeight);
+    int covered = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        if (std::isinf(expected[i])) {
+            EXPECT_TRUE(std::isinf(depth[i])) << "pixel " << i;
+        } else {
+            ++covered;
+            // Float positions relative to the cloud centre (~1e-7 of a 10 m extent) and a float
+            // transform on the GPU: depths around 5 agree to ~1e-6.
+            EXPECT_NEAR(depth[i], expected[i], 1e-5 * expected[i]) << "pixel " << i;
+        }
+    }
+    EXPECT_GT(covered, kWidth * kHeight / 2);
+    EXPECT_TRUE(std::filesystem::exists(exported / "color.png"));
+}
+
+TEST(RenderCommandGLTest, FarFromTheOriginRendersLikeAtTheOrigin) {
+    const test::TempDir dir;
+    const glm::dvec3 offset(651234.0, 4123456.0, 35.0);
+    const glm::dmat4 view = glm::lookAt(glm::dvec3(0.5, 1, 7), glm::dvec3(0), glm::dvec3(0, 1, 0));
+    std::vector<glm::dvec3> points = makePoints(view);
+    const auto near = dir.write("near.ply", asciiPly(points));
+    for (glm::dvec3& p : points) {
+        p += offset;
+    }
+    const auto far = dir.write("far.ply", asciiPly(points));
+    const auto nearCamera = dir.write("near.json", cameraJson(view).dump());
+    const auto farCamera =
+        dir.write("far.json", cameraJson(view * glm::translate(glm::dmat4(1.0), -offset)).dump());
+
+    for (const auto& [scan, camera, out] : {std::tuple{near, nearCamera, dir / "near.png"},
+                                            std::tuple{far, farCamera, dir / "far.png"}}) {
+        const auto result =
+            runSubscan({"render", scan.string(), "-o", out.string(), "--camera", camera.string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+    }
+    // 4e6 m stored as float would move points by 0.25 m, i.e. many pixels: identical images
+    // show the double-precision path keeps every point in its pixel.
+    EXPECT_EQ(fileBytes(dir / "near.png"), fileBytes(dir / "far.png"));
+}
+
+TEST(RenderCommandGLTest, EveryModeDrawsTheObject) {
+    const test::TempDir dir;
+    for (const char* mode : {"points", "points-gl", "splats"}) {
+        const auto out = dir / (std::string(mode) + ".png");
+        const auto result =
+            runSubscan({"render", "synthetic:sphere?points=3000", "-o", out.string(), "--mode",
+                        mode, "--width", "64", "--height", "48", "--background", "#000000"});
+        ASSERT_EQ(result.exitCode, 0) << mode << ": " << result.err;
+        const Image8 image = readPng(out);
+        int lit = 0;
+        for (std::size_t i = 0; i < image.pixels.size(); i += 4) {
+            lit += image.pixels[i] > 0;
+        }
+        // A sphere filling the view covers about pi/4 of the frame; 1-pixel points from 3000
+        // samples cover far fewer pixels but certainly more than 5 %.
+        EXPECT_GT(lit, 64 * 48 / 20) << mode;
+    }
+}
+
+TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
+    const test::TempDir dir;
+    const auto scan = dir.write("scan.ply", asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+    const auto out = dir / "out.png";
+    struct Case {
+        std::vector<std::string> arguments;
+        std::vector<std::string> environment;
+        int exitCode;
+        const char* message;
+    };
+    const auto badCamera = dir.write("bad.json", R"({"width": 10})");
+    const std::vector<Case> cases{
+        {{"render", scan.string(), "-o", scan.string()}, {}, 1, "over the input scan"},
+        {{"render", scan.string(), "-o", (dir / "missing" / "x.png").string()},
+         {},
+         1,
+         "does not exist"},
+        {{"render", scan.string(), "-o", out.string(), "--camera", badCamera.string()},
+         {},
+         1,
+         "the camera has no 'height'"},
+        {{"render", scan.string(), "-o", out.string(), "--width", "60000"},
+         {},
+         1,
+         "outside what the GPU can render"},
+        {{"render", scan.string(), "-o", out.string(), "--width", "0"}, {}, 2, ""},
+        {{"render", scan.string(), "-o", out.string(), "--mode", "voxels"}, {}, 2, ""},
+        // glvnd finds no EGL vendor: what a machine without any OpenGL driver looks like.
+        {{"render", scan.string(), "-o", out.string()},
+         {"__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl.json",
+          "__EGL_VENDOR_LIBRARY_DIRS=/nonexistent"},
+         1,
+         "no usable OpenGL"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.arguments.back());
+        const auto result = runSubscan(c.arguments, c.environment);
+        EXPECT_EQ(result.exitCode, c.exitCode) << result.err;
+        EXPECT_THAT(result.err, HasSubstr(c.message));
+        if (c.exitCode == 1) {
+            EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+        }
+        EXPECT_FALSE(std::filesystem::exists(out));
+    }
+    // The refused overwrite left the input intact.
+    EXPECT_EQ(fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+}
+
+}  // namespace
+}  // namespace subscan

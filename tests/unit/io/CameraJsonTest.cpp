@@ -1,0 +1,72 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "io/CameraJson.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(CameraJsonTest, RoundTripsAndWritesRowMajorMatrices) {
+    Camera camera;
+    camera.width = 320;
+    camera.height = 200;
+    camera.fovyDegrees = 37.5;
+    camera.nearPlane = 0.25;
+    camera.farPlane = 80;
+    camera.view = glm::lookAt(glm::dvec3(500001.5, 5400002.25, 30), glm::dvec3(500000, 5400000, 0),
+                              glm::dvec3(0, 0, 1));
+    const nlohmann::json json = cameraToJson(camera);
+    // Row-major: the translation sits in the last column of the first three rows.
+    EXPECT_EQ(json["view"][0][3].get<double>(), camera.view[3][0]);
+    EXPECT_EQ(json["projection"][3][2].get<double>(), -1.0);
+    const test::TempDir dir;
+    writeCameraFile(dir / "camera.json", camera);
+    const Camera back = readCameraFile(dir / "camera.json");
+    EXPECT_EQ(back.width, 320);
+    EXPECT_EQ(back.height, 200);
+    EXPECT_EQ(back.fovyDegrees, 37.5);
+    EXPECT_EQ(back.nearPlane, 0.25);
+    EXPECT_EQ(back.farPlane, 80);
+    EXPECT_EQ(back.view, camera.view);  // JSON numbers round-trip doubles exactly
+}
+
+TEST(CameraJsonTest, InvalidFieldsAreNamed) {
+    const nlohmann::json valid = cameraToJson(Camera{});
+    struct Case {
+        const char* key;
+        nlohmann::json value;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"width", 0, "outside 1..65536"},
+        {"height", "tall", "'height' has the wrong type"},
+        {"fovy_deg", 180, "fovy_deg"},
+        {"near", -1, "0 < near < far"},
+        {"far", 0.001, "0 < near < far"},
+        {"view", nlohmann::json::array({nlohmann::json::array({1, 2, 3, 4})}),
+         "4 rows of 4 numbers"},
+        {"view", nlohmann::json::array({1, 2}), "'view' has the wrong type"},
+    };
+    for (const Case& c : cases) {
+        nlohmann::json json = valid;
+        json[c.key] = c.value;
+        try {
+            cameraFromJson(json);
+            ADD_FAILURE() << c.key << " accepted";
+        } catch (const Error& error) {
+            EXPECT_THAT(error.what(), HasSubstr(c.message)) << c.key;
+        }
+    }
+    nlohmann::json missing = valid;
+    missing.erase("view");
+    EXPECT_THROW(cameraFromJson(missing), Error);
+}
+
+}  // namespace
+}  // namespace subscan

@@ -1,0 +1,45 @@
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "io/Image.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+TEST(ImageTest, PfmStoresRowsBottomUpAndRoundTrips) {
+    const test::TempDir dir;
+    const ImageF image{3, 2, 1, {1, 2, 3, 4, 5, std::numeric_limits<float>::infinity()}};
+    writePfm(dir / "d.pfm", image);
+    // The first stored row is the image's bottom row (4, 5, inf), as the format requires.
+    std::ifstream stream(dir / "d.pfm", std::ios::binary);
+    std::string header(std::istreambuf_iterator<char>(stream), {});
+    ASSERT_EQ(header.substr(0, 12), "Pf\n3 2\n-1.0\n");
+    float first = 0;
+    std::memcpy(&first, header.data() + 12, sizeof(float));
+    EXPECT_EQ(first, 4.0f);
+    const ImageF back = readPfm(dir / "d.pfm");
+    EXPECT_EQ(back.width, 3);
+    EXPECT_EQ(back.height, 2);
+    EXPECT_EQ(back.values, image.values);
+}
+
+TEST(ImageTest, PngRoundTrips) {
+    const test::TempDir dir;
+    Image8 image{5, 3, 4, {}};
+    for (int i = 0; i < 5 * 3 * 4; ++i) {
+        image.pixels.push_back(static_cast<std::uint8_t>(i * 17));
+    }
+    writePng(dir / "i.png", image);
+    const Image8 back = readPng(dir / "i.png");
+    EXPECT_EQ(back.width, 5);
+    EXPECT_EQ(back.height, 3);
+    EXPECT_EQ(back.channels, 4);
+    EXPECT_EQ(back.pixels, image.pixels);
+}
+
+}  // namespace
+}  // namespace subscan

@@ -1,0 +1,57 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "render/GpuPointCloud.h"
+#include "render/RenderSettings.h"
+
+namespace subscan {
+namespace {
+
+TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
+    RasterSettings settings;
+    settings.mode = RenderMode::Splats;
+    settings.path = RasterPath::TwoPass32;
+    settings.pointSize = 6;
+    settings.backgroundSrgb = {0.1f, 0.2f, 0.3f};
+    settings.timing = TimingMode::FinishAndClock;
+    const RasterSettings back = nlohmann::json(settings).get<RasterSettings>();
+    EXPECT_EQ(back.mode, settings.mode);
+    EXPECT_EQ(back.path, settings.path);
+    EXPECT_EQ(back.pointSize, settings.pointSize);
+    EXPECT_EQ(back.backgroundSrgb, settings.backgroundSrgb);
+    EXPECT_EQ(back.timing, settings.timing);
+
+    const RasterSettings partial = nlohmann::json{{"point_size", 3}}.get<RasterSettings>();
+    EXPECT_EQ(partial.pointSize, 3);
+    EXPECT_EQ(partial.mode, RasterSettings{}.mode);
+}
+
+TEST(RenderSettingsTest, BadValuesAreNamed) {
+    EXPECT_THROW(nlohmann::json({{"mode", "voxels"}}).get<RasterSettings>(), Error);
+    EXPECT_THROW(nlohmann::json({{"point_size", 0}}).get<RasterSettings>(), Error);
+    EXPECT_THROW(nlohmann::json({{"background_srgb", {2, 0, 0}}}).get<RasterSettings>(), Error);
+    try {
+        parseRenderMode("voxels");
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("points, points-gl, splats"));
+    }
+}
+
+TEST(RenderSettingsTest, DisplayColorsUseColourThenIntensityThenGrey) {
+    PointCloud cloud;
+    cloud.positions.resize(3);
+    cloud.colors = {{1, 2, 3, 255}, {4, 5, 6, 255}, {7, 8, 9, 255}};
+    EXPECT_EQ(displayColors(cloud)[1], 4u | 5u << 8 | 6u << 16 | 255u << 24);
+    cloud.colors.clear();
+    cloud.intensities = {0.0f, 50.0f, 100.0f};
+    const auto grey = displayColors(cloud);
+    EXPECT_LT(grey[0] & 0xFF, grey[1] & 0xFF);  // brighter with intensity
+    EXPECT_LT(grey[1] & 0xFF, grey[2] & 0xFF);
+    cloud.intensities.clear();
+    EXPECT_EQ(displayColors(cloud)[2] & 0xFFFFFF, 200u | 200u << 8 | 200u << 16);
+}
+
+}  // namespace
+}  // namespace subscan
