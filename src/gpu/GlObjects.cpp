@@ -144,82 +144,69 @@ void Buffer::bindUniform(GLuint binding) const {
 
 // ---- Texture ------------------------------------------------------------------------------
 
-Texture::Texture(TextureFormat format, int width, int height, int levels,
-                 std::string_view labelText)
-    : format_(format), width_(width), height_(height), levels_(levels) {
+Texture::Texture(TextureFormat format, int width, int height, std::string_view labelText)
+    : format_(format), width_(width), height_(height) {
     GLuint id = 0;
     glCreateTextures(GL_TEXTURE_2D, 1, &id);
     name_ = GlName<TextureTraits>(id);
-    glTextureStorage2D(id, levels, info(format).internalFormat, width, height);
+    glTextureStorage2D(id, 1, info(format).internalFormat, width, height);
     checkAllocation(fmt::format("a {}x{} texture", width, height), labelText);
     // Passes read texels explicitly (texelFetch/imageLoad); nearest keeps samplers honest too.
-    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     label(GL_TEXTURE, id, labelText);
 }
 
-int Texture::width(int level) const {
-    return std::max(1, (width_ + (1 << level) - 1) >> level);
-}
-int Texture::height(int level) const {
-    return std::max(1, (height_ + (1 << level) - 1) >> level);
-}
 int Texture::channels() const {
     return info(format_).channels;
 }
 
-void Texture::bindImage(GLuint unit, int level, GLenum access) const {
-    glBindImageTexture(unit, id(), level, GL_FALSE, 0, access, info(format_).internalFormat);
+void Texture::bindImage(GLuint unit, GLenum access) const {
+    glBindImageTexture(unit, id(), 0, GL_FALSE, 0, access, info(format_).internalFormat);
 }
 
 void Texture::bindSampler(GLuint unit) const {
     glBindTextureUnit(unit, id());
 }
 
-void Texture::clear(int level, const float value[4]) {
-    glClearTexImage(id(), level, info(format_).pixelFormat, GL_FLOAT, value);
+void Texture::clear(const float value[4]) {
+    glClearTexImage(id(), 0, info(format_).pixelFormat, GL_FLOAT, value);
 }
 
-void Texture::clearUint(int level, std::uint32_t value) {
-    const std::uint32_t values[4] = {value, value, value, value};
-    glClearTexImage(id(), level, info(format_).pixelFormat, GL_UNSIGNED_INT, values);
-}
+namespace {
 
-std::vector<float> Texture::readFloats(int level) const {
-    std::vector<float> values(static_cast<std::size_t>(width(level)) *
-                              static_cast<std::size_t>(height(level)) *
-                              static_cast<std::size_t>(channels()));
+template <class T>
+std::vector<T> readTexels(GLuint id, GLenum format, GLenum type, std::size_t count) {
+    std::vector<T> values(count);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glGetTextureImage(id(), level, info(format_).pixelFormat, GL_FLOAT,
-                      static_cast<GLsizei>(values.size() * sizeof(float)), values.data());
-    return values;
-}
-
-std::vector<std::uint32_t> Texture::readUints(int level) const {
-    std::vector<std::uint32_t> values(static_cast<std::size_t>(width(level)) *
-                                      static_cast<std::size_t>(height(level)) *
-                                      static_cast<std::size_t>(channels()));
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glGetTextureImage(id(), level, info(format_).pixelFormat, GL_UNSIGNED_INT,
-                      static_cast<GLsizei>(values.size() * sizeof(std::uint32_t)), values.data());
-    return values;
-}
-
-std::vector<std::uint8_t> Texture::readRgba8(int level) const {
-    std::vector<std::uint8_t> values(static_cast<std::size_t>(width(level)) *
-                                     static_cast<std::size_t>(height(level)) * 4);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    glGetTextureImage(id(), level, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(values.size()),
+    glGetTextureImage(id, 0, format, type, static_cast<GLsizei>(values.size() * sizeof(T)),
                       values.data());
     return values;
 }
 
-void Texture::uploadFloats(int level, std::span<const float> values) {
+}  // namespace
+
+std::vector<float> Texture::readFloats() const {
+    return readTexels<float>(id(), info(format_).pixelFormat, GL_FLOAT,
+                             static_cast<std::size_t>(width_ * height_ * channels()));
+}
+
+std::vector<std::uint32_t> Texture::readUints() const {
+    return readTexels<std::uint32_t>(id(), info(format_).pixelFormat, GL_UNSIGNED_INT,
+                                     static_cast<std::size_t>(width_ * height_ * channels()));
+}
+
+std::vector<std::uint8_t> Texture::readRgba8() const {
+    return readTexels<std::uint8_t>(id(), GL_RGBA, GL_UNSIGNED_BYTE,
+                                    static_cast<std::size_t>(width_ * height_ * 4));
+}
+
+void Texture::uploadFloats(std::span<const float> values) {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage2D(id(), level, 0, 0, width(level), height(level), info(format_).pixelFormat,
-                        GL_FLOAT, values.data());
+    glTextureSubImage2D(id(), 0, 0, 0, width_, height_, info(format_).pixelFormat, GL_FLOAT,
+                        values.data());
 }
 
 // ---- Program ------------------------------------------------------------------------------

@@ -116,38 +116,36 @@ class UniformBlock {
 
 enum class TextureFormat { R32F, RG32F, RGBA16F, RGBA32F, RGBA8, R32UI, R8, Depth32F };
 
-/// 2-D texture with immutable storage and `levels` mip levels.
+/// 2-D texture with immutable storage and a single level. (Image pyramids live in storage
+/// buffers instead: GL mip levels are floor(W / 2^R) wide, the pipeline's levels ceil(W / 2^R).)
 class Texture {
   public:
     Texture() = default;
-    Texture(TextureFormat format, int width, int height, int levels, std::string_view label);
+    Texture(TextureFormat format, int width, int height, std::string_view label);
 
     GLuint id() const { return name_.id(); }
     TextureFormat format() const { return format_; }
-    int width(int level = 0) const;
-    int height(int level = 0) const;
-    int levels() const { return levels_; }
+    int width() const { return width_; }
+    int height() const { return height_; }
     int channels() const;
 
-    void bindImage(GLuint unit, int level, GLenum access) const;
+    void bindImage(GLuint unit, GLenum access) const;
     void bindSampler(GLuint unit) const;
-    /// Sets every texel of `level` to `value` (as many components as the format has).
-    void clear(int level, const float value[4]);
-    void clearUint(int level, std::uint32_t value);
+    /// Sets every texel to `value` (as many components as the format has).
+    void clear(const float value[4]);
 
-    /// Texel values of `level`, row 0 first, `channels()` floats per texel (float formats; RGBA8
-    /// and R8 come back normalised to 0..1).
-    std::vector<float> readFloats(int level = 0) const;
-    std::vector<std::uint32_t> readUints(int level = 0) const;
-    std::vector<std::uint8_t> readRgba8(int level = 0) const;
-    void uploadFloats(int level, std::span<const float> values);
+    /// Texel values, row 0 first, `channels()` per texel (RGBA8 and R8 come back normalised to
+    /// 0..1 by readFloats).
+    std::vector<float> readFloats() const;
+    std::vector<std::uint32_t> readUints() const;
+    std::vector<std::uint8_t> readRgba8() const;
+    void uploadFloats(std::span<const float> values);
 
   private:
     GlName<TextureTraits> name_;
     TextureFormat format_ = TextureFormat::RGBA8;
     int width_ = 0;
     int height_ = 0;
-    int levels_ = 0;
 };
 
 /// A linked shader program built from embedded sources.

@@ -22,7 +22,7 @@ void DrawPointsPass::execute(FrameContext& frame) {
     Texture& depth = frame.resources.ensureTexture("depth", TextureFormat::R32F, width, height);
     Texture& color = frame.resources.ensureTexture("color", TextureFormat::RGBA16F, width, height);
     if (depthTest_.width() != width || depthTest_.height() != height || !depthTest_.id()) {
-        depthTest_ = Texture(TextureFormat::Depth32F, width, height, 1, "DrawPoints.depthTest");
+        depthTest_ = Texture(TextureFormat::Depth32F, width, height, "DrawPoints.depthTest");
     }
     if (attachedColor_ != color.id() || attachedDepth_ != depthTest_.id()) {
         const std::array<const Texture*, 2> targets{&color, &depth};

@@ -1,5 +1,7 @@
 #include "render/FrameResources.h"
 
+#include <utility>
+
 #include <fmt/format.h>
 
 #include "core/Error.h"
@@ -29,19 +31,28 @@ std::size_t bytesPerTexel(TextureFormat format) {
 }  // namespace
 
 Texture& FrameResources::ensureTexture(std::string_view name, TextureFormat format, int width,
-                                       int height, int levels) {
+                                       int height) {
     auto found = textures_.find(name);
-    if (found != textures_.end()) {
-        Texture& texture = found->second;
-        if (texture.format() == format && texture.width() == width && texture.height() == height &&
-            texture.levels() == levels) {
-            return texture;
-        }
-        texture = Texture(format, width, height, levels, name);
-        return texture;
+    if (found == textures_.end()) {
+        return textures_.emplace(std::string(name), Texture(format, width, height, name))
+            .first->second;
     }
-    return textures_.emplace(std::string(name), Texture(format, width, height, levels, name))
-        .first->second;
+    Texture& texture = found->second;
+    if (texture.format() != format || texture.width() != width || texture.height() != height) {
+        texture = Texture(format, width, height, name);
+    }
+    return texture;
+}
+
+Buffer& FrameResources::ensureBuffer(std::string_view name, std::size_t bytes) {
+    auto found = buffers_.find(name);
+    if (found == buffers_.end()) {
+        return buffers_.emplace(std::string(name), Buffer(bytes, nullptr, name)).first->second;
+    }
+    if (found->second.size() != bytes) {
+        found->second = Buffer(bytes, nullptr, name);
+    }
+    return found->second;
 }
 
 Texture& FrameResources::texture(std::string_view name) {
@@ -56,26 +67,30 @@ const Texture& FrameResources::texture(std::string_view name) const {
     return found->second;
 }
 
-bool FrameResources::has(std::string_view name) const {
-    return textures_.contains(name);
+Buffer& FrameResources::buffer(std::string_view name) {
+    return const_cast<Buffer&>(std::as_const(*this).buffer(name));
 }
 
-std::vector<std::string> FrameResources::names() const {
-    std::vector<std::string> names;
-    for (const auto& [name, texture] : textures_) {
-        names.push_back(name);
+const Buffer& FrameResources::buffer(std::string_view name) const {
+    const auto found = buffers_.find(name);
+    if (found == buffers_.end()) {
+        throw Error(fmt::format("no render pass produced the buffer '{}'", name));
     }
-    return names;
+    return found->second;
+}
+
+bool FrameResources::has(std::string_view name) const {
+    return textures_.contains(name) || buffers_.contains(name);
 }
 
 std::size_t FrameResources::bytes() const {
     std::size_t total = 0;
     for (const auto& [name, texture] : textures_) {
-        for (int level = 0; level < texture.levels(); ++level) {
-            total += static_cast<std::size_t>(texture.width(level)) *
-                     static_cast<std::size_t>(texture.height(level)) *
-                     bytesPerTexel(texture.format());
-        }
+        total += static_cast<std::size_t>(texture.width()) *
+                 static_cast<std::size_t>(texture.height()) * bytesPerTexel(texture.format());
+    }
+    for (const auto& [name, buffer] : buffers_) {
+        total += buffer.size();
     }
     return total;
 }

@@ -117,8 +117,8 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         runPerChunk(indexStage_, frame, false);
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    depth.bindImage(SUBSCAN_IMAGE_OUT0, 0, GL_WRITE_ONLY);
-    color.bindImage(SUBSCAN_IMAGE_OUT1, 0, GL_WRITE_ONLY);
+    depth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    color.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     runPerChunk(int64 ? resolve64_ : resolve32_, frame, true);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
