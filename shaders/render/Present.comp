@@ -1,10 +1,13 @@
 #version 450
-// Final image: linear colour -> sRGB 8-bit; pixels with nothing in them get the background.
+// Final image: linear colour -> sRGB 8-bit. With a depth input (HAS_DEPTH), pixels where it is
+// +inf show the background; without one the colour already includes it.
 #include "shared/common.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(binding = SUBSCAN_IMAGE_IN0, rgba16f) readonly uniform image2D inColor;
+#if HAS_DEPTH
 layout(binding = SUBSCAN_IMAGE_IN1, r32f) readonly uniform image2D inDepth;
+#endif
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
 
 void main() {
@@ -12,7 +15,11 @@ void main() {
     if (any(greaterThanEqual(pixel, imageSizeOfFrame()))) {
         return;
     }
-    bool covered = imageLoad(inDepth, pixel).r < kInfinity;
-    vec3 color = covered ? imageLoad(inColor, pixel).rgb : frame.background.rgb;
+    vec3 color = imageLoad(inColor, pixel).rgb;
+#if HAS_DEPTH
+    if (isinf(imageLoad(inDepth, pixel).r)) {
+        color = frame.background.rgb;
+    }
+#endif
     imageStore(outImage, pixel, vec4(linearToSrgb(color), 1.0));
 }

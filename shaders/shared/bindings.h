@@ -20,6 +20,11 @@ using mat4 = glm::mat4;
 // ---- uniform blocks (std140) ----
 #define SUBSCAN_UBO_FRAME 0
 #define SUBSCAN_UBO_PASS 1
+#define SUBSCAN_UBO_PYRAMID 2
+#define SUBSCAN_UBO_SURFACE 3
+
+// ---- plain uniforms ----
+#define SUBSCAN_UNIFORM_LEVEL 0  // uint: the pyramid level a per-level dispatch works on
 
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_POSITIONS 0    // float x, y, z per point (cloud-relative)
@@ -27,16 +32,29 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_DEPTH_BITS 2   // uint per pixel: floatBitsToUint(linear depth)
 #define SUBSCAN_SSBO_POINT_INDEX 3  // uint per pixel: the winning point
 #define SUBSCAN_SSBO_DEPTH_INDEX 4  // uint64 per pixel: depth bits << 32 | point index
+#define SUBSCAN_SSBO_PYRAMID 5      // float per texel, all levels: min depth
+#define SUBSCAN_SSBO_PULL_VALUES 6  // vec4 per texel, all levels: w * (depth, r, g, b)
+#define SUBSCAN_SSBO_PULL_WEIGHTS 7 // float per texel, all levels: clamped weight w
+#define SUBSCAN_SSBO_PUSH_VALUES 8  // vec4 per texel, all levels: complete (depth, r, g, b)
+#define SUBSCAN_SSBO_NORMALS 9      // vec4 per texel, all levels: view-space normal, w unused
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0
 #define SUBSCAN_IMAGE_OUT1 1
-#define SUBSCAN_IMAGE_IN0 2
-#define SUBSCAN_IMAGE_IN1 3
+#define SUBSCAN_IMAGE_OUT2 2
+#define SUBSCAN_IMAGE_OUT3 3
+#define SUBSCAN_IMAGE_IN0 4
+#define SUBSCAN_IMAGE_IN1 5
+#define SUBSCAN_IMAGE_IN2 6
+#define SUBSCAN_IMAGE_IN3 7
 
 // ---- vertex attributes (GL_POINTS baseline) ----
 #define SUBSCAN_ATTRIBUTE_POSITION 0
 #define SUBSCAN_ATTRIBUTE_COLOR 1
+
+// ---- limits ----
+#define SUBSCAN_MAX_PYRAMID_LEVELS 16  // 1 + ceil(log2(65536)): the largest image side
+#define SUBSCAN_MAX_LIGHTS 4           // directional lights besides the head light
 
 // ---- compute work group sizes ----
 #define SUBSCAN_POINTS_GROUP_SIZE 256
@@ -64,7 +82,37 @@ struct DrawParams {
     vec4 pointSize;  // x: size in pixels
 };
 
+// Where each level of an image pyramid sits in its buffer. Level R is ceil(W / 2^R) x
+// ceil(H / 2^R); the last level is 1x1.
+struct PyramidLayout {
+    uvec4 levels[SUBSCAN_MAX_PYRAMID_LEVELS];  // x: first texel, y: width, z: height, w: unused
+    uvec4 info;                                // x: number of levels, y: total texels
+};
+
+// The reconstruction passes (HiddenPointRemoval, PullPush, FillRemoval, Normals). World radii
+// are in scene units; each pass turns its radius into a pyramid level per pixel:
+// level = log2(radius * focal length / depth).
+struct SurfaceParams {
+    vec4 visibility;  // x: HPR radius, y: threshold tau, z: edge rule (1 or 0), w: unused
+    vec4 fill;        // x: radius of the expected gap, y: pull-weight threshold
+    vec4 normals;     // x: smoothing radius
+    vec4 unused0;
+};
+
+// Deferred shading; directions are in view space, pointing towards the light.
+struct ShadeParams {
+    vec4 headLight;  // rgb: radiance of a light at the eye
+    vec4 ambient;    // rgb: ambient radiance
+    vec4 specular;   // x: specular reflectance, y: Blinn-Phong exponent
+    vec4 lightDirection[SUBSCAN_MAX_LIGHTS];
+    vec4 lightColor[SUBSCAN_MAX_LIGHTS];
+    uvec4 lightCount;  // x: how many of the directional lights are used
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
+static_assert(sizeof(SurfaceParams) == 64);
+static_assert(sizeof(ShadeParams) == 3 * 16 + 2 * SUBSCAN_MAX_LIGHTS * 16 + 16);
 static_assert(sizeof(FrameParams) == 2 * 64 + 3 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);

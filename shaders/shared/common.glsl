@@ -35,3 +35,16 @@ bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
 }
 
 vec3 unpackColor(uint rgba8) { return srgbToLinear(unpackUnorm4x8(rgba8).rgb); }
+
+/// View-space position of a point seen at window position `window` (full-resolution pixels,
+/// row 0 at the top; a pixel's centre is its index + 0.5) at linear depth `depth`.
+vec3 viewPositionAt(vec2 window, float depth) {
+    float focal = frame.depthRange.z;
+    vec2 centred = vec2(window.x - 0.5 * frame.viewport.x, 0.5 * frame.viewport.y - window.y);
+    return vec3(centred * (depth / focal), -depth);
+}
+
+/// The pyramid level whose texels span `worldRadius` at `depth` (fractional, unclamped).
+float levelForRadius(float worldRadius, float depth) {
+    return log2(worldRadius * frame.depthRange.z / depth);
+}

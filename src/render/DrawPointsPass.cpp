@@ -39,8 +39,8 @@ void DrawPointsPass::execute(FrameContext& frame) {
     glClearNamedFramebufferfv(fbo, GL_COLOR, 1, infinity);
     glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &farthest);
 
-    const bool splats = frame.raster.mode == RenderMode::Splats;
-    params_.set({glm::vec4(splats ? frame.raster.pointSize : 1.0f, 0, 0, 0)});
+    const bool splats = frame.settings.raster.mode == RenderMode::Splats;
+    params_.set({glm::vec4(splats ? frame.settings.raster.pointSize : 1.0f, 0, 0, 0)});
     params_.bind(SUBSCAN_UBO_PASS);
 
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);

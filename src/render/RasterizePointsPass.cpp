@@ -97,7 +97,8 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     const int width = frame.camera.width;
     const int height = frame.camera.height;
     const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    const bool int64 = resolvePath(frame.raster.path, frame.capabilities) == RasterPath::Int64;
+    const bool int64 =
+        resolvePath(frame.settings.raster.path, frame.capabilities) == RasterPath::Int64;
     lastFrameInt64_ = int64;
     ensurePixelBuffers(pixels, int64);
     Texture& depth = frame.resources.ensureTexture("depth", TextureFormat::R32F, width, height);

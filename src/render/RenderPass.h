@@ -8,17 +8,23 @@
 #include "render/FrameResources.h"
 #include "render/GpuPointCloud.h"
 #include "render/RenderSettings.h"
+#include "shared/bindings.h"
 
 namespace subscan {
 
-/// Everything a pass may use while it runs. The frame's camera block (FrameParams) is already
-/// bound at SUBSCAN_UBO_FRAME.
+/// Everything a pass may use while it runs. The frame-wide uniform blocks (FrameParams,
+/// PyramidLayout, SurfaceParams) are already bound.
 struct FrameContext {
     const Camera& camera;
     const GpuPointCloud& cloud;
-    const RasterSettings& raster;
+    const RenderSettings& settings;
     const GlCapabilities& capabilities;
     FrameResources& resources;
+    const gpu::PyramidLayout& pyramid;
+    double spacing;  // the point spacing h, scene units
+
+    int width() const { return camera.width; }
+    int height() const { return camera.height; }
 };
 
 /// One step of the frame pipeline: one class and one shader of the same name (Falcor's

@@ -1,35 +1,47 @@
 #include "render/RenderSettings.h"
 
 #include <array>
+#include <fstream>
 #include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "io/AtomicFile.h"
+#include "render/SettingsJson.h"
+#include "shared/bindings.h"
 
 namespace subscan {
 
 namespace {
 
-constexpr std::array<std::pair<RenderMode, std::string_view>, 3> kModes{{
+constexpr std::pair<RenderMode, std::string_view> kModes[] = {
     {RenderMode::Points, "points"},
     {RenderMode::PointsGl, "points-gl"},
     {RenderMode::Splats, "splats"},
-}};
-constexpr std::array<std::pair<RasterPath, std::string_view>, 3> kPaths{{
+    {RenderMode::Surface, "surface"},
+};
+constexpr std::pair<RasterPath, std::string_view> kPaths[] = {
     {RasterPath::Auto, "auto"},
     {RasterPath::Int64, "int64"},
     {RasterPath::TwoPass32, "two-pass"},
-}};
-constexpr std::array<std::pair<TimingMode, std::string_view>, 3> kTimings{{
+};
+constexpr std::pair<TimingMode, std::string_view> kTimings[] = {
     {TimingMode::Auto, "auto"},
     {TimingMode::GpuQueries, "gpu-queries"},
     {TimingMode::FinishAndClock, "finish-and-clock"},
-}};
+};
+constexpr std::pair<Stage, std::string_view> kStages[] = {
+    {Stage::Final, "final"},     {Stage::Depth, "depth"},
+    {Stage::Pyramid, "pyramid"}, {Stage::Visibility, "visibility"},
+    {Stage::Pull, "pull"},       {Stage::Push, "push"},
+    {Stage::Fill, "fill"},       {Stage::Normals, "normals"},
+    {Stage::Shaded, "shaded"},
+};
 
 template <class Enum, std::size_t N>
-std::string nameOf(const std::array<std::pair<Enum, std::string_view>, N>& table, Enum value) {
+std::string nameOf(const std::pair<Enum, std::string_view> (&table)[N], Enum value) {
     for (const auto& [candidate, name] : table) {
         if (candidate == value) {
             return std::string(name);
@@ -39,7 +51,7 @@ std::string nameOf(const std::array<std::pair<Enum, std::string_view>, N>& table
 }
 
 template <class Enum, std::size_t N>
-Enum parse(const std::array<std::pair<Enum, std::string_view>, N>& table, std::string_view text,
+Enum parse(const std::pair<Enum, std::string_view> (&table)[N], std::string_view text,
            std::string_view what) {
     std::string allowed;
     for (const auto& [value, name] : table) {
@@ -50,6 +62,17 @@ Enum parse(const std::array<std::pair<Enum, std::string_view>, N>& table, std::s
         allowed += name;
     }
     throw Error(fmt::format("'{}' is not a {} (expected one of: {})", text, what, allowed));
+}
+
+template <class Enum, std::size_t N>
+void readEnum(const nlohmann::json& json, std::string_view key, Enum& value,
+              const std::pair<Enum, std::string_view> (&table)[N], std::string_view what) {
+    if (const auto found = json.find(key); found != json.end()) {
+        if (!found->is_string()) {
+            throw Error(fmt::format("the setting '{}' must be a string", key));
+        }
+        value = parse(table, found->get<std::string>(), what);
+    }
 }
 
 }  // namespace
@@ -66,44 +89,73 @@ std::string toString(RasterPath path) {
 RasterPath parseRasterPath(std::string_view text) {
     return parse(kPaths, text, "raster path");
 }
+std::string toString(Stage stage) {
+    return nameOf(kStages, stage);
+}
+Stage parseStage(std::string_view text) {
+    return parse(kStages, text, "stage");
+}
 
 void to_json(nlohmann::json& json, const RasterSettings& settings) {
     json = {
         {"mode", toString(settings.mode)},
         {"raster_path", toString(settings.path)},
         {"point_size", settings.pointSize},
-        {"background_srgb",
-         {settings.backgroundSrgb.r, settings.backgroundSrgb.g, settings.backgroundSrgb.b}},
+        {"background_srgb", toJson(settings.backgroundSrgb)},
         {"timing", nameOf(kTimings, settings.timing)},
+        {"stage", toString(settings.stage)},
+        {"stage_level", settings.stageLevel},
     };
 }
 
 void from_json(const nlohmann::json& json, RasterSettings& settings) {
-    // Absent keys keep their defaults, so a settings file may hold only what it changes.
-    if (json.contains("mode")) {
-        settings.mode = parseRenderMode(json.at("mode").get<std::string>());
+    readEnum(json, "mode", settings.mode, kModes, "render mode");
+    readEnum(json, "raster_path", settings.path, kPaths, "raster path");
+    readSetting(json, "point_size", settings.pointSize, 1.0f, 64.0f);
+    readSetting(json, "background_srgb", settings.backgroundSrgb, 0.0f, 1.0f);
+    readEnum(json, "timing", settings.timing, kTimings, "timing mode");
+    readEnum(json, "stage", settings.stage, kStages, "stage");
+    readSetting(json, "stage_level", settings.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
+}
+
+void to_json(nlohmann::json& json, const RenderSettings& settings) {
+    json = {
+        {"raster", settings.raster}, {"surface", settings.surface}, {"shading", settings.shading}};
+}
+
+void from_json(const nlohmann::json& json, RenderSettings& settings) {
+    if (!json.is_object()) {
+        throw Error("the settings must be a JSON object");
     }
-    if (json.contains("raster_path")) {
-        settings.path = parseRasterPath(json.at("raster_path").get<std::string>());
-    }
-    if (json.contains("point_size")) {
-        settings.pointSize = json.at("point_size").get<float>();
-        if (!(settings.pointSize >= 1.0f && settings.pointSize <= 64.0f)) {
-            throw Error(fmt::format("point_size {} is outside 1..64 pixels", settings.pointSize));
+    for (const auto& [key, value] : json.items()) {
+        if (key != "raster" && key != "surface" && key != "shading") {
+            throw Error(
+                fmt::format("unknown settings section '{}' (expected raster, surface, "
+                            "shading)",
+                            key));
         }
     }
-    if (json.contains("background_srgb")) {
-        const auto values = json.at("background_srgb").get<std::array<float, 3>>();
-        for (const float value : values) {
-            if (!(value >= 0.0f && value <= 1.0f)) {
-                throw Error("background_srgb values must lie in 0..1");
-            }
-        }
-        settings.backgroundSrgb = {values[0], values[1], values[2]};
+    settings.raster = json.value("raster", nlohmann::json::object()).get<RasterSettings>();
+    settings.surface = json.value("surface", nlohmann::json::object()).get<SurfaceSettings>();
+    settings.shading = json.value("shading", nlohmann::json::object()).get<ShadingSettings>();
+}
+
+RenderSettings readSettingsFile(const std::filesystem::path& path) {
+    std::ifstream stream(path);
+    if (!stream) {
+        throw Error(fmt::format("{}: cannot open the settings file", path.string()));
     }
-    if (json.contains("timing")) {
-        settings.timing = parse(kTimings, json.at("timing").get<std::string>(), "timing mode");
+    try {
+        return nlohmann::json::parse(stream).get<RenderSettings>();
+    } catch (const nlohmann::json::parse_error& error) {
+        throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), error.byte));
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", path.string(), error.what()));
     }
+}
+
+void writeSettingsFile(const std::filesystem::path& path, const RenderSettings& settings) {
+    writeFileAtomically(path, nlohmann::json(settings).dump(2) + "\n");
 }
 
 }  // namespace subscan

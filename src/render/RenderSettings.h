@@ -2,11 +2,13 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 
 #include <glm/vec3.hpp>
 #include <nlohmann/json_fwd.hpp>
 
 #include "gpu/PassTimer.h"
+#include "render/SurfaceSettings.h"
 
 namespace subscan {
 
@@ -15,28 +17,52 @@ enum class RenderMode {
     Points,    // compute-rasterized 1-pixel points (the input of the reconstruction)
     PointsGl,  // baseline: GL_POINTS, 1 pixel
     Splats,    // baseline: GL_POINTS of pointSize pixels with depth test (common viewers)
+    Surface,   // screen-space reconstruction, shaded
 };
+
+/// An intermediate buffer of the surface pipeline shown instead of the final image (the panels
+/// of the paper's Figure 2).
+enum class Stage { Final, Depth, Pyramid, Visibility, Pull, Push, Fill, Normals, Shaded };
 
 /// Which compute rasterizer runs: Auto takes the one-pass 64-bit path where the driver has
 /// 64-bit atomics and the two-pass 32-bit path elsewhere; the others force one (tests, bench).
 enum class RasterPath { Auto, Int64, TwoPass32 };
 
-/// Settings of the rasterization and presentation (one struct per concern; JSON load/save).
+/// Rasterization and presentation.
 struct RasterSettings {
     RenderMode mode = RenderMode::Points;
     RasterPath path = RasterPath::Auto;
     float pointSize = 4.0f;                         // splats, in pixels
     glm::vec3 backgroundSrgb{0.19f, 0.19f, 0.19f};  // sRGB-encoded 0..1, like colour pickers
     TimingMode timing = TimingMode::Auto;
+    Stage stage = Stage::Final;
+    int stageLevel = 3;  // the pyramid level the pyramid and pull stages show
 };
+
+/// Every setting of a frame, one struct per concern; the JSON the CLI's --settings and the
+/// viewer read and write: {"raster": {...}, "surface": {...}, "shading": {...}}.
+struct RenderSettings {
+    RasterSettings raster;
+    SurfaceSettings surface;
+    ShadingSettings shading;
+};
+
+/// The settings file the CLI (--settings) and the viewer share; throws subscan::Error naming the
+/// file and the bad setting. Absent keys keep their defaults.
+RenderSettings readSettingsFile(const std::filesystem::path& path);
+void writeSettingsFile(const std::filesystem::path& path, const RenderSettings& settings);
 
 void to_json(nlohmann::json& json, const RasterSettings& settings);
 void from_json(const nlohmann::json& json, RasterSettings& settings);
+void to_json(nlohmann::json& json, const RenderSettings& settings);
+void from_json(const nlohmann::json& json, RenderSettings& settings);
 
+/// Names as the CLI and JSON spell them; the parsers throw subscan::Error listing the choices.
 std::string toString(RenderMode mode);
-/// Throws subscan::Error naming the allowed values.
 RenderMode parseRenderMode(std::string_view text);
 std::string toString(RasterPath path);
 RasterPath parseRasterPath(std::string_view text);
+std::string toString(Stage stage);
+Stage parseStage(std::string_view text);
 
 }  // namespace subscan

@@ -1,7 +1,10 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "core/Camera.h"
@@ -9,16 +12,24 @@
 #include "gpu/GlContext.h"
 #include "gpu/PassTimer.h"
 #include "gpu/ShaderSources.h"
-#include "render/DrawPointsPass.h"
 #include "render/FrameResources.h"
 #include "render/GpuPointCloud.h"
 #include "render/PassRunner.h"
-#include "render/PresentPass.h"
-#include "render/RasterizePointsPass.h"
 #include "render/RenderSettings.h"
 #include "shared/bindings.h"
 
 namespace subscan {
+
+class RasterizePointsPass;
+class DrawPointsPass;
+class MinDepthPyramidPass;
+class HiddenPointRemovalPass;
+class PullPushPass;
+class FillRemovalPass;
+class NormalsPass;
+class ShadePass;
+class StageViewPass;
+class PresentPass;
 
 struct FrameResult {
     std::vector<PassTiming> passes;
@@ -26,36 +37,51 @@ struct FrameResult {
 };
 
 /// The frame pipeline for one cloud: uploads it once, then renders frames for any camera and
-/// settings with the passes of the chosen mode followed by Present. The same code serves the
-/// headless CLI, the viewer and the benchmark. Needs its context current.
+/// settings with the passes of the chosen mode (and stage) followed by Present. The same code
+/// serves the headless CLI, the viewer, the evaluation and the benchmark. Needs its context
+/// current.
 class Renderer {
   public:
-    /// `maxChunkPoints`: see GpuPointCloud (tests force small chunks).
-    Renderer(GlContext& context, const PointCloud& cloud, std::size_t maxChunkPoints = 0);
+    /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` see GpuPointCloud.
+    Renderer(GlContext& context, const PointCloud& cloud,
+             std::optional<double> spacing = std::nullopt, std::size_t maxChunkPoints = 0);
+    ~Renderer();
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a
     /// forced raster path the driver lacks) and GL errors inside a pass.
-    FrameResult render(const Camera& camera, const RasterSettings& settings);
+    FrameResult render(const Camera& camera, const RenderSettings& settings);
 
     /// The last presented image: RGBA8, sRGB-encoded, row 0 at the top.
     std::vector<std::uint8_t> readImage() const;
     const FrameResources& resources() const { return resources_; }
     const GpuPointCloud& gpuCloud() const { return cloud_; }
     const GlCapabilities& capabilities() const { return context_.capabilities(); }
-    /// The compute rasterizer, once a Points frame has been rendered (null before).
+    double spacing() const { return spacing_; }
+    /// The compute rasterizer, once a frame has used it (null before).
     const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
 
   private:
-    std::vector<RenderPass*> passesFor(RenderMode mode);
+    std::vector<RenderPass*> passesFor(const RasterSettings& raster);
+    PresentPass& present(const std::string& color, const std::string& depth);
 
     GlContext& context_;
     ShaderSources sources_;
     GpuPointCloud cloud_;
+    double spacing_;
     FrameResources resources_;
     UniformBlock<gpu::FrameParams> frameParams_{"FrameParams"};
+    UniformBlock<gpu::PyramidLayout> pyramidLayout_{"PyramidLayout"};
+    UniformBlock<gpu::SurfaceParams> surfaceParams_{"SurfaceParams"};
     std::unique_ptr<RasterizePointsPass> rasterize_;
     std::unique_ptr<DrawPointsPass> drawPoints_;
-    std::unique_ptr<PresentPass> present_;
+    std::unique_ptr<MinDepthPyramidPass> minDepthPyramid_;
+    std::unique_ptr<HiddenPointRemovalPass> hiddenPointRemoval_;
+    std::unique_ptr<PullPushPass> pullPush_;
+    std::unique_ptr<FillRemovalPass> fillRemoval_;
+    std::unique_ptr<NormalsPass> normals_;
+    std::unique_ptr<ShadePass> shade_;
+    std::map<Stage, std::unique_ptr<StageViewPass>> stageViews_;
+    std::map<std::pair<std::string, std::string>, std::unique_ptr<PresentPass>> presents_;
     std::unique_ptr<PassRunner> runner_;
     TimingMode runnerTiming_ = TimingMode::Auto;
 };

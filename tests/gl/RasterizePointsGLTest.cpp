@@ -13,6 +13,7 @@
 
 #include "core/Camera.h"
 #include "core/Error.h"
+#include "render/RasterizePointsPass.h"
 #include "render/Renderer.h"
 #include "support/GlTestSupport.h"
 
@@ -156,9 +157,9 @@ TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
     for (const RasterPath path : paths) {
         for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
             SCOPED_TRACE(toString(path) + (chunk ? ", chunks of 97" : ", one chunk"));
-            Renderer renderer(context, cloud, chunk);
-            RasterSettings settings;
-            settings.path = path;
+            Renderer renderer(context, cloud, std::nullopt, chunk);
+            RenderSettings settings;
+            settings.raster.path = path;
             renderer.render(camera, settings);
             expectMatchesReference(renderer, cloud, camera, reference);
         }
@@ -172,8 +173,8 @@ TEST(RasterizePointsGLTest, ForcingInt64WithoutSupportIsAClearError) {
     }
     const Camera camera = smallCamera();
     Renderer renderer(context, testCloud(camera, 2));
-    RasterSettings settings;
-    settings.path = RasterPath::Int64;
+    RenderSettings settings;
+    settings.raster.path = RasterPath::Int64;
     EXPECT_THROW(renderer.render(camera, settings), Error);
 }
 
@@ -182,9 +183,9 @@ TEST(RasterizePointsGLTest, GlPointsBaselineSeesTheSameNearestPoints) {
     const Camera camera = smallCamera();
     const PointCloud cloud = testCloud(camera, 3);
     const Reference reference = rasterizeOnCpu(cloud, camera);
-    Renderer renderer(context, cloud, 500);
-    RasterSettings settings;
-    settings.mode = RenderMode::PointsGl;
+    Renderer renderer(context, cloud, std::nullopt, 500);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::PointsGl;
     renderer.render(camera, settings);
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
     for (std::size_t pixel = 0; pixel < reference.depth.size(); ++pixel) {
@@ -205,9 +206,9 @@ TEST(RasterizePointsGLTest, SplatsCoverTheirSquare) {
     builder.add({pointAtPixel(camera, 18.5, 11.5, 4.0)});
     std::vector<std::string> warnings;
     Renderer renderer(context, builder.finish(warnings));
-    RasterSettings settings;
-    settings.mode = RenderMode::Splats;
-    settings.pointSize = 5.0f;
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Splats;
+    settings.raster.pointSize = 5.0f;
     renderer.render(camera, settings);
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
     for (int y = 0; y < camera.height; ++y) {
@@ -224,8 +225,8 @@ TEST(RasterizePointsGLTest, PresentEncodesSrgbAndFillsTheBackground) {
     const PointCloud cloud = testCloud(camera, 4);
     const Reference reference = rasterizeOnCpu(cloud, camera);
     Renderer renderer(context, cloud);
-    RasterSettings settings;
-    settings.backgroundSrgb = {0.2f, 0.4f, 0.6f};
+    RenderSettings settings;
+    settings.raster.backgroundSrgb = {0.2f, 0.4f, 0.6f};
     renderer.render(camera, settings);
     const std::vector<std::uint8_t> image = renderer.readImage();
     for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {

@@ -14,6 +14,7 @@
 #include "gpu/GlContext.h"
 #include "io/CameraJson.h"
 #include "io/Image.h"
+#include "render/RenderSettings.h"
 #include "render/Renderer.h"
 
 namespace subscan::cli {
@@ -25,7 +26,7 @@ struct RenderOptions {
     std::string output;
     int width = 1280;
     int height = 720;
-    std::string mode = "points";
+    std::string mode;
     std::optional<float> pointSize;
     double yaw = 30.0;
     double pitch = 20.0;
@@ -36,7 +37,9 @@ struct RenderOptions {
     std::string background;
     std::string exportDirectory;
     std::string raster;
+    std::string stage;
     std::string settingsFile;
+    std::string saveSettingsFile;
     bool timings = false;
     bool verbose = false;
     bool software = false;
@@ -69,7 +72,7 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
 /// Per-pass median over `timed` frames after one warm-up (llvmpipe compiles shaders lazily and
 /// buffers are allocated on the first frame).
 std::vector<PassTiming> medianTimings(Renderer& renderer, const Camera& camera,
-                                      const RasterSettings& settings, int timed) {
+                                      const RenderSettings& settings, int timed) {
     renderer.render(camera, settings);
     std::vector<std::vector<PassTiming>> frames;
     for (int i = 0; i < timed; ++i) {
@@ -87,36 +90,65 @@ std::vector<PassTiming> medianTimings(Renderer& renderer, const Camera& camera,
     return medians;
 }
 
+/// Linear 0..1 -> sRGB-encoded 8-bit, the CPU twin of linearToSrgb in shared/common.glsl.
+std::uint8_t encodeSrgb(float linear) {
+    const float clamped = std::clamp(linear, 0.0f, 1.0f);
+    const float encoded =
+        clamped <= 0.0031308f ? 12.92f * clamped : 1.055f * std::pow(clamped, 1.0f / 2.4f) - 0.055f;
+    return static_cast<std::uint8_t>(std::lround(encoded * 255.0f));
+}
+
+/// Keeps `channels` of the 4 in an RGBA float image (for PFM, which holds 1 or 3).
+ImageF channelsOf(const Texture& texture, int channels) {
+    const std::vector<float> rgba = texture.readFloats();
+    ImageF image{texture.width(), texture.height(), channels, {}};
+    const std::size_t pixels = rgba.size() / 4;
+    image.values.reserve(pixels * static_cast<std::size_t>(channels));
+    for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+        for (int c = 0; c < channels; ++c) {
+            image.values.push_back(rgba[4 * pixel + static_cast<std::size_t>(c)]);
+        }
+    }
+    return image;
+}
+
+/// camera.json, depth.pfm and color.png always; in surface mode also normals.pfm, mask.png and
+/// radiance.pfm, with depth.pfm holding the reconstructed depth (+inf outside the mask).
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
-                   const Camera& camera) {
+                   const Camera& camera, RenderMode mode) {
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) {
         throw Error(fmt::format("{}: cannot create the directory: {}", directory.string(),
                                 error.message()));
     }
+    const FrameResources& resources = renderer.resources();
+    const bool surface = mode == RenderMode::Surface;
     writeCameraFile(directory / "camera.json", camera);
-    const Texture& depthTexture = renderer.resources().texture("depth");
+    const Texture& depthTexture = resources.texture(surface ? "surfaceDepth" : "depth");
     const std::vector<float> depth = depthTexture.readFloats();
     writePfm(directory / "depth.pfm", {camera.width, camera.height, 1, depth});
 
-    // color.png: the rasterized colour, sRGB, alpha 0 where no point landed.
-    const std::vector<float> color = renderer.resources().texture("color").readFloats();
-    Image8 png{camera.width, camera.height, 4, {}};
-    png.pixels.resize(color.size());
+    // color.png: the point (or filled) colour, sRGB, alpha 0 where nothing is.
+    const std::vector<float> color = resources.texture(surface ? "albedo" : "color").readFloats();
+    Image8 png{camera.width, camera.height, 4, std::vector<std::uint8_t>(color.size())};
     for (std::size_t pixel = 0; pixel < depth.size(); ++pixel) {
-        for (int c = 0; c < 3; ++c) {
-            const float linear =
-                std::clamp(color[4 * pixel + static_cast<std::size_t>(c)], 0.0f, 1.0f);
-            const float encoded = linear <= 0.0031308f
-                                      ? 12.92f * linear
-                                      : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
-            png.pixels[4 * pixel + static_cast<std::size_t>(c)] =
-                static_cast<std::uint8_t>(std::lround(encoded * 255.0f));
+        for (std::size_t c = 0; c < 3; ++c) {
+            png.pixels[4 * pixel + c] = encodeSrgb(color[4 * pixel + c]);
         }
         png.pixels[4 * pixel + 3] = std::isinf(depth[pixel]) ? 0 : 255;
     }
     writePng(directory / "color.png", png);
+    if (!surface) {
+        return;
+    }
+    writePfm(directory / "normals.pfm", channelsOf(resources.texture("normals"), 3));
+    writePfm(directory / "radiance.pfm", channelsOf(resources.texture("radiance"), 3));
+    Image8 mask{camera.width, camera.height, 1, std::vector<std::uint8_t>(depth.size())};
+    for (std::size_t pixel = 0; pixel < depth.size(); ++pixel) {
+        mask.pixels[pixel] = std::isinf(depth[pixel]) ? 0 : 255;
+    }
+    writePng(directory / "mask.png", mask);
 }
 
 int runRender(const RenderOptions& options) {
@@ -126,31 +158,28 @@ int runRender(const RenderOptions& options) {
             fmt::format("{}: refusing to write the image over the input scan", options.output));
     }
 
-    RasterSettings settings;
+    RenderSettings settings;
     if (!options.settingsFile.empty()) {
-        std::ifstream stream(options.settingsFile);
-        if (!stream) {
-            throw Error(fmt::format("{}: cannot open the settings file", options.settingsFile));
-        }
-        try {
-            const nlohmann::json json = nlohmann::json::parse(stream);
-            settings = json.value("raster", nlohmann::json::object()).get<RasterSettings>();
-        } catch (const nlohmann::json::exception& error) {
-            throw Error(
-                fmt::format("{}: invalid settings: {}", options.settingsFile, error.what()));
-        } catch (const Error& error) {
-            throw Error(fmt::format("{}: {}", options.settingsFile, error.what()));
-        }
+        settings = readSettingsFile(options.settingsFile);
     }
-    settings.mode = parseRenderMode(options.mode);
+    RasterSettings& raster = settings.raster;
+    if (!options.mode.empty()) {
+        raster.mode = parseRenderMode(options.mode);
+    }
     if (options.pointSize) {
-        settings.pointSize = *options.pointSize;
+        raster.pointSize = *options.pointSize;
     }
     if (!options.raster.empty()) {
-        settings.path = parseRasterPath(options.raster);
+        raster.path = parseRasterPath(options.raster);
+    }
+    if (!options.stage.empty()) {
+        raster.stage = parseStage(options.stage);
     }
     if (!options.background.empty()) {
-        settings.backgroundSrgb = parseBackground(options.background);
+        raster.backgroundSrgb = parseBackground(options.background);
+    }
+    if (!options.saveSettingsFile.empty()) {
+        writeSettingsFile(options.saveSettingsFile, settings);
     }
 
     const LoadedScan scan = loadScanForCommand(options.source);
@@ -189,7 +218,7 @@ int runRender(const RenderOptions& options) {
     }
 
     if (!options.exportDirectory.empty()) {
-        exportBuffers(options.exportDirectory, renderer, camera);
+        exportBuffers(options.exportDirectory, renderer, camera, raster.mode);
     }
     writePng(output, {camera.width, camera.height, 4, renderer.readImage()});
     return 0;
@@ -206,8 +235,14 @@ Command addRenderCommand(CLI::App& parent) {
         ->check(CLI::Range(1, 65536));
     render->add_option("--height", options->height, "Image height in pixels")
         ->check(CLI::Range(1, 65536));
-    render->add_option("--mode", options->mode, "points | points-gl | splats")
-        ->check(CLI::IsMember({"points", "points-gl", "splats"}));
+    render->add_option("--mode", options->mode, "points (default) | points-gl | splats | surface")
+        ->check(CLI::IsMember({"points", "points-gl", "splats", "surface"}));
+    render
+        ->add_option("--stage", options->stage,
+                     "Show an intermediate: depth | pyramid | visibility | pull | push | fill | "
+                     "normals | shaded (surface mode; depth in any)")
+        ->check(CLI::IsMember({"final", "depth", "pyramid", "visibility", "pull", "push", "fill",
+                               "normals", "shaded"}));
     render->add_option("--point-size", options->pointSize, "Splat size in pixels (splats mode)")
         ->check(CLI::Range(1.0f, 64.0f));
     render->add_option("--yaw", options->yaw, "Orbit angle around the up axis, degrees");
@@ -228,7 +263,13 @@ Command addRenderCommand(CLI::App& parent) {
                        "Directory for camera.json, depth.pfm, color.png");
     render->add_option("--raster", options->raster, "Compute rasterizer: auto | int64 | two-pass")
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
-    render->add_option("--settings", options->settingsFile, "Settings JSON (its \"raster\" part)");
+    render
+        ->add_option("--settings", options->settingsFile,
+                     "Settings JSON ({\"raster\", \"surface\", \"shading\"}); options given "
+                     "here override it")
+        ->check(CLI::ExistingFile);
+    render->add_option("--save-settings", options->saveSettingsFile,
+                       "Write the effective settings as JSON");
     render->add_flag("--timings", options->timings, "Print per-pass milliseconds");
     render->add_flag("-v,--verbose", options->verbose, "Print the OpenGL renderer");
     render->add_flag("--software", options->software,

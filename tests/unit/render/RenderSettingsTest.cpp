@@ -5,6 +5,7 @@
 #include "core/Error.h"
 #include "render/GpuPointCloud.h"
 #include "render/RenderSettings.h"
+#include "support/TestSupport.h"
 
 namespace subscan {
 namespace {
@@ -28,6 +29,33 @@ TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
     EXPECT_EQ(partial.mode, RasterSettings{}.mode);
 }
 
+TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Surface;
+    settings.raster.stage = Stage::Normals;
+    settings.surface.visibilityThreshold = 0.3f;
+    settings.surface.edgeRule = false;
+    settings.shading.lights.push_back({{1, 2, 3}, {0.5f, 0.5f, 0.5f}});
+    const test::TempDir dir;
+    writeSettingsFile(dir / "s.json", settings);
+    const RenderSettings back = readSettingsFile(dir / "s.json");
+    EXPECT_EQ(back.raster.mode, RenderMode::Surface);
+    EXPECT_EQ(back.raster.stage, Stage::Normals);
+    EXPECT_EQ(back.surface.visibilityThreshold, 0.3f);
+    EXPECT_FALSE(back.surface.edgeRule);
+    ASSERT_EQ(back.shading.lights.size(), 1u);
+    EXPECT_EQ(back.shading.lights[0].direction, glm::vec3(1, 2, 3));
+    const auto bad = dir.write("bad.json", R"({"surface": {"fill_threshold": 3}})");
+    try {
+        readSettingsFile(bad);
+        FAIL() << "accepted";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("'fill_threshold' = 3 is outside 0..1"));
+    }
+    const auto unknown = dir.write("unknown.json", R"({"surfaces": {}})");
+    EXPECT_THROW(readSettingsFile(unknown), Error);
+}
+
 TEST(RenderSettingsTest, BadValuesAreNamed) {
     EXPECT_THROW(nlohmann::json({{"mode", "voxels"}}).get<RasterSettings>(), Error);
     EXPECT_THROW(nlohmann::json({{"point_size", 0}}).get<RasterSettings>(), Error);
@@ -35,7 +63,7 @@ TEST(RenderSettingsTest, BadValuesAreNamed) {
     try {
         parseRenderMode("voxels");
     } catch (const Error& error) {
-        EXPECT_THAT(error.what(), ::testing::HasSubstr("points, points-gl, splats"));
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("points, points-gl, splats, surface"));
     }
 }
 

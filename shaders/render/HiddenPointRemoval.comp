@@ -1,0 +1,75 @@
+#version 450
+// Hidden point removal on the min-depth pyramid (paper §4; Pintus 2011, Bouchiba 2018).
+// For a pixel holding a point x, in each of 8 directions look at the neighbouring texel on
+// every level up to L(x) and keep the smallest
+//     omega(x, y) = 1 - dot(normalize(y - x), normalize(-x)),
+// i.e. the neighbour y that rises most towards the camera. x is visible when the mean of the 8
+// smallest omegas reaches tau, or (the paper's edge rule) when 3 consecutive directions occlude
+// while at least 3 others are open: x then lies just beyond an occluder's silhouette.
+#include "shared/pyramid.glsl"
+
+layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
+    SurfaceParams surface;
+};
+layout(std430, binding = SUBSCAN_SSBO_PYRAMID) readonly buffer Pyramid {
+    float minDepth[];
+};
+layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility;
+
+const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
+                                     ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (!insideLevel(0u, pixel)) {
+        return;
+    }
+    float depth = minDepth[texelIndex(0u, pixel)];
+    if (isinf(depth)) {
+        imageStore(outVisibility, pixel, vec4(0.0));
+        return;
+    }
+    vec3 x = viewPositionAt(vec2(pixel) + 0.5, depth);
+    vec3 toCamera = normalize(-x);
+    float maxLevel = clamp(levelForRadius(surface.visibility.x, depth), 0.0,
+                           float(levelCount() - 1u));
+    uint levels = uint(maxLevel);
+    float tau = surface.visibility.y;
+
+    float omega[8];
+    float sum = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        // A direction without any neighbour counts as open sideways (omega = 1).
+        float smallest = 1.0;
+        bool found = false;
+        for (uint level = 0u; level <= levels; ++level) {
+            ivec2 texel = (pixel >> level) + kDirections[k];
+            if (!insideLevel(level, texel)) {
+                continue;
+            }
+            float neighbourDepth = minDepth[texelIndex(level, texel)];
+            if (isinf(neighbourDepth)) {
+                continue;
+            }
+            vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
+            float value = 1.0 - dot(normalize(y - x), toCamera);
+            smallest = found ? min(smallest, value) : value;
+            found = true;
+        }
+        omega[k] = smallest;
+        sum += smallest;
+    }
+    bool visible = sum / 8.0 >= tau;
+    if (!visible && surface.visibility.z > 0.5) {
+        int open = 0;
+        for (int k = 0; k < 8; ++k) {
+            open += omega[k] >= tau ? 1 : 0;
+        }
+        for (int k = 0; k < 8 && !visible; ++k) {
+            bool run = omega[k] < tau && omega[(k + 1) % 8] < tau && omega[(k + 2) % 8] < tau;
+            visible = run && open >= 3;
+        }
+    }
+    imageStore(outVisibility, pixel, vec4(visible ? 1.0 : 0.0));
+}

@@ -1,0 +1,36 @@
+#version 450
+// Min-depth pyramid (paper Fig. 3): level 0 is the rasterized depth, a texel of level R the
+// minimum of its 2x2 children on level R-1 (children past an odd edge simply do not exist).
+//   STAGE_COPY    level 0 from the "depth" image
+//   STAGE_REDUCE  level `level` from level `level` - 1
+#include "shared/pyramid.glsl"
+
+layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
+layout(std430, binding = SUBSCAN_SSBO_PYRAMID) buffer Pyramid {
+    float minDepth[];
+};
+#if STAGE_COPY
+layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
+#endif
+
+void main() {
+    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    if (!insideLevel(level, texel)) {
+        return;
+    }
+#if STAGE_COPY
+    minDepth[texelIndex(0u, texel)] = imageLoad(inDepth, texel).r;
+#else
+    float nearest = kInfinity;
+    for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+            ivec2 child = 2 * texel + ivec2(dx, dy);
+            if (insideLevel(level - 1u, child)) {
+                nearest = min(nearest, minDepth[texelIndex(level - 1u, child)]);
+            }
+        }
+    }
+    minDepth[texelIndex(level, texel)] = nearest;
+#endif
+}

@@ -1,0 +1,99 @@
+#version 450
+// Normals from the filled depth (Bouchiba 2018): on every push level, back-project a texel and
+// its neighbours, take per axis the tangent towards the neighbour with the smaller depth jump
+// (so silhouettes do not bend normals), cross them and face the result to the camera. Each
+// pixel then blends the normals of the two levels around its fractional smoothing level.
+//   STAGE_LEVEL  normals of level `level` into the normal pyramid
+//   STAGE_BLEND  the per-pixel blend into the "normals" image (view space)
+#include "shared/pyramid.glsl"
+
+layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
+layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
+    SurfaceParams surface;
+};
+layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) readonly buffer PushValues {
+    vec4 pushValue[];
+};
+layout(std430, binding = SUBSCAN_SSBO_NORMALS) buffer Normals {
+    vec4 normalPyramid[];
+};
+#if STAGE_BLEND
+layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
+layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outNormals;
+#endif
+
+#if STAGE_LEVEL
+vec3 positionOf(ivec2 texel) {
+    return viewPositionAt(texelCentre(level, texel), pushValue[texelIndex(level, texel)].x);
+}
+
+/// The tangent along `axis`: towards whichever existing neighbour has the smaller depth jump.
+vec3 tangent(ivec2 texel, vec3 centre, ivec2 axis) {
+    bool hasNext = insideLevel(level, texel + axis);
+    bool hasPrevious = insideLevel(level, texel - axis);
+    vec3 next = hasNext ? positionOf(texel + axis) - centre : vec3(0.0);
+    vec3 previous = hasPrevious ? centre - positionOf(texel - axis) : vec3(0.0);
+    if (!hasPrevious) {
+        return next;
+    }
+    if (!hasNext) {
+        return previous;
+    }
+    return abs(next.z) <= abs(previous.z) ? next : previous;
+}
+#endif
+
+#if STAGE_BLEND
+vec3 normalOnLevel(uint normalLevel, vec2 window) {
+    ivec2 texels[4];
+    float weights[4];
+    bilinearTexels(normalLevel, window, texels, weights);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < 4; ++i) {
+        sum += weights[i] * normalPyramid[texelIndex(normalLevel, texels[i])].xyz;
+    }
+    return sum;
+}
+#endif
+
+void main() {
+    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+#if STAGE_LEVEL
+    if (!insideLevel(level, texel)) {
+        return;
+    }
+    vec3 centre = positionOf(texel);
+    vec3 normal = cross(tangent(texel, centre, ivec2(1, 0)), tangent(texel, centre, ivec2(0, 1)));
+    float length2 = dot(normal, normal);
+    // Degenerate (a 1-texel level, or infinite depth): face the camera.
+    normal = length2 > 0.0 && !isinf(length2) && !isnan(length2) ? normal * inversesqrt(length2)
+                                                                  : normalize(-centre);
+    if (isnan(normal.x)) {
+        normal = vec3(0.0, 0.0, 1.0);
+    }
+    if (dot(normal, -centre) < 0.0) {
+        normal = -normal;
+    }
+    normalPyramid[texelIndex(level, texel)] = vec4(normal, 0.0);
+#else
+    if (!insideLevel(0u, texel)) {
+        return;
+    }
+    float depth = imageLoad(inSurfaceDepth, texel).r;
+    if (isinf(depth)) {
+        imageStore(outNormals, texel, vec4(0.0));
+        return;
+    }
+    float smoothing = clamp(levelForRadius(surface.normals.x, depth), 0.0,
+                            float(levelCount() - 1u));
+    uint lower = uint(smoothing);
+    uint upper = min(lower + 1u, levelCount() - 1u);
+    vec2 window = vec2(texel) + 0.5;
+    vec3 normal = mix(normalOnLevel(lower, window), normalOnLevel(upper, window),
+                      smoothing - float(lower));
+    float length2 = dot(normal, normal);
+    normal = length2 > 0.0 ? normal * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
+    imageStore(outNormals, texel, vec4(normal, 1.0));
+#endif
+}

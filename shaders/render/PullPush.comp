@@ -1,0 +1,87 @@
+#version 450
+// Pull-push interpolation (Kraus 2009) of depth and colour together, weighted by visibility.
+//   STAGE_PULL_INIT  level 0: w = 1 for visible points, else 0; a = w * (depth, r, g, b)
+//   STAGE_PULL       level R from R-1: W and A summed over the 4x4 children with the kernel
+//                    h = {1/3, 1, 1, 1/3} per axis; w = min(1, W), a = A * w / W
+//   STAGE_PUSH_TOP   the coarsest level: complete value a / w
+//   STAGE_PUSH       level R from R+1: m = bilinear of the complete coarser level with the
+//                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 also
+//                    writes the "filledDepth" and "filledColor" images.
+#include "shared/pyramid.glsl"
+
+layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
+layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) buffer PullValues {
+    vec4 pullValue[];
+};
+layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) buffer PullWeights {
+    float pullWeight[];
+};
+layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) buffer PushValues {
+    vec4 pushValue[];
+};
+#if STAGE_PULL_INIT
+layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
+layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inColor;
+layout(binding = SUBSCAN_IMAGE_IN2, r8) readonly uniform image2D inVisibility;
+#endif
+#if STAGE_PUSH
+layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
+layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor;
+#endif
+
+const float kPullKernel[4] = float[](1.0 / 3.0, 1.0, 1.0, 1.0 / 3.0);
+
+void main() {
+    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    if (!insideLevel(level, texel)) {
+        return;
+    }
+    uint index = texelIndex(level, texel);
+#if STAGE_PULL_INIT
+    bool visible = imageLoad(inVisibility, texel).r > 0.5;
+    // Only visible texels carry values: an empty texel's depth is +inf, and 0 * inf is NaN.
+    pullWeight[index] = visible ? 1.0 : 0.0;
+    pullValue[index] = visible ? vec4(imageLoad(inDepth, texel).r, imageLoad(inColor, texel).rgb)
+                               : vec4(0.0);
+#elif STAGE_PULL
+    float weightSum = 0.0;
+    vec4 valueSum = vec4(0.0);
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            ivec2 child = 2 * texel + ivec2(i - 1, j - 1);
+            if (!insideLevel(level - 1u, child)) {
+                continue;
+            }
+            uint childIndex = texelIndex(level - 1u, child);
+            float h = kPullKernel[i] * kPullKernel[j];
+            weightSum += h * pullWeight[childIndex];
+            valueSum += h * pullValue[childIndex];
+        }
+    }
+    float clamped = min(1.0, weightSum);
+    pullWeight[index] = clamped;
+    pullValue[index] = weightSum > 0.0 ? valueSum * (clamped / weightSum) : vec4(0.0);
+#elif STAGE_PUSH_TOP
+    float weight = pullWeight[index];
+    pushValue[index] = weight > 0.0 ? pullValue[index] / weight : vec4(kInfinity, 0.0, 0.0, 0.0);
+#else
+    // Coarse neighbours of this texel and their weights {3/4, 1/4} per axis.
+    ivec2 coarseSize = levelSize(level + 1u);
+    ivec2 near = texel >> 1;
+    ivec2 far = clamp(near + ((texel & 1) * 2 - 1), ivec2(0), coarseSize - 1);
+    vec4 m = 0.5625 * pushValue[texelIndex(level + 1u, near)] +
+             0.1875 * pushValue[texelIndex(level + 1u, ivec2(far.x, near.y))] +
+             0.1875 * pushValue[texelIndex(level + 1u, ivec2(near.x, far.y))] +
+             0.0625 * pushValue[texelIndex(level + 1u, far)];
+    // A fully weighted texel needs nothing from above (and an empty image above would give
+    // 0 * inf = NaN).
+    float weight = pullWeight[index];
+    vec4 complete = weight >= 1.0 ? pullValue[index] : pullValue[index] + (1.0 - weight) * m;
+    pushValue[index] = complete;
+    if (level == 0u) {
+        imageStore(outDepth, texel, vec4(complete.x));
+        imageStore(outColor, texel, vec4(complete.yzw, 1.0));
+    }
+#endif
+}

@@ -1,0 +1,29 @@
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "gpu/GlObjects.h"
+#include "gpu/ShaderSources.h"
+
+namespace subscan {
+
+/// The variants of one compute shader, one per STAGE_* macro: `names` {"COPY", "REDUCE"} build
+/// the shader once with STAGE_COPY 1 (others 0), once with STAGE_REDUCE 1, and so on.
+class ComputeStages {
+  public:
+    ComputeStages(const ShaderSources& sources, std::string_view path,
+                  const std::vector<std::string>& names);
+    const Program& operator[](std::size_t stage) const { return programs_[stage]; }
+
+    /// Runs `stage` over a width x height grid of image-sized work groups, with the per-level
+    /// uniform set to `level` where the stage declares it.
+    void runOverImage(std::size_t stage, int width, int height, unsigned level = 0) const;
+
+  private:
+    std::vector<Program> programs_;
+    std::vector<bool> hasLevelUniform_;
+};
+
+}  // namespace subscan

@@ -1,0 +1,18 @@
+#include "render/HiddenPointRemovalPass.h"
+
+namespace subscan {
+
+HiddenPointRemovalPass::HiddenPointRemovalPass(const ShaderSources& sources)
+    : stages_(sources, "render/HiddenPointRemoval.comp", {"ALL"}) {}
+
+void HiddenPointRemovalPass::execute(FrameContext& frame) {
+    Texture& visibility = frame.resources.ensureTexture("visibility", TextureFormat::R8,
+                                                        frame.width(), frame.height());
+    frame.resources.buffer("pyramid").bindStorage(SUBSCAN_SSBO_PYRAMID);
+    visibility.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    stages_.runOverImage(0, frame.width(), frame.height());
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+}  // namespace subscan

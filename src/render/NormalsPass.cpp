@@ -1,0 +1,29 @@
+#include "render/NormalsPass.h"
+
+#include "render/Pyramid.h"
+
+namespace subscan {
+
+NormalsPass::NormalsPass(const ShaderSources& sources)
+    : stages_(sources, "render/Normals.comp", {"LEVEL", "BLEND"}) {}
+
+void NormalsPass::execute(FrameContext& frame) {
+    FrameResources& resources = frame.resources;
+    resources.ensureBuffer("normalPyramid", pyramidTexels(frame.pyramid) * 4 * sizeof(float))
+        .bindStorage(SUBSCAN_SSBO_NORMALS);
+    resources.buffer("pushValues").bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
+    Texture& normals =
+        resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
+    for (unsigned level = 0; level < frame.pyramid.info.x; ++level) {
+        const auto& size = frame.pyramid.levels[level];
+        stages_.runOverImage(Level, static_cast<int>(size.y), static_cast<int>(size.z), level);
+    }
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    stages_.runOverImage(Blend, frame.width(), frame.height());
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+}  // namespace subscan

@@ -1,0 +1,25 @@
+#pragma once
+
+#include "render/ComputeStages.h"
+#include "render/RenderPass.h"
+
+namespace subscan {
+
+/// Normals of the reconstructed surface (DESIGN.md §5.5): per push level into the buffer
+/// "normalPyramid", then blended per pixel between the two levels around its smoothing level
+/// into "normals" (view space, zero outside the mask).
+class NormalsPass final : public RenderPass {
+  public:
+    explicit NormalsPass(const ShaderSources& sources);
+
+    std::string_view name() const override { return "Normals"; }
+    std::vector<std::string_view> inputs() const override { return {"pushValues", "surfaceDepth"}; }
+    std::vector<std::string_view> outputs() const override { return {"normalPyramid", "normals"}; }
+    void execute(FrameContext& frame) override;
+
+  private:
+    enum Stage { Level, Blend };
+    ComputeStages stages_;
+};
+
+}  // namespace subscan

@@ -1,0 +1,47 @@
+#include "render/PullPushPass.h"
+
+#include "render/Pyramid.h"
+
+namespace subscan {
+
+PullPushPass::PullPushPass(const ShaderSources& sources)
+    : stages_(sources, "render/PullPush.comp", {"PULL_INIT", "PULL", "PUSH_TOP", "PUSH"}) {}
+
+void PullPushPass::execute(FrameContext& frame) {
+    const std::size_t texels = pyramidTexels(frame.pyramid);
+    FrameResources& resources = frame.resources;
+    resources.ensureBuffer("pullValues", texels * 4 * sizeof(float))
+        .bindStorage(SUBSCAN_SSBO_PULL_VALUES);
+    resources.ensureBuffer("pullWeights", texels * sizeof(float))
+        .bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
+    resources.ensureBuffer("pushValues", texels * 4 * sizeof(float))
+        .bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
+    Texture& filledDepth =
+        resources.ensureTexture("filledDepth", TextureFormat::R32F, frame.width(), frame.height());
+    Texture& filledColor = resources.ensureTexture("filledColor", TextureFormat::RGBA16F,
+                                                   frame.width(), frame.height());
+    resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    resources.texture("color").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+    resources.texture("visibility").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
+    filledDepth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    filledColor.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+
+    const unsigned levels = frame.pyramid.info.x;
+    auto run = [&](Stage stage, unsigned level) {
+        const auto& size = frame.pyramid.levels[level];
+        stages_.runOverImage(stage, static_cast<int>(size.y), static_cast<int>(size.z), level);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    };
+    run(PullInit, 0);
+    for (unsigned level = 1; level < levels; ++level) {
+        run(Pull, level);
+    }
+    run(PushTop, levels - 1);
+    for (unsigned level = levels - 1; level-- > 0;) {
+        run(Push, level);
+    }
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+}  // namespace subscan

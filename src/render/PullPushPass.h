@@ -1,0 +1,29 @@
+#pragma once
+
+#include "render/ComputeStages.h"
+#include "render/RenderPass.h"
+
+namespace subscan {
+
+/// Pull-push fill of depth and colour from the visible points (DESIGN.md §5.4). Keeps every
+/// pull level ("pullValues" w*(depth, rgb), "pullWeights" w) and push level ("pushValues"), and
+/// writes level 0 of the push as "filledDepth" and "filledColor".
+class PullPushPass final : public RenderPass {
+  public:
+    explicit PullPushPass(const ShaderSources& sources);
+
+    std::string_view name() const override { return "PullPush"; }
+    std::vector<std::string_view> inputs() const override {
+        return {"depth", "color", "visibility"};
+    }
+    std::vector<std::string_view> outputs() const override {
+        return {"pullValues", "pullWeights", "pushValues", "filledDepth", "filledColor"};
+    }
+    void execute(FrameContext& frame) override;
+
+  private:
+    enum Stage { PullInit, Pull, PushTop, Push };
+    ComputeStages stages_;
+};
+
+}  // namespace subscan

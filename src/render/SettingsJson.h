@@ -1,0 +1,71 @@
+#pragma once
+
+#include <array>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+
+namespace subscan {
+
+/// Reads `key` into `value` when present (absent keys keep their defaults, so a settings file
+/// holds only what it changes), checking min <= value <= max. Throws subscan::Error naming the
+/// key.
+template <class T>
+void readSetting(const nlohmann::json& json, std::string_view key, T& value, T min, T max) {
+    const auto found = json.find(key);
+    if (found == json.end()) {
+        return;
+    }
+    T read{};
+    try {
+        read = found->get<T>();
+    } catch (const nlohmann::json::exception&) {
+        throw Error(fmt::format("the setting '{}' has the wrong type", key));
+    }
+    if (!(read >= min && read <= max)) {
+        throw Error(fmt::format("the setting '{}' = {} is outside {}..{}", key, read, min, max));
+    }
+    value = read;
+}
+
+inline void readSetting(const nlohmann::json& json, std::string_view key, bool& value) {
+    const auto found = json.find(key);
+    if (found == json.end()) {
+        return;
+    }
+    if (!found->is_boolean()) {
+        throw Error(fmt::format("the setting '{}' must be true or false", key));
+    }
+    value = found->get<bool>();
+}
+
+/// An RGB triple, each component within min..max.
+inline void readSetting(const nlohmann::json& json, std::string_view key, glm::vec3& value,
+                        float min, float max) {
+    const auto found = json.find(key);
+    if (found == json.end()) {
+        return;
+    }
+    std::array<float, 3> read{};
+    try {
+        read = found->get<std::array<float, 3>>();
+    } catch (const nlohmann::json::exception&) {
+        throw Error(fmt::format("the setting '{}' must be 3 numbers", key));
+    }
+    for (const float component : read) {
+        if (!(component >= min && component <= max)) {
+            throw Error(fmt::format("the setting '{}' has a value outside {}..{}", key, min, max));
+        }
+    }
+    value = {read[0], read[1], read[2]};
+}
+
+inline nlohmann::json toJson(const glm::vec3& value) {
+    return {value.x, value.y, value.z};
+}
+
+}  // namespace subscan

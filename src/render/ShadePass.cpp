@@ -1,0 +1,50 @@
+#include "render/ShadePass.h"
+
+#include <algorithm>
+
+#include <glm/geometric.hpp>
+
+namespace subscan {
+
+ShadePass::ShadePass(const ShaderSources& sources)
+    : stages_(sources, "render/Shade.comp", {"ALL"}) {}
+
+gpu::ShadeParams ShadePass::parameters(const ShadingSettings& settings, const Camera& camera) {
+    gpu::ShadeParams params{};
+    params.headLight = glm::vec4(settings.headLight, 0.0f);
+    params.ambient = glm::vec4(settings.ambient, 0.0f);
+    params.specular = {settings.specular, settings.shininess, 0.0f, 0.0f};
+    const std::size_t count = std::min<std::size_t>(settings.lights.size(), SUBSCAN_MAX_LIGHTS);
+    for (std::size_t i = 0; i < count; ++i) {
+        const glm::dvec3 direction =
+            glm::dvec3(camera.view * glm::dvec4(glm::dvec3(settings.lights[i].direction), 0.0));
+        params.lightDirection[i] = glm::vec4(glm::normalize(direction), 0.0);
+        params.lightColor[i] = glm::vec4(settings.lights[i].radiance, 0.0f);
+    }
+    params.lightCount = {static_cast<std::uint32_t>(count), 0, 0, 0};
+    return params;
+}
+
+void ShadePass::execute(FrameContext& frame) {
+    FrameResources& resources = frame.resources;
+    const int width = frame.width();
+    const int height = frame.height();
+    Texture& diffuse = resources.ensureTexture("diffuse", TextureFormat::RGBA16F, width, height);
+    Texture& specular = resources.ensureTexture("specular", TextureFormat::RGBA16F, width, height);
+    Texture& albedo = resources.ensureTexture("albedo", TextureFormat::RGBA16F, width, height);
+    Texture& radiance = resources.ensureTexture("radiance", TextureFormat::RGBA16F, width, height);
+    params_.set(parameters(frame.settings.shading, frame.camera));
+    params_.bind(SUBSCAN_UBO_PASS);
+    resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    resources.texture("normals").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+    resources.texture("filledColor").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
+    diffuse.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    specular.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    albedo.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    radiance.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
+    stages_.runOverImage(0, width, height);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+}  // namespace subscan

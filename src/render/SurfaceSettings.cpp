@@ -1,0 +1,66 @@
+#include "render/SurfaceSettings.h"
+
+#include "render/SettingsJson.h"
+#include "shared/bindings.h"
+
+namespace subscan {
+
+void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
+    json = {
+        {"visibility_radius", settings.visibilityRadius},
+        {"visibility_threshold", settings.visibilityThreshold},
+        {"edge_rule", settings.edgeRule},
+        {"fill_radius", settings.fillRadius},
+        {"fill_threshold", settings.fillThreshold},
+        {"normal_radius", settings.normalRadius},
+    };
+}
+
+void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
+    readSetting(json, "visibility_radius", settings.visibilityRadius, 0.1f, 1000.0f);
+    readSetting(json, "visibility_threshold", settings.visibilityThreshold, 0.0f, 2.0f);
+    readSetting(json, "edge_rule", settings.edgeRule);
+    readSetting(json, "fill_radius", settings.fillRadius, 0.1f, 1000.0f);
+    readSetting(json, "fill_threshold", settings.fillThreshold, 0.0f, 1.0f);
+    readSetting(json, "normal_radius", settings.normalRadius, 0.1f, 1000.0f);
+}
+
+void to_json(nlohmann::json& json, const ShadingSettings& settings) {
+    nlohmann::json lights = nlohmann::json::array();
+    for (const DirectionalLight& light : settings.lights) {
+        lights.push_back(
+            {{"direction", toJson(light.direction)}, {"radiance", toJson(light.radiance)}});
+    }
+    json = {
+        {"head_light", toJson(settings.headLight)},
+        {"ambient", toJson(settings.ambient)},
+        {"specular", settings.specular},
+        {"shininess", settings.shininess},
+        {"lights", lights},
+    };
+}
+
+void from_json(const nlohmann::json& json, ShadingSettings& settings) {
+    readSetting(json, "head_light", settings.headLight, 0.0f, 100.0f);
+    readSetting(json, "ambient", settings.ambient, 0.0f, 100.0f);
+    readSetting(json, "specular", settings.specular, 0.0f, 1.0f);
+    readSetting(json, "shininess", settings.shininess, 1.0f, 10000.0f);
+    if (const auto lights = json.find("lights"); lights != json.end()) {
+        if (!lights->is_array() || lights->size() > SUBSCAN_MAX_LIGHTS) {
+            throw Error(fmt::format("the setting 'lights' must be a list of at most {} lights",
+                                    SUBSCAN_MAX_LIGHTS));
+        }
+        settings.lights.clear();
+        for (const nlohmann::json& entry : *lights) {
+            DirectionalLight light;
+            readSetting(entry, "direction", light.direction, -1e6f, 1e6f);
+            readSetting(entry, "radiance", light.radiance, 0.0f, 100.0f);
+            if (!(glm::dot(light.direction, light.direction) > 0.0f)) {
+                throw Error("a light's 'direction' must not be zero");
+            }
+            settings.lights.push_back(light);
+        }
+    }
+}
+
+}  // namespace subscan

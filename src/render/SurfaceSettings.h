@@ -1,0 +1,41 @@
+#pragma once
+
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json_fwd.hpp>
+
+namespace subscan {
+
+/// The screen-space reconstruction (DESIGN.md §5 steps 3-5). Radii are multiples of the point
+/// spacing h, so the defaults fit any scan at any scale; each pass turns its radius into a
+/// pyramid level per pixel: level = log2(radius * h * focal length / depth).
+struct SurfaceSettings {
+    float visibilityRadius = 4.0f;     // HPR looks this far for occluders (x h)
+    float visibilityThreshold = 0.1f;  // tau: mean of the 8 smallest omegas for "visible"
+    bool edgeRule = true;              // the paper's silhouette rule
+    float fillRadius = 1.0f;           // the expected gap between points (x h)
+    float fillThreshold = 0.5f;        // pull weight on the gap level for "surface"
+    float normalRadius = 2.0f;         // normal smoothing (x h)
+};
+
+struct DirectionalLight {
+    glm::vec3 direction{0.0f, 1.0f, 0.0f};  // towards the light, world space
+    glm::vec3 radiance{1.0f};
+};
+
+/// Deferred shading (DESIGN.md §5 step 6). Radiances are linear RGB.
+struct ShadingSettings {
+    glm::vec3 headLight{0.85f};
+    glm::vec3 ambient{0.15f};
+    float specular = 0.08f;                // Blinn-Phong reflectance
+    float shininess = 40.0f;               // Blinn-Phong exponent
+    std::vector<DirectionalLight> lights;  // at most SUBSCAN_MAX_LIGHTS
+};
+
+void to_json(nlohmann::json& json, const SurfaceSettings& settings);
+void from_json(const nlohmann::json& json, SurfaceSettings& settings);
+void to_json(nlohmann::json& json, const ShadingSettings& settings);
+void from_json(const nlohmann::json& json, ShadingSettings& settings);
+
+}  // namespace subscan
