@@ -1,11 +1,398 @@
 #include "io/LasReader.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
 #include "core/Error.h"
+#include "io/ByteOrder.h"
 
 namespace subscan {
 
-PointCloud readLas(std::span<const std::byte>, ReadContext&) {
-    throw Error("Las reading is being written");
+namespace {
+
+/// Byte offsets of the public header block fields we use (LAS 1.4 R15, table 3; the fields up to
+/// byte 227 sit at the same place in every version since 1.0).
+namespace header_field {
+constexpr std::size_t kVersionMajor = 24;
+constexpr std::size_t kVersionMinor = 25;
+constexpr std::size_t kHeaderSize = 94;
+constexpr std::size_t kPointDataOffset = 96;
+constexpr std::size_t kVlrCount = 100;
+constexpr std::size_t kPointFormat = 104;
+constexpr std::size_t kRecordLength = 105;
+constexpr std::size_t kLegacyPointCount = 107;
+constexpr std::size_t kScale = 131;         // x, y, z doubles
+constexpr std::size_t kOffset = 155;        // x, y, z doubles
+constexpr std::size_t kBounds = 179;        // max x, min x, max y, min y, max z, min z doubles
+constexpr std::size_t kPointCount64 = 247;  // LAS 1.4 only
+}  // namespace header_field
+
+constexpr std::string_view kSignature = "LASF";
+constexpr std::size_t kHeaderSizeUpTo12 = 227;
+constexpr std::size_t kHeaderSize13 = 235;  // adds the waveform data offset
+constexpr std::size_t kHeaderSize14 = 375;  // adds EVLRs and 64-bit point counts
+constexpr int kLatestMinorVersion = 4;
+
+// laszip marks compressed point data with bit 7 of the point format byte (bit 6 too in its
+// layered-chunk variant) and describes the compressor in a VLR.
+constexpr std::uint8_t kCompressionBits = 0xC0;
+constexpr std::size_t kVlrHeaderSize = 54;
+constexpr std::size_t kVlrUserIdOffset = 2;
+constexpr std::size_t kVlrUserIdSize = 16;
+constexpr std::size_t kVlrRecordIdOffset = 18;
+constexpr std::size_t kVlrLengthOffset = 20;
+constexpr std::string_view kLaszipUserId = "laszip encoded";
+constexpr std::uint16_t kLaszipRecordId = 22204;
+
+constexpr std::size_t kIntensityOffset = 12;  // in every point format
+
+struct PointFormatLayout {
+    std::size_t recordSize;
+    std::optional<std::size_t> colorOffset;  // three uint16 (R, G, B) where the format has them
+    int firstMinorVersion;                   // the LAS 1.x version that introduced the format
+};
+
+// LAS 1.4 R15, section 2.6: formats 0-5 extend the 20-byte legacy core, formats 6-10 the 30-byte
+// core that LAS 1.4 introduced (wider return and class fields, 16-bit scan angle, GPS time).
+constexpr std::array<PointFormatLayout, 11> kPointFormats{{
+    {20, std::nullopt, 0},
+    {28, std::nullopt, 0},
+    {26, 20, 2},
+    {34, 28, 2},
+    {57, std::nullopt, 3},
+    {63, 28, 3},
+    {30, std::nullopt, 4},
+    {36, 30, 4},
+    {38, 30, 4},
+    {59, std::nullopt, 4},
+    {67, 30, 4},
+}};
+
+struct LasHeader {
+    int versionMinor = 0;
+    std::size_t headerSize = 0;
+    std::size_t pointDataOffset = 0;
+    int pointFormat = 0;
+    std::size_t recordLength = 0;
+    std::uint64_t pointCount = 0;
+    glm::dvec3 scale{1.0};
+    glm::dvec3 offset{0.0};
+    Bounds declaredBounds;
+};
+
+template <class T>
+T loadField(std::span<const std::byte> file, std::size_t offset) {
+    return loadLittleEndian<T>(file.data() + offset);
+}
+
+glm::dvec3 loadDoubleTriple(std::span<const std::byte> file, std::size_t offset) {
+    return {loadField<double>(file, offset), loadField<double>(file, offset + 8),
+            loadField<double>(file, offset + 16)};
+}
+
+std::size_t requiredHeaderSize(int versionMinor) {
+    if (versionMinor <= 2) {
+        return kHeaderSizeUpTo12;
+    }
+    return versionMinor == 3 ? kHeaderSize13 : kHeaderSize14;
+}
+
+[[noreturn]] void throwCompressed() {
+    throw Error(
+        "compressed LAS (LAZ) is not supported yet; decompress it first, e.g. with "
+        "'laszip -i in.laz -o out.las' or 'pdal translate in.laz out.las'");
+}
+
+/// Whether the VLRs (between the header and the point data) contain the laszip descriptor. A file
+/// whose format byte lost its compression bits still holds compressed points then. The VLR area
+/// belongs to other readers: a malformed one merely ends the search.
+bool hasLaszipRecord(std::span<const std::byte> file, const LasHeader& header) {
+    const std::uint32_t vlrCount = loadField<std::uint32_t>(file, header_field::kVlrCount);
+    std::size_t position = header.headerSize;
+    for (std::uint32_t i = 0; i < vlrCount; ++i) {
+        if (header.pointDataOffset - position < kVlrHeaderSize) {
+            return false;
+        }
+        const std::byte* record = file.data() + position;
+        const std::string_view userId(reinterpret_cast<const char*>(record + kVlrUserIdOffset),
+                                      kVlrUserIdSize);
+        if (userId.substr(0, userId.find('\0')) == kLaszipUserId &&
+            loadLittleEndian<std::uint16_t>(record + kVlrRecordIdOffset) == kLaszipRecordId) {
+            return true;
+        }
+        const std::size_t payload = loadLittleEndian<std::uint16_t>(record + kVlrLengthOffset);
+        if (header.pointDataOffset - position - kVlrHeaderSize < payload) {
+            return false;
+        }
+        position += kVlrHeaderSize + payload;
+    }
+    return false;
+}
+
+void checkScaleAndOffset(const LasHeader& header) {
+    for (int axis = 0; axis < 3; ++axis) {
+        const char name = "xyz"[axis];
+        const double scale = header.scale[axis];
+        if (!std::isfinite(scale) || scale == 0.0) {
+            throw Error(
+                fmt::format("the LAS {} scale factor is {}; it must be a finite, non-zero "
+                            "number",
+                            name, scale));
+        }
+        if (!std::isfinite(header.offset[axis])) {
+            throw Error(fmt::format("the LAS {} offset is {}; it must be a finite number", name,
+                                    header.offset[axis]));
+        }
+    }
+}
+
+/// Validates the public header block against the file; every size it returns is in range.
+LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
+    if (file.size() < kSignature.size() ||
+        std::memcmp(file.data(), kSignature.data(), kSignature.size()) != 0) {
+        throw Error("it does not start with the LAS signature 'LASF'");
+    }
+    if (file.size() < kHeaderSizeUpTo12) {
+        throw Error(
+            fmt::format("the file has only {} bytes, fewer than the {} bytes of the smallest "
+                        "LAS header (file truncated?)",
+                        file.size(), kHeaderSizeUpTo12));
+    }
+    // Checked before anything else: whatever else a LAZ header says, the answer is the same.
+    const auto formatByte = loadField<std::uint8_t>(file, header_field::kPointFormat);
+    if ((formatByte & kCompressionBits) != 0) {
+        throwCompressed();
+    }
+
+    LasHeader header;
+    const int major = loadField<std::uint8_t>(file, header_field::kVersionMajor);
+    header.versionMinor = loadField<std::uint8_t>(file, header_field::kVersionMinor);
+    if (major != 1 || header.versionMinor > kLatestMinorVersion) {
+        throw Error(fmt::format("LAS version {}.{} is not supported (supported: 1.0 to 1.{})",
+                                major, header.versionMinor, kLatestMinorVersion));
+    }
+    header.headerSize = loadField<std::uint16_t>(file, header_field::kHeaderSize);
+    const std::size_t required = requiredHeaderSize(header.versionMinor);
+    if (header.headerSize < required) {
+        throw Error(
+            fmt::format("the LAS 1.{} header declares a size of {} bytes, less than the {} "
+                        "bytes that version needs",
+                        header.versionMinor, header.headerSize, required));
+    }
+    if (header.headerSize > file.size()) {
+        throw Error(
+            fmt::format("the file has only {} bytes, fewer than its {}-byte LAS header "
+                        "(file truncated?)",
+                        file.size(), header.headerSize));
+    }
+    header.pointDataOffset = loadField<std::uint32_t>(file, header_field::kPointDataOffset);
+    if (header.pointDataOffset < header.headerSize) {
+        throw Error(fmt::format("the LAS point data offset {} lies inside the {}-byte header",
+                                header.pointDataOffset, header.headerSize));
+    }
+    if (header.pointDataOffset > file.size()) {
+        throw Error(
+            fmt::format("the LAS point data offset {} lies beyond the end of the file "
+                        "({} bytes; file truncated?)",
+                        header.pointDataOffset, file.size()));
+    }
+    if (hasLaszipRecord(file, header)) {
+        throwCompressed();
+    }
+
+    header.pointFormat = formatByte;
+    if (header.pointFormat >= static_cast<int>(kPointFormats.size())) {
+        throw Error(fmt::format("the LAS point data format {} is unknown (supported: 0 to {})",
+                                header.pointFormat, kPointFormats.size() - 1));
+    }
+    const PointFormatLayout& layout = kPointFormats[header.pointFormat];
+    if (layout.firstMinorVersion > header.versionMinor) {
+        context.warnings.push_back(fmt::format(
+            "point format {} is not defined before LAS 1.{}, but the file says LAS 1.{}; read "
+            "as LAS 1.{} defines it",
+            header.pointFormat, layout.firstMinorVersion, header.versionMinor,
+            layout.firstMinorVersion));
+    }
+    header.recordLength = loadField<std::uint16_t>(file, header_field::kRecordLength);
+    if (header.recordLength < layout.recordSize) {
+        throw Error(
+            fmt::format("the LAS point record length {} is shorter than the {} bytes "
+                        "point format {} needs",
+                        header.recordLength, layout.recordSize, header.pointFormat));
+    }
+
+    const std::uint32_t legacyCount =
+        loadField<std::uint32_t>(file, header_field::kLegacyPointCount);
+    header.pointCount = legacyCount;
+    if (header.versionMinor >= 4) {
+        // 1.4 writers leave the legacy count 0 when it cannot hold the count (formats 6-10 or
+        // more than 2^32 points); older writers that ignore the new field leave that one 0.
+        const auto count64 = loadField<std::uint64_t>(file, header_field::kPointCount64);
+        if (count64 != 0) {
+            if (legacyCount != 0 && legacyCount != count64) {
+                context.warnings.push_back(fmt::format(
+                    "the LAS header's legacy point count {} disagrees with its 64-bit count {}; "
+                    "using the 64-bit count",
+                    legacyCount, count64));
+            }
+            header.pointCount = count64;
+        }
+    }
+
+    header.scale = loadDoubleTriple(file, header_field::kScale);
+    header.offset = loadDoubleTriple(file, header_field::kOffset);
+    checkScaleAndOffset(header);
+    const std::size_t bounds = header_field::kBounds;
+    header.declaredBounds.max = {loadField<double>(file, bounds),
+                                 loadField<double>(file, bounds + 16),
+                                 loadField<double>(file, bounds + 32)};
+    header.declaredBounds.min = {loadField<double>(file, bounds + 8),
+                                 loadField<double>(file, bounds + 24),
+                                 loadField<double>(file, bounds + 40)};
+    return header;
+}
+
+enum class ColorDepth { None, EightBit, SixteenBit };
+
+/// LAS stores 16-bit colour, but many writers put 8-bit values in those fields. Only if no
+/// channel of any point exceeds 255 are the values taken as 8-bit; real 16-bit colour nearly
+/// always shows a larger value within the first points, so the scan usually stops early.
+ColorDepth detectColorDepth(const std::byte* points, std::size_t count, std::size_t stride,
+                            std::size_t colorOffset) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::byte* rgb = points + i * stride + colorOffset;
+        const auto any = static_cast<std::uint16_t>(loadLittleEndian<std::uint16_t>(rgb) |
+                                                    loadLittleEndian<std::uint16_t>(rgb + 2) |
+                                                    loadLittleEndian<std::uint16_t>(rgb + 4));
+        if (any > 255) {
+            return ColorDepth::SixteenBit;
+        }
+    }
+    return ColorDepth::EightBit;
+}
+
+template <ColorDepth depth>
+std::uint8_t toColorChannel(const std::byte* p) {
+    const std::uint16_t value = loadLittleEndian<std::uint16_t>(p);
+    if constexpr (depth == ColorDepth::SixteenBit) {
+        // round(value * 255 / 65535) = round(value / 257), exactly, in integers.
+        return static_cast<std::uint8_t>((value + 128u) / 257u);
+    } else {
+        return static_cast<std::uint8_t>(value);
+    }
+}
+
+/// The hot loop: the caller has checked that all `count` records lie inside the file.
+template <ColorDepth depth>
+void decodePoints(const std::byte* points, std::size_t count, const LasHeader& header,
+                  std::size_t colorOffset, PointCloudBuilder& builder, const ReadContext& context) {
+    constexpr std::size_t kProgressEvery = 1 << 16;
+    const std::size_t stride = header.recordLength;
+    PointRecord record;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::byte* p = points + i * stride;
+        const glm::dvec3 stored{loadLittleEndian<std::int32_t>(p),
+                                loadLittleEndian<std::int32_t>(p + 4),
+                                loadLittleEndian<std::int32_t>(p + 8)};
+        record.position = stored * header.scale + header.offset;
+        record.intensity = loadLittleEndian<std::uint16_t>(p + kIntensityOffset);
+        if constexpr (depth != ColorDepth::None) {
+            const std::byte* rgb = p + colorOffset;
+            record.color = {toColorChannel<depth>(rgb), toColorChannel<depth>(rgb + 2),
+                            toColorChannel<depth>(rgb + 4), 255};
+        }
+        builder.add(record);
+        if (i % kProgressEvery == 0) {
+            context.reportProgress(i, count);
+        }
+    }
+}
+
+/// Header bounds are often stale after edits; a mismatch is worth telling, not refusing.
+void warnIfBoundsDisagree(const LasHeader& header, const Bounds& decoded, ReadContext& context) {
+    for (int axis = 0; axis < 3; ++axis) {
+        // One scale step is what a writer's rounding can account for; the relative term covers
+        // the last bits of doubles at large coordinates when the scale is extremely fine.
+        const double magnitude = std::max(std::abs(decoded.min[axis]), std::abs(decoded.max[axis]));
+        const double tolerance =
+            std::abs(header.scale[axis]) + 4.0 * std::numeric_limits<double>::epsilon() * magnitude;
+        const double declaredMin = header.declaredBounds.min[axis];
+        const double declaredMax = header.declaredBounds.max[axis];
+        if (!(std::abs(declaredMin - decoded.min[axis]) <= tolerance &&
+              std::abs(declaredMax - decoded.max[axis]) <= tolerance)) {
+            context.warnings.push_back(fmt::format(
+                "the LAS header bounds ({:.12g} {:.12g} {:.12g} to {:.12g} {:.12g} {:.12g}) "
+                "disagree with the points ({:.12g} {:.12g} {:.12g} to {:.12g} {:.12g} {:.12g}); "
+                "the points are used",
+                header.declaredBounds.min.x, header.declaredBounds.min.y,
+                header.declaredBounds.min.z, header.declaredBounds.max.x,
+                header.declaredBounds.max.y, header.declaredBounds.max.z, decoded.min.x,
+                decoded.min.y, decoded.min.z, decoded.max.x, decoded.max.y, decoded.max.z));
+            return;
+        }
+    }
+}
+
+}  // namespace
+
+PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
+    const LasHeader header = parseHeader(file, context);
+    context.formatDetail =
+        fmt::format("LAS 1.{}, point format {}", header.versionMinor, header.pointFormat);
+
+    // One bounds check for the whole point block, before reserving anything: a lying count must
+    // neither read past the end nor allocate memory for points that are not there.
+    const std::size_t available = (file.size() - header.pointDataOffset) / header.recordLength;
+    if (header.pointCount > available) {
+        throw Error(
+            fmt::format("the LAS header declares {} points, but the point data holds "
+                        "only {} (file truncated, or the count is wrong)",
+                        header.pointCount, available));
+    }
+    if (header.pointCount > kMaxPoints) {
+        throw Error(
+            fmt::format("the LAS header declares {} points, more than the {} points "
+                        "subscan can hold",
+                        header.pointCount, kMaxPoints));
+    }
+    const auto count = static_cast<std::size_t>(header.pointCount);
+    const std::byte* points = file.data() + header.pointDataOffset;
+
+    const std::optional<std::size_t> colorOffset = kPointFormats[header.pointFormat].colorOffset;
+    const ColorDepth depth =
+        colorOffset ? detectColorDepth(points, count, header.recordLength, *colorOffset)
+                    : ColorDepth::None;
+    PointAttributes attributes;
+    attributes.color = colorOffset.has_value();
+    attributes.intensity = true;
+    PointCloudBuilder builder(attributes, count);
+    switch (depth) {
+        case ColorDepth::None:
+            decodePoints<ColorDepth::None>(points, count, header, 0, builder, context);
+            break;
+        case ColorDepth::EightBit:
+            decodePoints<ColorDepth::EightBit>(points, count, header, *colorOffset, builder,
+                                               context);
+            break;
+        case ColorDepth::SixteenBit:
+            decodePoints<ColorDepth::SixteenBit>(points, count, header, *colorOffset, builder,
+                                                 context);
+            break;
+    }
+    context.reportProgress(count, count);
+
+    PointCloud cloud = builder.finish(context.warnings);
+    warnIfBoundsDisagree(header, cloud.bounds, context);
+    return cloud;
 }
 
 }  // namespace subscan
