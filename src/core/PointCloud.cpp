@@ -40,11 +40,13 @@ PointCloud PointCloudBuilder::finish(std::vector<std::string>& warnings) {
         if (total == 0) {
             throw Error("it contains no points");
         }
-        throw Error(fmt::format("all {} points have NaN or infinite coordinates", total));
+        throw Error(fmt::format(
+            "all {} points have NaN or infinite coordinates (or ones beyond +-1e15)", total));
     }
     if (droppedPoints_ > 0) {
-        warnings.push_back(fmt::format("dropped {} of {} points with NaN or infinite coordinates",
-                                       droppedPoints_, total));
+        warnings.push_back(fmt::format(
+            "dropped {} of {} points with NaN or infinite coordinates (or ones beyond +-1e15)",
+            droppedPoints_, total));
     }
 
     if (!vertexRemap_.empty()) {

@@ -24,6 +24,8 @@ using Triangle = std::array<std::uint32_t, 3>;
 /// Points are addressed by 32-bit indices on the GPU; one value is reserved as "no point".
 inline constexpr std::uint64_t kMaxPoints = 0xFFFFFFFEu;
 inline constexpr std::uint32_t kInvalidIndex = 0xFFFFFFFFu;
+/// Coordinates beyond this are corrupt data (the Earth is 1.3e7 m across); they are dropped.
+inline constexpr double kMaxCoordinate = 1e15;
 
 /// Axis-aligned box in the file's own coordinates (double: UTM and ECEF coordinates need it).
 struct Bounds {
@@ -75,7 +77,8 @@ struct PointRecord {
     float intensity = 0.0f;
 };
 
-/// Collects points from a reader: drops points with NaN/Inf coordinates (counting them), tracks
+/// Collects points from a reader: drops points with NaN, infinite or absurd (beyond
+/// kMaxCoordinate) coordinates, counting them; tracks
 /// exact double bounds and stores float positions relative to the first valid point; finish()
 /// then re-centres them on the middle of the bounds.
 class PointCloudBuilder {
@@ -86,7 +89,9 @@ class PointCloudBuilder {
 
     void add(const PointRecord& point) {
         const glm::dvec3& p = point.position;
-        if (!(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) {
+        // Also false for NaN; the bound keeps p - origin within float range.
+        if (!(std::abs(p.x) <= kMaxCoordinate && std::abs(p.y) <= kMaxCoordinate &&
+              std::abs(p.z) <= kMaxCoordinate)) {
             dropVertex();
             return;
         }

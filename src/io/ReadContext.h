@@ -10,7 +10,7 @@ namespace subscan {
 /// What a reader may report besides the cloud: progress for long loads, warnings about data it
 /// had to skip and a description of the variant it read. Errors are thrown as subscan::Error.
 struct ReadContext {
-    /// Called with the fraction done (0..1), at most every few megabytes; may be empty.
+    /// Called with the fraction done (0..1) every few tens of thousands of points; may be empty.
     std::function<void(double)> progress;
     std::vector<std::string> warnings;
     /// Filled by the reader, e.g. "PLY 1.0 binary_little_endian" or "LAS 1.4, point format 7".

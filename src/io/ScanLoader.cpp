@@ -28,7 +28,7 @@ bool startsWith(std::span<const std::byte> file, std::string_view prefix) {
                       [](char c, std::byte b) { return static_cast<char>(b) == c; });
 }
 
-/// PCD headers start with comment lines and then VERSION (or FIELDS in old files).
+/// PCD headers start with comment lines and then VERSION (or FIELDS/COLUMNS in old files).
 bool looksLikePcd(std::span<const std::byte> file) {
     const std::string_view text(reinterpret_cast<const char*>(file.data()),
                                 std::min<std::size_t>(file.size(), 4096));
@@ -37,13 +37,14 @@ bool looksLikePcd(std::span<const std::byte> file) {
         const std::size_t end = std::min(text.find('\n', position), text.size());
         const std::string_view line = text.substr(position, end - position);
         position = end + 1;
-        if (line.empty() || line.front() == '#') {
+        if (line.empty() || line == "\r" || line.front() == '#') {
             if (line.starts_with("# .PCD")) {
                 return true;
             }
             continue;
         }
-        return line.starts_with("VERSION") || line.starts_with("FIELDS");
+        return line.starts_with("VERSION") || line.starts_with("FIELDS") ||
+               line.starts_with("COLUMNS");
     }
     return false;
 }

@@ -62,6 +62,18 @@ TEST(PointCloudTest, DropsNonFinitePointsWithTheirAttributes) {
     EXPECT_THAT(warnings[0], HasSubstr("dropped 2 of 4 points"));
 }
 
+TEST(PointCloudTest, AbsurdCoordinatesAreDroppedLikeNan) {
+    // A finite double beyond float range would make the float position undefined behaviour.
+    PointCloudBuilder builder({}, 3);
+    builder.add(at(1, 2, 3));
+    builder.add(at(1e300, 0, 0));
+    builder.add(at(0, -2e15, 0));
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    EXPECT_EQ(cloud.size(), 1u);
+    EXPECT_THAT(warnings, ::testing::Contains(HasSubstr("dropped 2 of 3 points")));
+}
+
 TEST(PointCloudTest, TrianglesFollowKeptVerticesAndLoseDroppedOnes) {
     PointCloudBuilder builder({}, 5, /*mapVertexIndices=*/true);
     builder.add(at(0, 0, 0));

@@ -12,7 +12,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 // subscan_core links liblzf privately, so its include directory does not reach the tests.
-#include <liblzf/lzf.h>
+#include <lzf.h>
 
 #include "io/PcdReader.h"
 #include "support/TestSupport.h"
