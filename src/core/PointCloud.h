@@ -69,6 +69,15 @@ struct PointAttributes {
     bool intensity = false;
 };
 
+/// double -> float for attribute values from files: out-of-range values saturate (a plain cast
+/// would be undefined behaviour); NaN stays NaN.
+inline float saturateToFloat(double value) {
+    constexpr double kLargest = std::numeric_limits<float>::max();
+    return value > kLargest ? std::numeric_limits<float>::infinity()
+           : value < -kLargest ? -std::numeric_limits<float>::infinity()
+                               : static_cast<float>(value);
+}
+
 /// One decoded point as a reader produces it; attributes not announced to the builder are ignored.
 struct PointRecord {
     glm::dvec3 position{0.0};

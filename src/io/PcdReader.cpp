@@ -510,13 +510,6 @@ double loadValue(PcdType type, const std::byte* p) {
     return 0.0;
 }
 
-/// Converting a double beyond float's range is undefined behaviour: such values become the
-/// largest float of their sign instead; NaN stays NaN.
-float toFloat(double value) {
-    constexpr double kLargest = std::numeric_limits<float>::max();
-    return static_cast<float>(std::isnan(value) ? value : std::clamp(value, -kLargest, kLargest));
-}
-
 Rgba8 unpackColor(std::uint32_t bits, bool hasAlpha) {
     return {static_cast<std::uint8_t>(bits >> 16), static_cast<std::uint8_t>(bits >> 8),
             static_cast<std::uint8_t>(bits),
@@ -540,7 +533,7 @@ class ChannelColors {
         std::array<float, 4> kept{};
         for (int channel = 0; channel < 4; ++channel) {
             const double value = values[channel];
-            kept[channel] = toFloat(value);
+            kept[channel] = saturateToFloat(value);
             if (isWide(types_[channel]) && value > 255.0) {
                 wideValuesAbove8Bits_ = true;
             }
@@ -604,11 +597,11 @@ class PointSink {
         }
         if (layout_.normal) {
             const auto& n = *layout_.normal;
-            record.normal = {toFloat(valueOf(n[0])), toFloat(valueOf(n[1])),
-                             toFloat(valueOf(n[2]))};
+            record.normal = {saturateToFloat(valueOf(n[0])), saturateToFloat(valueOf(n[1])),
+                             saturateToFloat(valueOf(n[2]))};
         }
         if (layout_.intensity) {
-            record.intensity = toFloat(valueOf(*layout_.intensity));
+            record.intensity = saturateToFloat(valueOf(*layout_.intensity));
         }
         if (!channelColors_) {
             builder_.add(record);
@@ -651,7 +644,7 @@ std::optional<std::uint32_t> parsePackedColor(std::string_view token, PcdType ty
         return std::nullopt;
     }
     if (isFloat(type)) {
-        return std::bit_cast<std::uint32_t>(toFloat(value));
+        return std::bit_cast<std::uint32_t>(saturateToFloat(value));
     }
     // A signed I field wraps: -16777216 is 0xFF000000.
     if (value >= -2147483648.0 && value < 4294967296.0) {

@@ -549,11 +549,11 @@ PointCloud PlyBodyReader::read() {
         }
         if (layout.normal) {
             const auto& n = *layout.normal;
-            record.normal = {static_cast<float>(value(n[0])), static_cast<float>(value(n[1])),
-                             static_cast<float>(value(n[2]))};
+            record.normal = {saturateToFloat(value(n[0])), saturateToFloat(value(n[1])),
+                             saturateToFloat(value(n[2]))};
         }
         if (layout.intensity) {
-            record.intensity = static_cast<float>(value(*layout.intensity));
+            record.intensity = saturateToFloat(value(*layout.intensity));
         }
         return record;
     };

@@ -913,11 +913,11 @@ PointRecord PointLineReader::makeRecord() const {
     }
     if (l.normal) {
         const ColumnTriple& n = *l.normal;
-        record.normal = {static_cast<float>(values_[n[0]]), static_cast<float>(values_[n[1]]),
-                         static_cast<float>(values_[n[2]])};
+        record.normal = {saturateToFloat(values_[n[0]]), saturateToFloat(values_[n[1]]),
+                         saturateToFloat(values_[n[2]])};
     }
     if (l.intensity) {
-        record.intensity = static_cast<float>(values_[*l.intensity]);
+        record.intensity = saturateToFloat(values_[*l.intensity]);
     }
     return record;
 }

@@ -318,7 +318,7 @@ TEST(XyzReaderTest, NumbersAreCorrectlyRoundedLikeStrtod) {
             // Such coordinates are dropped as corrupt, so read the number as an intensity (a
             // float: both sides round the same double).
             const LoadedScan scan = decode("0 0 0 " + number + "\n", "one.xyz");
-            EXPECT_EQ(scan.cloud.intensities.at(0), static_cast<float>(expected));
+            EXPECT_EQ(scan.cloud.intensities.at(0), saturateToFloat(expected));
             continue;
         }
         const LoadedScan scan = decode(number + " 0 0\n", "one.xyz");
