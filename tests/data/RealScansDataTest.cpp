@@ -1,0 +1,176 @@
+// `subscan info` and `subscan render` on every file of the shared real-scan folder
+// (../shared/data or $SUBSCAN_TEST_DATA; see its README). Skipped, visibly, when it is absent.
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "io/Image.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::runSubscan;
+using ::testing::HasSubstr;
+
+struct Expected {
+    const char* file;
+    std::uint64_t points;  // 0: the file must be refused
+    std::uint64_t faces;
+    const char* refusal;
+};
+
+// Counts from the folder's README (itself checked against the file bodies); face counts from
+// the PLY headers.
+const Expected kFiles[] = {
+    {"ankylosaurus_mesh_rgb.ply", 34820, 69636, nullptr},
+    {"autzen_trim.las", 110000, 0, nullptr},
+    {"autzen_trim_las14_pf7.las", 110000, 0, nullptr},
+    {"autzen_trim.laz", 0, 0, "compressed LAS (LAZ) is not supported yet"},
+    {"autzen_utm_binary.pcd", 1065, 0, nullptr},
+    {"bun_zipper.ply", 35947, 69451, nullptr},
+    {"bun_zipper_res2.ply", 8171, 16301, nullptr},
+    {"bun_zipper_res3.ply", 1889, 3851, nullptr},
+    {"bun_zipper_res4.ply", 453, 948, nullptr},
+    {"bunnyDouble.e57", 0, 0, "E57 files are not supported yet"},
+    {"bunnyInt32.e57", 0, 0, "E57 files are not supported yet"},
+    {"bunny_scans_registered.ply", 362272, 0, nullptr},
+    {"dragon_stand_registered.ply", 469193, 0, nullptr},
+    {"happy_stand_registered.ply", 1099005, 0, nullptr},
+    {"isprs_CSite2_orig-utm.pcd", 486800, 0, nullptr},
+    {"lone_star.copc.laz", 0, 0, "compressed LAS (LAZ) is not supported yet"},
+    {"lone_star.laz", 0, 0, "compressed LAS (LAZ) is not supported yet"},
+    {"pcl_bunny_ascii.pcd", 397, 0, nullptr},
+    {"room_scan1.pcd", 112586, 0, nullptr},
+    {"simple.las", 1065, 0, nullptr},
+    // 307,200 organised points, of which 97,920 are NaN ("no measurement") and dropped.
+    {"table_scene_mug_stereo_textured.pcd", 209280, 0, nullptr},
+};
+
+nlohmann::json info(const std::filesystem::path& file) {
+    const auto result = runSubscan({"info", file.string(), "--json"});
+    EXPECT_EQ(result.exitCode, 0) << file << ": " << result.err;
+    return result.exitCode == 0 ? nlohmann::json::parse(result.out) : nlohmann::json{};
+}
+
+/// The vertex count a PLY header declares, read here without subscan's reader.
+std::uint64_t headerVertexCount(const std::filesystem::path& file) {
+    std::ifstream stream(file, std::ios::binary);
+    std::string line;
+    while (std::getline(stream, line) && line.rfind("end_header", 0) != 0) {
+        if (line.rfind("element vertex ", 0) == 0) {
+            return std::stoull(line.substr(15));
+        }
+    }
+    return 0;
+}
+
+TEST(RealScansDataTest, InfoGivesExactCountsOrTheClearRefusal) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    for (const Expected& expected : kFiles) {
+        SCOPED_TRACE(expected.file);
+        const std::filesystem::path file = data / expected.file;
+        if (expected.refusal != nullptr) {
+            const auto result = runSubscan({"info", file.string(), "--json"});
+            EXPECT_EQ(result.exitCode, 1);
+            EXPECT_THAT(result.err, HasSubstr(expected.refusal));
+            EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1);
+            continue;
+        }
+        const nlohmann::json json = info(file);
+        EXPECT_EQ(json["points"], expected.points);
+        EXPECT_EQ(json["faces"], expected.faces);
+    }
+}
+
+TEST(RealScansDataTest, EveryStanfordRangeScanLoadsWithItsHeaderCount) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    // Folder totals from the README; some headers carry stray 'bye' lines.
+    const std::pair<const char*, std::uint64_t> folders[] = {
+        {"stanford_bunny_scans", 362272},
+        {"stanford_dragon_stand", 469193},
+        {"stanford_happy_stand", 1099005},
+    };
+    for (const auto& [folder, total] : folders) {
+        std::uint64_t sum = 0;
+        for (const auto& entry : std::filesystem::directory_iterator(data / folder)) {
+            if (entry.path().extension() != ".ply") {
+                continue;
+            }
+            SCOPED_TRACE(entry.path().filename().string());
+            const std::uint64_t declared = headerVertexCount(entry.path());
+            EXPECT_EQ(info(entry.path())["points"], declared);
+            sum += declared;
+        }
+        EXPECT_EQ(sum, total) << folder;
+    }
+}
+
+TEST(RealScansDataTest, RegisteredScanBoundsMatchTheFloatsInTheFile) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    for (const char* name : {"bunny_scans_registered.ply", "dragon_stand_registered.ply",
+                             "happy_stand_registered.ply"}) {
+        SCOPED_TRACE(name);
+        // The layout is known (float x y z, uchar scan_index, little-endian): read it directly.
+        std::ifstream stream(data / name, std::ios::binary);
+        std::string line;
+        while (std::getline(stream, line) && line != "end_header") {
+        }
+        std::vector<double> low(3, std::numeric_limits<double>::infinity());
+        std::vector<double> high(3, -std::numeric_limits<double>::infinity());
+        char record[13];
+        while (stream.read(record, sizeof(record))) {
+            for (int axis = 0; axis < 3; ++axis) {
+                float value = 0;
+                std::memcpy(&value, record + 4 * axis, sizeof(float));
+                low[axis] = std::min(low[axis], static_cast<double>(value));
+                high[axis] = std::max(high[axis], static_cast<double>(value));
+            }
+        }
+        const nlohmann::json json = info(data / name);
+        // Bounds are kept in double from the file's floats: exact.
+        EXPECT_EQ(json["bounds_min"].get<std::vector<double>>(), low);
+        EXPECT_EQ(json["bounds_max"].get<std::vector<double>>(), high);
+    }
+}
+
+TEST(RealScansDataTest, UtmCoordinatesStayInUtm) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const nlohmann::json json = info(data / "isprs_CSite2_orig-utm.pcd");
+    // Northing around 5.4e6 m, easting around 5.1e5 m (README).
+    EXPECT_NEAR(json["bounds_min"][1].get<double>(), 5.4e6, 1e4);
+    EXPECT_NEAR(json["bounds_min"][0].get<double>(), 5.13e5, 1e4);
+}
+
+TEST(RealScansDataTest, EveryReadableFileRenders) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const test::TempDir dir;
+    for (const Expected& expected : kFiles) {
+        if (expected.refusal != nullptr) {
+            continue;
+        }
+        SCOPED_TRACE(expected.file);
+        const auto out = dir / "out.png";
+        const auto result = runSubscan({"render", (data / expected.file).string(), "-o",
+                                        out.string(), "--width", "96", "--height", "72",
+                                        "--background", "#000000"});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        const Image8 image = readPng(out);
+        int drawn = 0;
+        for (std::size_t i = 0; i < image.pixels.size(); i += 4) {
+            drawn += image.pixels[i] + image.pixels[i + 1] + image.pixels[i + 2] > 0;
+        }
+        // Auto-framing puts the cloud in view: it covers a visible share of the image.
+        EXPECT_GT(drawn, 96 * 72 / 100);
+    }
+}
+
+}  // namespace
+}  // namespace subscan
