@@ -14,7 +14,6 @@
 #include "render/NormalsPass.h"
 #include "render/PresentPass.h"
 #include "render/PullPushPass.h"
-#include "render/Pyramid.h"
 #include "render/RasterizePointsPass.h"
 #include "render/ShadePass.h"
 #include "render/StageViewPass.h"
@@ -107,33 +106,8 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
         runnerTiming_ = settings.raster.timing;
     }
 
-    gpu::FrameParams frame{};
-    frame.viewFromCloud = glm::mat4(camera.viewFromCloud(cloud_.origin()));
-    frame.projection = glm::mat4(camera.projection());
-    frame.viewport = {static_cast<float>(camera.width), static_cast<float>(camera.height),
-                      1.0f / static_cast<float>(camera.width),
-                      1.0f / static_cast<float>(camera.height)};
-    frame.depthRange = {static_cast<float>(camera.nearPlane), static_cast<float>(camera.farPlane),
-                        static_cast<float>(camera.focalLengthPixels()), 0.0f};
-    const glm::vec3& background = settings.raster.backgroundSrgb;
-    frame.background = {srgbToLinear(background.r), srgbToLinear(background.g),
-                        srgbToLinear(background.b), 1.0f};
-    frameParams_.set(frame);
-    frameParams_.bind(SUBSCAN_UBO_FRAME);
-
-    const gpu::PyramidLayout layout = pyramidLayout(camera.width, camera.height);
-    pyramidLayout_.set(layout);
-    pyramidLayout_.bind(SUBSCAN_UBO_PYRAMID);
-
-    const SurfaceSettings& surface = settings.surface;
-    const auto h = static_cast<float>(spacing_);
-    gpu::SurfaceParams surfaceParams{};
-    surfaceParams.visibility = {surface.visibilityRadius * h, surface.visibilityThreshold,
-                                surface.edgeRule ? 1.0f : 0.0f, 0.0f};
-    surfaceParams.fill = {surface.fillRadius * h, surface.fillThreshold, 0.0f, 0.0f};
-    surfaceParams.normals = {surface.normalRadius * h, 0.0f, 0.0f, 0.0f};
-    surfaceParams_.set(surfaceParams);
-    surfaceParams_.bind(SUBSCAN_UBO_SURFACE);
+    const gpu::PyramidLayout& layout =
+        uniforms_.update(camera, settings, spacing_, cloud_.origin());
 
     const std::vector<RenderPass*> passes = passesFor(settings.raster);
     FrameContext context{camera, cloud_, settings, capabilities(), resources_, layout, spacing_};

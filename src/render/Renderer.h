@@ -13,6 +13,7 @@
 #include "gpu/PassTimer.h"
 #include "gpu/ShaderSources.h"
 #include "render/FrameResources.h"
+#include "render/FrameUniforms.h"
 #include "render/GpuPointCloud.h"
 #include "render/PassRunner.h"
 #include "render/RenderSettings.h"
@@ -69,9 +70,7 @@ class Renderer {
     GpuPointCloud cloud_;
     double spacing_;
     FrameResources resources_;
-    UniformBlock<gpu::FrameParams> frameParams_{"FrameParams"};
-    UniformBlock<gpu::PyramidLayout> pyramidLayout_{"PyramidLayout"};
-    UniformBlock<gpu::SurfaceParams> surfaceParams_{"SurfaceParams"};
+    FrameUniforms uniforms_;
     std::unique_ptr<RasterizePointsPass> rasterize_;
     std::unique_ptr<DrawPointsPass> drawPoints_;
     std::unique_ptr<MinDepthPyramidPass> minDepthPyramid_;

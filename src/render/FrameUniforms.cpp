@@ -1,0 +1,41 @@
+#include "render/FrameUniforms.h"
+
+#include "render/Pyramid.h"
+#include "render/Renderer.h"
+
+namespace subscan {
+
+const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
+                                                const RenderSettings& settings, double spacing,
+                                                const glm::dvec3& cloudOrigin) {
+    gpu::FrameParams frame{};
+    frame.viewFromCloud = glm::mat4(camera.viewFromCloud(cloudOrigin));
+    frame.projection = glm::mat4(camera.projection());
+    frame.viewport = {static_cast<float>(camera.width), static_cast<float>(camera.height),
+                      1.0f / static_cast<float>(camera.width),
+                      1.0f / static_cast<float>(camera.height)};
+    frame.depthRange = {static_cast<float>(camera.nearPlane), static_cast<float>(camera.farPlane),
+                        static_cast<float>(camera.focalLengthPixels()), 0.0f};
+    const glm::vec3& background = settings.raster.backgroundSrgb;
+    frame.background = {srgbToLinear(background.r), srgbToLinear(background.g),
+                        srgbToLinear(background.b), 1.0f};
+    frame_.set(frame);
+    frame_.bind(SUBSCAN_UBO_FRAME);
+
+    pyramid_ = pyramidLayout(camera.width, camera.height);
+    pyramidBlock_.set(pyramid_);
+    pyramidBlock_.bind(SUBSCAN_UBO_PYRAMID);
+
+    const SurfaceSettings& surface = settings.surface;
+    const auto h = static_cast<float>(spacing);
+    gpu::SurfaceParams params{};
+    params.visibility = {surface.visibilityRadius * h, surface.visibilityThreshold,
+                         surface.edgeRule ? 1.0f : 0.0f, 0.0f};
+    params.fill = {surface.fillRadius * h, surface.fillThreshold, 0.0f, 0.0f};
+    params.normals = {surface.normalRadius * h, 0.0f, 0.0f, 0.0f};
+    surface_.set(params);
+    surface_.bind(SUBSCAN_UBO_SURFACE);
+    return pyramid_;
+}
+
+}  // namespace subscan

@@ -1,0 +1,547 @@
+// Each reconstruction pass on a small odd-sized frame (37x23) against a CPU reference of the
+// same formula, fed with the GPU's own inputs so that each comparison tests one pass:
+// the pyramid exactly, pull-push and normals to float precision, visibility flags identical
+// except where the CPU finds a value within rounding distance of the threshold (a tie).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+
+#include "gpu/ShaderSources.h"
+#include "render/FillRemovalPass.h"
+#include "render/FrameUniforms.h"
+#include "render/HiddenPointRemovalPass.h"
+#include "render/MinDepthPyramidPass.h"
+#include "render/NormalsPass.h"
+#include "render/PullPushPass.h"
+#include "render/ShadePass.h"
+#include "support/GlTestSupport.h"
+
+namespace subscan {
+namespace {
+
+constexpr int kWidth = 37;
+constexpr int kHeight = 23;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Level {
+    int width, height, offset;
+};
+
+std::vector<Level> levels() {
+    std::vector<Level> result;
+    int w = kWidth, h = kHeight, offset = 0;
+    while (true) {
+        result.push_back({w, h, offset});
+        offset += w * h;
+        if (w == 1 && h == 1) {
+            return result;
+        }
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+}
+
+/// A frame of the pipeline outside the Renderer: uniforms, resources and a context for passes.
+class PassHarness {
+  public:
+    PassHarness() : cloud_(dummyCloud(), test::glTestContext().capabilities()) {
+        camera_.width = kWidth;
+        camera_.height = kHeight;
+        camera_.fovyDegrees = 50.0;
+        camera_.nearPlane = 0.1;
+        camera_.farPlane = 100.0;
+        // A threshold amid the many mean omegas of this frame (0.6..0.9), so that a formula
+        // error flips flags instead of hiding between the two clusters.
+        settings_.surface.visibilityThreshold = 0.7f;
+        settings_.surface.fillThreshold = 0.6f;
+        layout_ = uniforms_.update(camera_, settings_, kSpacing, cloud_.origin());
+    }
+
+    FrameContext context() {
+        return {camera_,    cloud_,  settings_, test::glTestContext().capabilities(),
+                resources_, layout_, kSpacing};
+    }
+    FrameResources& resources() { return resources_; }
+    const Camera& camera() const { return camera_; }
+    const RenderSettings& settings() const { return settings_; }
+    const ShaderSources& sources() const { return sources_; }
+    double focal() const { return camera_.focalLengthPixels(); }
+
+    // h: HPR looks up to ~log2(4 * 0.4 * 24.7 / 5) = 3 levels at depth 5.
+    static constexpr double kSpacing = 0.4;
+
+  private:
+    static PointCloud dummyCloud() {
+        PointCloudBuilder builder({}, 1);
+        builder.add({});
+        std::vector<std::string> warnings;
+        return builder.finish(warnings);
+    }
+
+    Camera camera_;
+    RenderSettings settings_;
+    GpuPointCloud cloud_;
+    FrameUniforms uniforms_;
+    gpu::PyramidLayout layout_{};
+    FrameResources resources_;
+    ShaderSources sources_;
+};
+
+/// Depth: a curved surface at 4..6 with holes (+inf) and a few far "back" points showing
+/// through; colour random.
+void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color) {
+    std::mt19937 random(5);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    depth.assign(kWidth * kHeight, 0.0f);
+    color.assign(kWidth * kHeight * 4, 1.0f);
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const int i = y * kWidth + x;
+            const float u = static_cast<float>(x) / kWidth, v = static_cast<float>(y) / kHeight;
+            float d = 4.0f + 1.5f * u + 0.8f * std::sin(6.0f * v) * u;
+            const float roll = unit(random);
+            if (roll < 0.45f) {
+                d = std::numeric_limits<float>::infinity();  // a gap between points
+            } else if (roll < 0.55f) {
+                d += 3.0f + 2.0f * unit(random);  // a point of a surface behind
+            }
+            depth[i] = d;
+            for (int c = 0; c < 3; ++c) {
+                color[4 * i + c] = unit(random);
+            }
+        }
+    }
+    FrameResources& resources = harness.resources();
+    resources.ensureTexture("depth", TextureFormat::R32F, kWidth, kHeight).uploadFloats(depth);
+    resources.ensureTexture("color", TextureFormat::RGBA16F, kWidth, kHeight).uploadFloats(color);
+}
+
+glm::dvec3 viewPosition(const PassHarness& harness, double wx, double wy, double depth) {
+    const double f = harness.focal();
+    return {(wx - 0.5 * kWidth) * depth / f, (0.5 * kHeight - wy) * depth / f, -depth};
+}
+
+std::vector<double> cpuPyramid(const std::vector<float>& depth) {
+    const auto all = levels();
+    std::vector<double> pyramid(all.back().offset + 1, kInf);
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+        pyramid[i] = depth[i];
+    }
+    for (std::size_t l = 1; l < all.size(); ++l) {
+        const Level& fine = all[l - 1];
+        const Level& coarse = all[l];
+        for (int y = 0; y < coarse.height; ++y) {
+            for (int x = 0; x < coarse.width; ++x) {
+                double nearest = kInf;
+                for (int dy = 0; dy < 2; ++dy) {
+                    for (int dx = 0; dx < 2; ++dx) {
+                        const int cx = 2 * x + dx, cy = 2 * y + dy;
+                        if (cx < fine.width && cy < fine.height) {
+                            nearest =
+                                std::min(nearest, pyramid[fine.offset + cy * fine.width + cx]);
+                        }
+                    }
+                }
+                pyramid[coarse.offset + y * coarse.width + x] = nearest;
+            }
+        }
+    }
+    return pyramid;
+}
+
+TEST(SurfacePassesGLTest, MinDepthPyramidIsExact) {
+    PassHarness harness;
+    std::vector<float> depth, color;
+    uploadInputs(harness, depth, color);
+    MinDepthPyramidPass pass(harness.sources());
+    FrameContext frame = harness.context();
+    pass.execute(frame);
+    const std::vector<float> gpu = harness.resources().buffer("pyramid").read<float>();
+    const std::vector<double> cpu = cpuPyramid(depth);
+    ASSERT_EQ(gpu.size(), cpu.size());
+    for (std::size_t i = 0; i < cpu.size(); ++i) {
+        EXPECT_EQ(static_cast<double>(gpu[i]), cpu[i]) << "texel " << i;  // min is exact
+    }
+}
+
+/// The CPU twin of HiddenPointRemoval.comp. Returns nullopt where a quantity lies within
+/// rounding distance of a decision boundary (the flag may then legitimately differ).
+std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<double>& pyramid,
+                               int px, int py) {
+    const auto all = levels();
+    const double depth = pyramid[py * kWidth + px];
+    if (std::isinf(depth)) {
+        return false;
+    }
+    const SurfaceSettings& surface = harness.settings().surface;
+    const double tau = surface.visibilityThreshold;
+    constexpr double kTie = 1e-4;  // float evaluation of omega differs from double by ~1e-6
+    const glm::dvec3 x = viewPosition(harness, px + 0.5, py + 0.5, depth);
+    const glm::dvec3 toCamera = glm::normalize(-x);
+    const double levelValue = std::clamp(
+        std::log2(surface.visibilityRadius * PassHarness::kSpacing * harness.focal() / depth), 0.0,
+        static_cast<double>(all.size() - 1));
+    if (std::abs(levelValue - std::round(levelValue)) < kTie) {
+        return std::nullopt;
+    }
+    const int maxLevel = static_cast<int>(levelValue);
+    const int directions[8][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
+                                  {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+    std::array<double, 8> omega{};
+    double sum = 0.0;
+    bool tie = false;
+    for (int k = 0; k < 8; ++k) {
+        double smallest = 1.0;
+        bool found = false;
+        for (int l = 0; l <= maxLevel; ++l) {
+            const Level& level = all[l];
+            const int qx = (px >> l) + directions[k][0], qy = (py >> l) + directions[k][1];
+            if (qx < 0 || qy < 0 || qx >= level.width || qy >= level.height) {
+                continue;
+            }
+            const double d = pyramid[level.offset + qy * level.width + qx];
+            if (std::isinf(d)) {
+                continue;
+            }
+            const double scale = 1 << l;
+            const glm::dvec3 y = viewPosition(harness, (qx + 0.5) * scale, (qy + 0.5) * scale, d);
+            const double value = 1.0 - glm::dot(glm::normalize(y - x), toCamera);
+            smallest = found ? std::min(smallest, value) : value;
+            found = true;
+        }
+        omega[k] = smallest;
+        sum += smallest;
+        tie = tie || std::abs(smallest - tau) < kTie;
+    }
+    if (std::abs(sum / 8.0 - tau) < kTie || (tie && surface.edgeRule)) {
+        return std::nullopt;
+    }
+    bool visible = sum / 8.0 >= tau;
+    if (!visible && surface.edgeRule) {
+        int open = 0;
+        for (double value : omega) {
+            open += value >= tau;
+        }
+        for (int k = 0; k < 8 && !visible; ++k) {
+            visible =
+                omega[k] < tau && omega[(k + 1) % 8] < tau && omega[(k + 2) % 8] < tau && open >= 3;
+        }
+    }
+    return visible;
+}
+
+TEST(SurfacePassesGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
+    PassHarness harness;
+    std::vector<float> depth, color;
+    uploadInputs(harness, depth, color);
+    FrameContext frame = harness.context();
+    MinDepthPyramidPass(harness.sources()).execute(frame);
+    HiddenPointRemovalPass(harness.sources()).execute(frame);
+    const std::vector<float> flags = harness.resources().texture("visibility").readFloats();
+    const std::vector<double> pyramid = cpuPyramid(depth);
+    int ties = 0, visible = 0, hidden = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const std::optional<bool> expected = cpuVisible(harness, pyramid, x, y);
+            if (!expected) {
+                ++ties;
+                continue;
+            }
+            EXPECT_EQ(flags[y * kWidth + x] > 0.5f, *expected) << x << "," << y;
+            if (!std::isinf(depth[y * kWidth + x])) {
+                (*expected ? visible : hidden)++;
+            }
+        }
+    }
+    EXPECT_LT(ties, 5);      // ties are rare; many would mean the test checks little
+    EXPECT_GT(visible, 50);  // both outcomes occur in this frame
+    EXPECT_GT(hidden, 20);
+}
+
+struct PullPush {
+    std::vector<glm::dvec4> pullValue;
+    std::vector<double> pullWeight;
+    std::vector<glm::dvec4> push;
+};
+
+/// The CPU twin of PullPush.comp from the given visibility flags.
+PullPush cpuPullPush(const std::vector<float>& depth, const std::vector<float>& color,
+                     const std::vector<float>& visibility) {
+    const auto all = levels();
+    const std::size_t texels = all.back().offset + 1;
+    PullPush result{std::vector<glm::dvec4>(texels), std::vector<double>(texels),
+                    std::vector<glm::dvec4>(texels)};
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+        const bool visible = visibility[i] > 0.5f;
+        result.pullWeight[i] = visible ? 1.0 : 0.0;
+        result.pullValue[i] =
+            visible ? glm::dvec4(depth[i], color[4 * i], color[4 * i + 1], color[4 * i + 2])
+                    : glm::dvec4(0.0);
+    }
+    const double kernel[4] = {1.0 / 3.0, 1.0, 1.0, 1.0 / 3.0};
+    for (std::size_t l = 1; l < all.size(); ++l) {
+        const Level& fine = all[l - 1];
+        const Level& coarse = all[l];
+        for (int y = 0; y < coarse.height; ++y) {
+            for (int x = 0; x < coarse.width; ++x) {
+                double weight = 0.0;
+                glm::dvec4 value(0.0);
+                for (int j = 0; j < 4; ++j) {
+                    for (int i = 0; i < 4; ++i) {
+                        const int cx = 2 * x + i - 1, cy = 2 * y + j - 1;
+                        if (cx < 0 || cy < 0 || cx >= fine.width || cy >= fine.height) {
+                            continue;
+                        }
+                        const int child = fine.offset + cy * fine.width + cx;
+                        weight += kernel[i] * kernel[j] * result.pullWeight[child];
+                        value += kernel[i] * kernel[j] * result.pullValue[child];
+                    }
+                }
+                const double clamped = std::min(1.0, weight);
+                const int index = coarse.offset + y * coarse.width + x;
+                result.pullWeight[index] = clamped;
+                result.pullValue[index] =
+                    weight > 0.0 ? value * (clamped / weight) : glm::dvec4(0.0);
+            }
+        }
+    }
+    const int top = all.back().offset;
+    result.push[top] = result.pullValue[top] / result.pullWeight[top];
+    for (std::size_t l = all.size() - 1; l-- > 0;) {
+        const Level& fine = all[l];
+        const Level& coarse = all[l + 1];
+        for (int y = 0; y < fine.height; ++y) {
+            for (int x = 0; x < fine.width; ++x) {
+                // Per axis: the coarse texel holding this one weighs 3/4, its neighbour on this
+                // texel's side 1/4 (clamped at the border).
+                const int nx = x / 2, ny = y / 2;
+                const int fx = std::clamp(nx + (x % 2 ? 1 : -1), 0, coarse.width - 1);
+                const int fy = std::clamp(ny + (y % 2 ? 1 : -1), 0, coarse.height - 1);
+                auto at = [&](int cx, int cy) {
+                    return result.push[coarse.offset + cy * coarse.width + cx];
+                };
+                const glm::dvec4 m = 0.5625 * at(nx, ny) + 0.1875 * at(fx, ny) +
+                                     0.1875 * at(nx, fy) + 0.0625 * at(fx, fy);
+                const int index = fine.offset + y * fine.width + x;
+                const double w = result.pullWeight[index];
+                result.push[index] =
+                    w >= 1.0 ? result.pullValue[index] : result.pullValue[index] + (1.0 - w) * m;
+            }
+        }
+    }
+    return result;
+}
+
+void runUpToPullPush(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color) {
+    uploadInputs(harness, depth, color);
+    FrameContext frame = harness.context();
+    MinDepthPyramidPass(harness.sources()).execute(frame);
+    HiddenPointRemovalPass(harness.sources()).execute(frame);
+    PullPushPass(harness.sources()).execute(frame);
+}
+
+TEST(SurfacePassesGLTest, PullPushMatchesToFloatPrecision) {
+    PassHarness harness;
+    std::vector<float> depth, color;
+    runUpToPullPush(harness, depth, color);
+    const FrameResources& resources = harness.resources();
+    // The colour input is RGBA16F: feed the reference the values the GPU actually read.
+    const std::vector<float> color16 = resources.texture("color").readFloats();
+    const PullPush cpu = cpuPullPush(depth, color16, resources.texture("visibility").readFloats());
+    const auto values = resources.buffer("pullValues").read<glm::vec4>();
+    const auto weights = resources.buffer("pullWeights").read<float>();
+    const auto push = resources.buffer("pushValues").read<glm::vec4>();
+    ASSERT_EQ(weights.size(), cpu.pullWeight.size());
+    for (std::size_t i = 0; i < weights.size(); ++i) {
+        // Sums of up to 16 floats per level over ~6 levels: relative error ~1e-6; 1e-4 of the
+        // value's scale (depths ~5, colours ~1) leaves room without hiding a formula error.
+        EXPECT_NEAR(weights[i], cpu.pullWeight[i], 1e-5) << "texel " << i;
+        for (int c = 0; c < 4; ++c) {
+            EXPECT_NEAR(values[i][c], cpu.pullValue[i][c],
+                        1e-4 * (1.0 + std::abs(cpu.pullValue[i][c])))
+                << "texel " << i;
+            EXPECT_NEAR(push[i][c], cpu.push[i][c], 1e-4 * (1.0 + std::abs(cpu.push[i][c])))
+                << "texel " << i;
+        }
+    }
+    // The filled images are push level 0.
+    const std::vector<float> filled = resources.texture("filledDepth").readFloats();
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+        EXPECT_NEAR(filled[i], cpu.push[i].x, 1e-4 * cpu.push[i].x);
+        EXPECT_TRUE(std::isfinite(filled[i]));  // level 0 of the push is fully filled
+    }
+}
+
+TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
+    PassHarness harness;
+    std::vector<float> depth, color;
+    runUpToPullPush(harness, depth, color);
+    FrameContext frame = harness.context();
+    FillRemovalPass(harness.sources()).execute(frame);
+    const FrameResources& resources = harness.resources();
+    const auto weights = resources.buffer("pullWeights").read<float>();
+    const std::vector<float> filled = resources.texture("filledDepth").readFloats();
+    const std::vector<float> mask = resources.texture("mask").readFloats();
+    const std::vector<float> surfaceDepth = resources.texture("surfaceDepth").readFloats();
+    const auto all = levels();
+    const SurfaceSettings& surface = harness.settings().surface;
+    int ties = 0, kept = 0, removed = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const double z = filled[y * kWidth + x];
+            const double level = std::clamp(
+                std::log2(surface.fillRadius * PassHarness::kSpacing * harness.focal() / z), 0.0,
+                static_cast<double>(all.size() - 1));
+            auto bilinear = [&](int l) {
+                const Level& lv = all[l];
+                const double u = (x + 0.5) / (1 << l) - 0.5, v = (y + 0.5) / (1 << l) - 0.5;
+                const int bx = static_cast<int>(std::floor(u)),
+                          by = static_cast<int>(std::floor(v));
+                const double tx = u - bx, ty = v - by;
+                auto w = [&](int cx, int cy) {
+                    cx = std::clamp(cx, 0, lv.width - 1);
+                    cy = std::clamp(cy, 0, lv.height - 1);
+                    return static_cast<double>(weights[lv.offset + cy * lv.width + cx]);
+                };
+                return (1 - tx) * (1 - ty) * w(bx, by) + tx * (1 - ty) * w(bx + 1, by) +
+                       (1 - tx) * ty * w(bx, by + 1) + tx * ty * w(bx + 1, by + 1);
+            };
+            const int lower = static_cast<int>(level);
+            const int upper = std::min(lower + 1, static_cast<int>(all.size() - 1));
+            const double weight =
+                bilinear(lower) + (level - lower) * (bilinear(upper) - bilinear(lower));
+            // float vs double evaluation: 1e-5 around the threshold is a tie.
+            if (std::abs(weight - surface.fillThreshold) < 1e-5) {
+                ++ties;
+                continue;
+            }
+            const bool expected = weight >= surface.fillThreshold;
+            const int i = y * kWidth + x;
+            EXPECT_EQ(mask[i] > 0.5f, expected) << x << "," << y;
+            EXPECT_EQ(std::isinf(surfaceDepth[i]), !expected);
+            (expected ? kept : removed)++;
+        }
+    }
+    EXPECT_LT(ties, 3);
+    EXPECT_GT(kept, 100);
+    EXPECT_GT(removed, 0);
+}
+
+TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
+    PassHarness harness;
+    std::vector<float> depth, color;
+    runUpToPullPush(harness, depth, color);
+    FrameContext frame = harness.context();
+    FillRemovalPass(harness.sources()).execute(frame);
+    NormalsPass(harness.sources()).execute(frame);
+    const FrameResources& resources = harness.resources();
+    const auto push = resources.buffer("pushValues").read<glm::vec4>();
+    const auto normals = resources.buffer("normalPyramid").read<glm::vec4>();
+    const auto all = levels();
+
+    // Per level: both tangent choices are candidates where the depth jumps tie.
+    std::vector<glm::dvec3> expected(normals.size());
+    for (std::size_t l = 0; l < all.size(); ++l) {
+        const Level& level = all[l];
+        const double scale = 1 << l;
+        auto position = [&](int x, int y) {
+            return viewPosition(harness, (x + 0.5) * scale, (y + 0.5) * scale,
+                                push[level.offset + y * level.width + x].x);
+        };
+        for (int y = 0; y < level.height; ++y) {
+            for (int x = 0; x < level.width; ++x) {
+                const glm::dvec3 centre = position(x, y);
+                auto tangents = [&](int ax, int ay) {
+                    std::vector<glm::dvec3> candidates;
+                    const bool next = x + ax < level.width && y + ay < level.height;
+                    const bool previous = x - ax >= 0 && y - ay >= 0;
+                    const glm::dvec3 n = next ? position(x + ax, y + ay) - centre : glm::dvec3(0);
+                    const glm::dvec3 p =
+                        previous ? centre - position(x - ax, y - ay) : glm::dvec3(0);
+                    if (!previous) {
+                        return std::vector<glm::dvec3>{n};
+                    }
+                    if (!next) {
+                        return std::vector<glm::dvec3>{p};
+                    }
+                    // A relative 1e-5 between the two jumps is within float rounding.
+                    if (std::abs(std::abs(n.z) - std::abs(p.z)) <=
+                        1e-5 * (std::abs(n.z) + std::abs(p.z))) {
+                        return std::vector<glm::dvec3>{n, p};
+                    }
+                    return std::vector<glm::dvec3>{std::abs(n.z) <= std::abs(p.z) ? n : p};
+                };
+                const glm::vec4 gpu = normals[level.offset + y * level.width + x];
+                double best = 1e9;
+                for (const glm::dvec3& tx : tangents(1, 0)) {
+                    for (const glm::dvec3& ty : tangents(0, 1)) {
+                        glm::dvec3 n = glm::cross(tx, ty);
+                        if (glm::dot(n, n) == 0.0) {
+                            n = glm::normalize(-centre);
+                        }
+                        n = glm::normalize(n);
+                        if (glm::dot(n, -centre) < 0.0) {
+                            n = -n;
+                        }
+                        best = std::min(best, glm::length(glm::dvec3(gpu) - n));
+                    }
+                }
+                // Unit vectors from float cross products of tangents ~0.1 long: ~1e-6 error;
+                // 1e-4 allows for cancellation on nearly flat patches.
+                EXPECT_LT(best, 1e-4) << "level " << l << " texel " << x << "," << y;
+            }
+        }
+    }
+}
+
+TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
+    PassHarness harness;
+    std::vector<float> depth, color;
+    runUpToPullPush(harness, depth, color);
+    FrameContext frame = harness.context();
+    FillRemovalPass(harness.sources()).execute(frame);
+    NormalsPass(harness.sources()).execute(frame);
+    ShadePass(harness.sources()).execute(frame);
+    const FrameResources& resources = harness.resources();
+    const auto surfaceDepth = resources.texture("surfaceDepth").readFloats();
+    const auto normals = resources.texture("normals").readFloats();
+    const auto albedo = resources.texture("filledColor").readFloats();
+    const auto diffuse = resources.texture("diffuse").readFloats();
+    const auto specular = resources.texture("specular").readFloats();
+    const ShadingSettings& shading = harness.settings().shading;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const int i = y * kWidth + x;
+            if (std::isinf(surfaceDepth[i])) {
+                EXPECT_EQ(diffuse[4 * i], 0.0f);
+                continue;
+            }
+            const glm::dvec3 toEye =
+                glm::normalize(-viewPosition(harness, x + 0.5, y + 0.5, surfaceDepth[i]));
+            const glm::dvec3 n(normals[4 * i], normals[4 * i + 1], normals[4 * i + 2]);
+            // Head light only (no directional lights in the defaults): L = V, so H = V too.
+            const double cosine = std::max(0.0, glm::dot(n, toEye));
+            for (int c = 0; c < 3; ++c) {
+                const double a = std::clamp(static_cast<double>(albedo[4 * i + c]), 0.0, 1.0);
+                const double expectedDiffuse =
+                    a * (shading.ambient[c] + shading.headLight[c] * cosine);
+                const double expectedSpecular = shading.headLight[c] * cosine * shading.specular *
+                                                std::pow(cosine, shading.shininess);
+                // RGBA16F outputs: 11 significant bits, ~5e-4 relative.
+                EXPECT_NEAR(diffuse[4 * i + c], expectedDiffuse, 2e-3 * (1 + expectedDiffuse));
+                EXPECT_NEAR(specular[4 * i + c], expectedSpecular, 2e-3 * (1 + expectedSpecular));
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace subscan
