@@ -25,7 +25,8 @@ struct LoadedScan {
     double loadMilliseconds = 0.0;  // reading and decoding, nothing after
 };
 
-/// Loads a scan file, or builds a built-in scene for "synthetic:NAME[?points=N]".
+/// Loads a scan file, or scans a built-in scene for "synthetic:NAME[?points=N][&noise=X]"
+/// (see makeSyntheticScene).
 /// Throws subscan::Error with one sentence that names the source and the problem.
 /// `progress` (may be empty) receives the fraction done while a file is decoded.
 LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress = {});

@@ -1,33 +1,65 @@
 #include "scan/SyntheticScenes.h"
 
 #include <charconv>
-#include <cmath>
-#include <numbers>
 #include <string>
 
 #include <fmt/format.h>
 
 #include "core/Error.h"
+#include "scan/Scene.h"
+#include "scan/VirtualScanner.h"
 
 namespace subscan {
 
 namespace {
 
-/// Points on the unit sphere by the Fibonacci lattice: nearly uniform, deterministic.
-PointCloud makeSphere(std::size_t count) {
-    std::vector<std::string> warnings;
-    PointCloudBuilder builder({.normal = true}, count);
-    const double goldenAngle = std::numbers::pi * (3.0 - std::sqrt(5.0));
-    for (std::size_t i = 0; i < count; ++i) {
-        const double z = 1.0 - (2.0 * static_cast<double>(i) + 1.0) / static_cast<double>(count);
-        const double radius = std::sqrt(1.0 - z * z);
-        const double angle = goldenAngle * static_cast<double>(i);
-        PointRecord record;
-        record.position = {radius * std::cos(angle), radius * std::sin(angle), z};
-        record.normal = glm::vec3(record.position);
-        builder.add(record);
+constexpr std::size_t kMaxSyntheticPoints = 100'000'000;
+
+struct SyntheticRequest {
+    std::size_t points = 0;  // 0: the scene's default
+    std::optional<NoiseAmount> noise;
+};
+
+std::size_t parsePointCount(std::string_view value) {
+    std::size_t points = 0;
+    const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), points);
+    if (ec != std::errc() || end != value.data() + value.size() || points == 0 ||
+        points > kMaxSyntheticPoints) {
+        throw Error(fmt::format("points={} is not a point count between 1 and {}", value,
+                                kMaxSyntheticPoints));
     }
-    return builder.finish(warnings);
+    return points;
+}
+
+/// Parses "key=value&key=value" after the '?'.
+SyntheticRequest parseParameters(std::string_view parameters) {
+    SyntheticRequest request;
+    while (!parameters.empty()) {
+        const std::size_t ampersand = parameters.find('&');
+        const std::string_view parameter = parameters.substr(0, ampersand);
+        parameters = ampersand == std::string_view::npos ? std::string_view()
+                                                         : parameters.substr(ampersand + 1);
+        const std::size_t equals = parameter.find('=');
+        const std::string_view key = parameter.substr(0, equals);
+        const std::string_view value =
+            equals == std::string_view::npos ? std::string_view() : parameter.substr(equals + 1);
+        if (equals != std::string_view::npos && key == "points") {
+            request.points = parsePointCount(value);
+        } else if (equals != std::string_view::npos && key == "noise") {
+            request.noise = parseNoiseAmount(value);
+            if (!request.noise) {
+                throw Error(fmt::format(
+                    "noise={} is not a distance >= 0 in metres or scan spacings (e.g. 0.0002 or "
+                    "0.1h)",
+                    value));
+            }
+        } else {
+            throw Error(
+                fmt::format("unknown synthetic scene parameter '{}' (expected points=N or noise=X)",
+                            parameter));
+        }
+    }
+    return request;
 }
 
 }  // namespace
@@ -35,26 +67,20 @@ PointCloud makeSphere(std::size_t count) {
 PointCloud makeSyntheticScene(std::string_view spec) {
     const std::size_t query = spec.find('?');
     const std::string_view name = spec.substr(0, query);
-    std::size_t points = 4000;
-    if (query != std::string_view::npos) {
-        const std::string_view parameter = spec.substr(query + 1);
-        constexpr std::string_view kPoints = "points=";
-        if (!parameter.starts_with(kPoints)) {
-            throw Error(fmt::format("unknown synthetic scene parameter '{}' (expected points=N)",
-                                    parameter));
-        }
-        const std::string_view value = parameter.substr(kPoints.size());
-        const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), points);
-        if (ec != std::errc() || end != value.data() + value.size() || points == 0 ||
-            points > 100'000'000) {
-            throw Error(
-                fmt::format("points={} is not a point count between 1 and 100000000", value));
-        }
-    }
-    if (name == "sphere") {
-        return makeSphere(points);
-    }
-    throw Error(fmt::format("there is no built-in scene '{}' (available: sphere)", name));
+    const SyntheticRequest request = parseParameters(
+        query == std::string_view::npos ? std::string_view() : spec.substr(query + 1));
+    const std::unique_ptr<Scene> scene = makeBuiltInScene(name);
+
+    const bool sphere = name == "sphere";
+    ScannerSettings settings;
+    settings.color = ScannerSettings::Color::Scene;
+    settings.normals = true;
+    const NoiseAmount noise =
+        request.noise.value_or(NoiseAmount{.value = sphere ? 0.0 : 0.1, .inSpacingUnits = true});
+    settings.noise = noise.value;
+    settings.noiseInSpacingUnits = noise.inSpacingUnits;
+    const std::size_t points = request.points != 0 ? request.points : (sphere ? 4000 : 200'000);
+    return scanToPointCount(*scene, settings, points);
 }
 
 }  // namespace subscan
