@@ -1,8 +1,12 @@
 #version 450
-// Fill removal (paper §4, "Rendering"): pull-push also fills the background around the object.
-// A pixel belongs to the surface only if the pull weight around it, read on the level of the
-// expected gap between points there, reaches a threshold. Writes "mask" (1 = surface) and
-// "surfaceDepth" (the filled depth on the surface, +inf elsewhere).
+// Fill removal: pull-push also fills the background around the object. A pixel belongs to the
+// surface when it holds a visible point, or when visible points surround it: in (by default)
+// all 8 directions, some level up to the expected-gap level L(x) (at least 1) finds pull weight
+// in the neighbouring texel. This replaces the paper's threshold on the pull weight at L(x),
+// which spreads the mask past the silhouette by about a texel of L(x) (the coarse weight is
+// interpolated across the edge): measured on the Stanford bunny, leakage fell from 4.6 % to 2 %
+// at equal coverage (bench/README.md). Writes "mask" (1 = surface) and "surfaceDepth" (the
+// filled depth there, +inf elsewhere).
 #include "shared/pyramid.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
@@ -16,16 +20,8 @@ layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inFilledDepth
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outMask;
 layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceDepth;
 
-float weightOnLevel(uint level, vec2 window) {
-    ivec2 texels[4];
-    float weights[4];
-    bilinearTexels(level, window, texels, weights);
-    float sum = 0.0;
-    for (int i = 0; i < 4; ++i) {
-        sum += weights[i] * pullWeight[texelIndex(level, texels[i])];
-    }
-    return sum;
-}
+const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
+                                     ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
 
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -35,13 +31,23 @@ void main() {
     float depth = imageLoad(inFilledDepth, pixel).r;
     bool surfacePixel = false;
     if (depth > 0.0 && !isinf(depth) && !isnan(depth)) {
-        float level = clamp(levelForRadius(surface.fill.x, depth), 0.0, float(levelCount() - 1u));
-        uint lower = uint(level);
-        uint upper = min(lower + 1u, levelCount() - 1u);
-        vec2 window = vec2(pixel) + 0.5;
-        float weight = mix(weightOnLevel(lower, window), weightOnLevel(upper, window),
-                           level - float(lower));
-        surfacePixel = weight >= surface.fill.y;
+        if (pullWeight[texelIndex(0u, pixel)] > 0.0) {
+            surfacePixel = true;
+        } else {
+            // Level 1 at least: its texels bridge one-pixel gaps between dense points.
+            uint levels = uint(ceil(clamp(levelForRadius(surface.fill.x, depth), 1.0,
+                                          float(levelCount() - 1u))));
+            int enclosed = 0;
+            for (int k = 0; k < 8; ++k) {
+                bool found = false;
+                for (uint level = 0u; level <= levels && !found; ++level) {
+                    ivec2 texel = (pixel >> level) + kDirections[k];
+                    found = insideLevel(level, texel) && pullWeight[texelIndex(level, texel)] > 0.0;
+                }
+                enclosed += found ? 1 : 0;
+            }
+            surfacePixel = float(enclosed) >= surface.fill.y;
+        }
     }
     imageStore(outMask, pixel, vec4(surfacePixel ? 1.0 : 0.0));
     imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? depth : kInfinity));

@@ -85,7 +85,9 @@ void main() {
         imageStore(outNormals, texel, vec4(0.0));
         return;
     }
-    float smoothing = clamp(levelForRadius(surface.normals.x, depth), 0.0,
+    // Level 1 at least: where points are denser than pixels, neighbouring pixels are closer
+    // than the scanner's noise allows a slope to be measured over.
+    float smoothing = clamp(levelForRadius(surface.normals.x, depth), 1.0,
                             float(levelCount() - 1u));
     uint lower = uint(smoothing);
     uint upper = min(lower + 1u, levelCount() - 1u);

@@ -2,15 +2,21 @@
 // Pull-push interpolation (Kraus 2009) of depth and colour together, weighted by visibility.
 //   STAGE_PULL_INIT  level 0: w = 1 for visible points, else 0; a = w * (depth, r, g, b)
 //   STAGE_PULL       level R from R-1: W and A summed over the 4x4 children with the kernel
-//                    h = {1/3, 1, 1, 1/3} per axis; w = min(1, W), a = A * w / W
+//                    h = {1/3, 1, 1, 1/3} per axis; w = min(1, W), a = A * w / W. Beyond
+//                    Kraus: only children on the front-most surface take part (see below).
 //   STAGE_PUSH_TOP   the coarsest level: complete value a / w
 //   STAGE_PUSH       level R from R+1: m = bilinear of the complete coarser level with the
 //                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 also
 //                    writes the "filledDepth" and "filledColor" images.
 #include "shared/pyramid.glsl"
 
+
+
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
+layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
+    SurfaceParams surface;
+};
 layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) buffer PullValues {
     vec4 pullValue[];
 };
@@ -45,6 +51,24 @@ void main() {
     pullValue[index] = visible ? vec4(imageLoad(inDepth, texel).r, imageLoad(inColor, texel).rgb)
                                : vec4(0.0);
 #elif STAGE_PULL
+    // Only the front-most surface among the children: a child deeper than the nearest one by
+    // more than `slope` texel widths (at that depth) belongs to a surface behind and is left out.
+    // Plain pull-push would blend both, and at an occluder's edge fill its gaps with depths from
+    // behind it; a surface steeper than the slope (atan 8 = 83 degrees by default) is cut.
+    float front = kInfinity;
+    for (int j = 0; j < 4; ++j) {
+        for (int i = 0; i < 4; ++i) {
+            ivec2 child = 2 * texel + ivec2(i - 1, j - 1);
+            if (insideLevel(level - 1u, child)) {
+                uint childIndex = texelIndex(level - 1u, child);
+                float w = pullWeight[childIndex];
+                if (w > 0.0) {
+                    front = min(front, pullValue[childIndex].x / w);
+                }
+            }
+        }
+    }
+    float tolerance = surface.fill.z * float(1u << level) * front / frame.depthRange.z;
     float weightSum = 0.0;
     vec4 valueSum = vec4(0.0);
     for (int j = 0; j < 4; ++j) {
@@ -54,8 +78,12 @@ void main() {
                 continue;
             }
             uint childIndex = texelIndex(level - 1u, child);
+            float w = pullWeight[childIndex];
+            if (w <= 0.0 || pullValue[childIndex].x / w > front + tolerance) {
+                continue;
+            }
             float h = kPullKernel[i] * kPullKernel[j];
-            weightSum += h * pullWeight[childIndex];
+            weightSum += h * w;
             valueSum += h * pullValue[childIndex];
         }
     }

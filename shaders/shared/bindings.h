@@ -94,7 +94,8 @@ struct PyramidLayout {
 // level = log2(radius * focal length / depth).
 struct SurfaceParams {
     vec4 visibility;  // x: HPR radius, y: threshold tau, z: edge rule (1 or 0), w: unused
-    vec4 fill;        // x: radius of the expected gap, y: pull-weight threshold
+    vec4 fill;        // x: radius of the expected gap, y: directions that must find points,
+                      // z: pull depth slope (texel widths), w: unused
     vec4 normals;     // x: smoothing radius
     vec4 unused0;
 };

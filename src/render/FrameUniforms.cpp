@@ -1,7 +1,7 @@
 #include "render/FrameUniforms.h"
 
+#include "core/Srgb.h"
 #include "render/Pyramid.h"
-#include "render/Renderer.h"
 
 namespace subscan {
 
@@ -31,7 +31,8 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
     gpu::SurfaceParams params{};
     params.visibility = {surface.visibilityRadius * h, surface.visibilityThreshold,
                          surface.edgeRule ? 1.0f : 0.0f, 0.0f};
-    params.fill = {surface.fillRadius * h, surface.fillThreshold, 0.0f, 0.0f};
+    params.fill = {surface.fillRadius * h, static_cast<float>(surface.fillDirections),
+                   surface.pullDepthSlope, 0.0f};
     params.normals = {surface.normalRadius * h, 0.0f, 0.0f, 0.0f};
     surface_.set(params);
     surface_.bind(SUBSCAN_UBO_SURFACE);

@@ -47,10 +47,6 @@ double FrameResult::totalMilliseconds() const {
                            [](double sum, const PassTiming& t) { return sum + t.milliseconds; });
 }
 
-float srgbToLinear(float encoded) {
-    return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
-}
-
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<double> spacing,
                    std::size_t maxChunkPoints)
     : context_(context),

@@ -85,7 +85,4 @@ class Renderer {
     TimingMode runnerTiming_ = TimingMode::Auto;
 };
 
-/// sRGB-encoded 0..1 -> linear, the CPU twin of srgbToLinear in shaders/shared/common.glsl.
-float srgbToLinear(float encoded);
-
 }  // namespace subscan

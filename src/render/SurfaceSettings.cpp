@@ -10,8 +10,9 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
         {"visibility_radius", settings.visibilityRadius},
         {"visibility_threshold", settings.visibilityThreshold},
         {"edge_rule", settings.edgeRule},
+        {"pull_depth_slope", settings.pullDepthSlope},
         {"fill_radius", settings.fillRadius},
-        {"fill_threshold", settings.fillThreshold},
+        {"fill_directions", settings.fillDirections},
         {"normal_radius", settings.normalRadius},
     };
 }
@@ -20,8 +21,9 @@ void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
     readSetting(json, "visibility_radius", settings.visibilityRadius, 0.1f, 1000.0f);
     readSetting(json, "visibility_threshold", settings.visibilityThreshold, 0.0f, 2.0f);
     readSetting(json, "edge_rule", settings.edgeRule);
+    readSetting(json, "pull_depth_slope", settings.pullDepthSlope, 0.1f, 1e6f);
     readSetting(json, "fill_radius", settings.fillRadius, 0.1f, 1000.0f);
-    readSetting(json, "fill_threshold", settings.fillThreshold, 0.0f, 1.0f);
+    readSetting(json, "fill_directions", settings.fillDirections, 1, 8);
     readSetting(json, "normal_radius", settings.normalRadius, 0.1f, 1000.0f);
 }
 

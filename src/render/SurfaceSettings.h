@@ -12,11 +12,13 @@ namespace subscan {
 /// pyramid level per pixel: level = log2(radius * h * focal length / depth).
 struct SurfaceSettings {
     float visibilityRadius = 4.0f;     // HPR looks this far for occluders (x h)
-    float visibilityThreshold = 0.1f;  // tau: mean of the 8 smallest omegas for "visible"
+    float visibilityThreshold = 0.3f;  // tau: mean of the 8 smallest omegas for "visible"
     bool edgeRule = true;              // the paper's silhouette rule
+    float pullDepthSlope = 8.0f;       // pull keeps children within this many texel widths
+                                       // behind the nearest one (the front-most surface)
     float fillRadius = 1.0f;           // the expected gap between points (x h)
-    float fillThreshold = 0.5f;        // pull weight on the gap level for "surface"
-    float normalRadius = 2.0f;         // normal smoothing (x h)
+    int fillDirections = 8;            // of 8 directions, how many must find points
+    float normalRadius = 1.5f;         // normal smoothing (x h)
 };
 
 struct DirectionalLight {

@@ -12,9 +12,9 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
+#include "core/Srgb.h"
 #include "scan/Marble.h"
 #include "scan/Scene.h"
-#include "scan/Srgb.h"
 
 namespace subscan {
 

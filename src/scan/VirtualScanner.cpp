@@ -15,8 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/Srgb.h"
 #include "scan/Marble.h"
-#include "scan/Srgb.h"
 
 namespace subscan {
 

@@ -13,6 +13,7 @@
 
 #include "core/Camera.h"
 #include "core/Error.h"
+#include "core/Srgb.h"
 #include "render/RasterizePointsPass.h"
 #include "render/Renderer.h"
 #include "support/GlTestSupport.h"

@@ -13,6 +13,7 @@ struct Command {
     std::function<int()> run;
 };
 
+Command addEvalCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addRenderCommand(CLI::App& parent);
 Command addScanCommand(CLI::App& parent);

@@ -11,6 +11,7 @@
 #include "app/cli/CommandSupport.h"
 #include "app/cli/Commands.h"
 #include "core/Error.h"
+#include "core/Srgb.h"
 #include "gpu/GlContext.h"
 #include "io/CameraJson.h"
 #include "io/Image.h"
@@ -90,14 +91,6 @@ std::vector<PassTiming> medianTimings(Renderer& renderer, const Camera& camera,
     return medians;
 }
 
-/// Linear 0..1 -> sRGB-encoded 8-bit, the CPU twin of linearToSrgb in shared/common.glsl.
-std::uint8_t encodeSrgb(float linear) {
-    const float clamped = std::clamp(linear, 0.0f, 1.0f);
-    const float encoded =
-        clamped <= 0.0031308f ? 12.92f * clamped : 1.055f * std::pow(clamped, 1.0f / 2.4f) - 0.055f;
-    return static_cast<std::uint8_t>(std::lround(encoded * 255.0f));
-}
-
 /// Keeps `channels` of the 4 in an RGBA float image (for PFM, which holds 1 or 3).
 ImageF channelsOf(const Texture& texture, int channels) {
     const std::vector<float> rgba = texture.readFloats();
@@ -134,7 +127,7 @@ void exportBuffers(const std::filesystem::path& directory, const Renderer& rende
     Image8 png{camera.width, camera.height, 4, std::vector<std::uint8_t>(color.size())};
     for (std::size_t pixel = 0; pixel < depth.size(); ++pixel) {
         for (std::size_t c = 0; c < 3; ++c) {
-            png.pixels[4 * pixel + c] = encodeSrgb(color[4 * pixel + c]);
+            png.pixels[4 * pixel + c] = srgb8Channel(color[4 * pixel + c]);
         }
         png.pixels[4 * pixel + 3] = std::isinf(depth[pixel]) ? 0 : 255;
     }

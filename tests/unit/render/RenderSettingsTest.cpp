@@ -45,12 +45,12 @@ TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
     EXPECT_FALSE(back.surface.edgeRule);
     ASSERT_EQ(back.shading.lights.size(), 1u);
     EXPECT_EQ(back.shading.lights[0].direction, glm::vec3(1, 2, 3));
-    const auto bad = dir.write("bad.json", R"({"surface": {"fill_threshold": 3}})");
+    const auto bad = dir.write("bad.json", R"({"surface": {"fill_directions": 9}})");
     try {
         readSettingsFile(bad);
         FAIL() << "accepted";
     } catch (const Error& error) {
-        EXPECT_THAT(error.what(), ::testing::HasSubstr("'fill_threshold' = 3 is outside 0..1"));
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("'fill_directions' = 9 is outside 1..8"));
     }
     const auto unknown = dir.write("unknown.json", R"({"surfaces": {}})");
     EXPECT_THROW(readSettingsFile(unknown), Error);

@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/Srgb.h"
 #include "scan/Scene.h"
-#include "scan/Srgb.h"
 #include "scan/VirtualScanner.h"
 #include "support/TestMeshes.h"
 

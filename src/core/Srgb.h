@@ -10,7 +10,8 @@
 
 namespace subscan {
 
-/// The sRGB transfer function (IEC 61966-2-1), for one channel in 0..1.
+/// The sRGB transfer function (IEC 61966-2-1), for one channel in 0..1; the CPU twins of
+/// srgbToLinear/linearToSrgb in shaders/shared/common.glsl.
 inline float srgbToLinear(float encoded) {
     return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
 }
@@ -25,13 +26,15 @@ inline glm::vec3 linearColor(const Rgba8& color) {
             srgbToLinear(color.b / 255.0f)};
 }
 
+/// One linear channel (clamped to 0..1) encoded as 8-bit sRGB, rounded to nearest.
+inline std::uint8_t srgb8Channel(float linear) {
+    return static_cast<std::uint8_t>(
+        std::lround(linearToSrgb(std::clamp(linear, 0.0f, 1.0f)) * 255.0f));
+}
+
 /// Linear RGB (clamped to 0..1) encoded as opaque 8-bit sRGB, rounded to nearest.
 inline Rgba8 srgb8Color(const glm::vec3& linear) {
-    auto channel = [](float value) {
-        const float encoded = linearToSrgb(std::clamp(value, 0.0f, 1.0f));
-        return static_cast<std::uint8_t>(std::lround(encoded * 255.0f));
-    };
-    return {channel(linear.r), channel(linear.g), channel(linear.b), 255};
+    return {srgb8Channel(linear.r), srgb8Channel(linear.g), srgb8Channel(linear.b), 255};
 }
 
 }  // namespace subscan

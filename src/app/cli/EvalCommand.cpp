@@ -1,0 +1,122 @@
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "app/cli/CommandSupport.h"
+#include "app/cli/Commands.h"
+#include "core/Error.h"
+#include "core/Srgb.h"
+#include "eval/Evaluation.h"
+#include "gpu/GlContext.h"
+#include "scan/Scene.h"
+#include "scan/SyntheticScenes.h"
+#include "scan/VirtualScanner.h"
+
+namespace subscan::cli {
+
+namespace {
+
+struct EvalOptions {
+    std::string source;
+    EvaluationSettings evaluation;
+    std::string points = "vertices";
+    std::string settingsFile;
+    bool json = false;
+    bool software = false;
+};
+
+/// The albedo the ground truth of a mesh shows, given to its points too so that PSNR compares
+/// geometry and shading, not a colour convention.
+constexpr float kMeshAlbedo = 0.7f;
+
+int runEval(const EvalOptions& options) {
+    RenderSettings render;
+    if (!options.settingsFile.empty()) {
+        render = readSettingsFile(options.settingsFile);
+    }
+    std::unique_ptr<Scene> truth;
+    PointCloud points;
+    constexpr std::string_view kSynthetic = "synthetic:";
+    if (std::string_view(options.source).starts_with(kSynthetic)) {
+        const std::string spec = options.source.substr(kSynthetic.size());
+        try {
+            truth = makeBuiltInScene(spec.substr(0, spec.find('?')));
+            points = makeSyntheticScene(spec);
+        } catch (const Error& error) {
+            throw Error(fmt::format("{}: {}", options.source, error.what()));
+        }
+    } else {
+        const LoadedScan mesh = loadScanForCommand(options.source);
+        if (mesh.cloud.triangles.empty()) {
+            throw Error(
+                fmt::format("{}: has no faces; eval needs a mesh as ground truth", options.source));
+        }
+        truth = makeMeshScene(mesh.cloud, AlbedoSource::Grey);
+        if (options.points == "vertices") {
+            points = mesh.cloud;
+            points.triangles.clear();
+            points.normals.clear();
+            points.intensities.clear();
+            points.colors.assign(points.size(), srgb8Color(glm::vec3(kMeshAlbedo)));
+        } else {
+            ScannerSettings scanner;
+            scanner.noise = 0.1;
+            scanner.noiseInSpacingUnits = true;
+            points = scanScene(*truth, scanner);
+        }
+    }
+
+    HeadlessContextOptions contextOptions;
+    contextOptions.preferHardware = !options.software;
+    const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
+    const EvaluationReport report = evaluate(*context, *truth, points, options.evaluation, render);
+    if (options.json) {
+        fmt::print("{}\n", toJson(report).dump(2));
+        return 0;
+    }
+    fmt::print("{}: {} points (h = {:.4g}), {} views of {}x{}\n", options.source, report.points,
+               report.spacing, report.views, report.width, report.height);
+    fmt::print("{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "method", "coverage",
+               "leakage", "depth/h", "occluded", "normal°", "normal95", "PSNR");
+    auto row = [](const std::string& name, const QualityMetrics& m) {
+        fmt::print("{:<14} {:>9.4f} {:>9.4f} {:>10.3f} {:>10.4f} {:>10} {:>10} {:>8.2f}\n", name,
+                   m.coverage, m.leakage, m.depthErrorMedianH, m.occlusionErrorRate,
+                   m.normalErrorMeanDeg ? fmt::format("{:.2f}", *m.normalErrorMeanDeg) : "-",
+                   m.normalErrorP95Deg ? fmt::format("{:.2f}", *m.normalErrorP95Deg) : "-",
+                   m.psnrDb);
+    };
+    row("points", report.points1px);
+    row(fmt::format("splats ({}px)", report.splatSize), report.splats);
+    row("surface", report.surface);
+    return 0;
+}
+
+}  // namespace
+
+Command addEvalCommand(CLI::App& parent) {
+    auto options = std::make_shared<EvalOptions>();
+    CLI::App* eval = parent.add_subcommand(
+        "eval", "Reconstruction quality against ground truth (a mesh, or synthetic:NAME)");
+    eval->add_option("mesh", options->source, "Mesh PLY with faces, or synthetic:NAME")->required();
+    eval->add_option("--views", options->evaluation.views, "Views on the orbit")
+        ->check(CLI::Range(1, 360));
+    eval->add_option("--width", options->evaluation.width, "Image width")
+        ->check(CLI::Range(16, 8192));
+    eval->add_option("--height", options->evaluation.height, "Image height")
+        ->check(CLI::Range(16, 8192));
+    eval->add_option("--points", options->points,
+                     "Points of a mesh: its vertices, or a virtual scan of it")
+        ->check(CLI::IsMember({"vertices", "scan"}));
+    eval->add_option("--settings", options->settingsFile, "Settings JSON for the surface")
+        ->check(CLI::ExistingFile);
+    eval->add_option("--export-views", options->evaluation.exportDirectory,
+                     "Directory for per-view pictures: truth, surface, coverage, normal error");
+    eval->add_flag("--json", options->json, "Machine-readable output");
+    eval->add_flag("--software", options->software,
+                   "Use Mesa's software rasterizer even when a GPU exists");
+    return {eval, [options] { return runEval(*options); }};
+}
+
+}  // namespace subscan::cli

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/PointCloud.h"
+#include "eval/Metrics.h"
+#include "gpu/GlContext.h"
+#include "render/RenderSettings.h"
+#include "scan/Scene.h"
+
+namespace subscan {
+
+/// How `subscan eval` looks at a scene: `views` cameras on an orbit around it (yaw spread over
+/// 360°, pitch alternating between +25° and -15°), auto-framed like `subscan render`.
+struct EvaluationSettings {
+    int views = 8;
+    int width = 1024;
+    int height = 1024;
+    double fovyDegrees = 45.0;
+    int smallestSplat = 2;  // the splats baseline reports the best size in this range
+    int largestSplat = 8;
+    /// When set, each view's pictures go here: truth.png and surface.png (shaded), coverage.png
+    /// (grey: both, red: missed, blue: leaked,
+    /// yellow: a surface behind the true one shows through) and normal_error.png (black 0° to white
+    /// 45°).
+    std::filesystem::path exportDirectory;
+};
+
+/// DESIGN.md §7 metrics of each method, averaged over the views.
+struct EvaluationReport {
+    int views = 0;
+    int width = 0;
+    int height = 0;
+    std::size_t points = 0;
+    double spacing = 0.0;
+    QualityMetrics points1px;
+    QualityMetrics splats;
+    int splatSize = 0;  // the best splat size in pixels (by PSNR)
+    QualityMetrics surface;
+};
+
+/// Renders `points` with each method and compares with `truth` seen by the same cameras.
+/// Points and splats have no normals: they are shaded flat (normal towards the eye) with the same
+/// lights, which is what a point viewer shows; the surface uses its reconstructed normals; the
+/// ground truth its exact ones. `render` holds the surface and shading settings.
+EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointCloud& points,
+                          const EvaluationSettings& settings, const RenderSettings& render);
+
+/// {"views", "width", "height", "points", "spacing", "methods": {"points", "splats",
+/// "surface"}} with the keys of each method named in the issue (snake case).
+nlohmann::json toJson(const EvaluationReport& report);
+
+}  // namespace subscan

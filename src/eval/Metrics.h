@@ -1,0 +1,42 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "eval/GroundTruth.h"
+
+namespace subscan {
+
+/// A method's per-pixel result for one view (rows top first): depth +inf where it shows nothing;
+/// normals empty when the method has none (1-pixel points, splats).
+struct ReconstructionImages {
+    std::vector<float> depth;
+    std::vector<glm::vec3> normals;
+};
+
+/// The quality metrics of DESIGN.md §7 for one view, or averaged over views.
+struct QualityMetrics {
+    double coverage = 0.0;            // |rec ∩ gt| / |gt|
+    double leakage = 0.0;             // |rec \ gt| / |rec|
+    double depthErrorMedianH = 0.0;   // median |z_rec - z_gt| / h over rec ∩ gt
+    double occlusionErrorRate = 0.0;  // share of rec ∩ gt with z_rec - z_gt > 3 h
+    std::optional<double> normalErrorMeanDeg;
+    std::optional<double> normalErrorP95Deg;
+    double psnrDb = 0.0;  // shaded image against the shaded ground truth, 8-bit sRGB
+};
+
+/// Everything but PSNR, from the images; `spacing` is h.
+QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
+                                    const GroundTruthImages& truth, double spacing);
+
+/// Peak signal-to-noise ratio of two RGBA8 images over their RGB channels, in dB (capped at
+/// 100 dB for identical images).
+double psnr(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b);
+
+/// The mean of per-view metrics (optional ones averaged where present).
+QualityMetrics average(const std::vector<QualityMetrics>& views);
+
+}  // namespace subscan
