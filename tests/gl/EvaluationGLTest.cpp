@@ -1,0 +1,70 @@
+// The reconstruction's measured quality on the virtual scan of the sculpture (with scanner
+// noise), against its analytic ground truth. Thresholds are the targets of the issue; 512x512
+// keeps the ring and fins several pixels wide (at 256 the 1-pixel silhouette band alone is 4 %
+// leakage) while the test stays within a few seconds.
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "eval/Evaluation.h"
+#include "scan/SyntheticScenes.h"
+#include "support/GlTestSupport.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+void expectTargets(const EvaluationReport& report) {
+    const QualityMetrics& surface = report.surface;
+    EXPECT_GE(surface.coverage, 0.97);
+    EXPECT_LE(surface.leakage, 0.03);
+    EXPECT_LE(surface.occlusionErrorRate, 0.01);
+    ASSERT_TRUE(surface.normalErrorMeanDeg.has_value());
+    EXPECT_LE(*surface.normalErrorMeanDeg, 10.0);
+    EXPECT_GT(surface.psnrDb, report.points1px.psnrDb);
+    EXPECT_GT(surface.psnrDb, report.splats.psnrDb);
+}
+
+TEST(EvaluationGLTest, SculptureScanWithNoiseMeetsTheTargets) {
+    const auto truth = makeBuiltInScene("sculpture");
+    const PointCloud points = makeSyntheticScene("sculpture");  // 200k points, 0.1 h noise
+    EvaluationSettings settings;
+    settings.views = 4;
+    settings.width = 512;
+    settings.height = 512;
+    const EvaluationReport report =
+        evaluate(test::glTestContext(), *truth, points, settings, RenderSettings{});
+    expectTargets(report);
+}
+
+TEST(EvaluationGLTest, EvalCommandJsonHasTheDocumentedShape) {
+    const auto result = test::runSubscan({"eval", "synthetic:sphere?points=3000", "--views", "1",
+                                          "--width", "64", "--height", "64", "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const nlohmann::json json = nlohmann::json::parse(result.out);
+    EXPECT_EQ(json["views"], 1);
+    EXPECT_EQ(json["width"], 64);
+    EXPECT_EQ(json["points"], 3000);
+    for (const char* method : {"points", "splats", "surface"}) {
+        for (const char* key :
+             {"coverage", "leakage", "depth_error_median_h", "occlusion_error_rate",
+              "normal_error_mean_deg", "normal_error_p95_deg", "psnr_db"}) {
+            EXPECT_TRUE(json["methods"][method].contains(key)) << method << "." << key;
+        }
+    }
+    EXPECT_TRUE(json["methods"]["points"]["normal_error_mean_deg"].is_null());
+    EXPECT_TRUE(json["methods"]["surface"]["normal_error_mean_deg"].is_number());
+}
+
+TEST(EvaluationGLTest, EvalRefusesAPointCloudWithoutFaces) {
+    const test::TempDir dir;
+    const auto cloud = dir.write("cloud.xyz", "0 0 0\n1 0 0\n0 1 0\n");
+    const auto result = test::runSubscan({"eval", cloud.string()});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_THAT(result.err, ::testing::HasSubstr("has no faces"));
+}
+
+}  // namespace
+}  // namespace subscan

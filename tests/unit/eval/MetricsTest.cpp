@@ -1,0 +1,83 @@
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/trigonometric.hpp>
+
+#include "eval/Metrics.h"
+
+namespace subscan {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+TEST(MetricsTest, CountsCoverageLeakageDepthAndOcclusion) {
+    // 10 pixels: truth covers 0..7; the reconstruction covers 2..9.
+    GroundTruthImages truth{10, 1, std::vector<float>(10, kInf),
+                            std::vector<glm::vec3>(10, {0, 0, 1}), std::vector<glm::vec3>(10)};
+    ReconstructionImages reconstruction{std::vector<float>(10, kInf), {}};
+    for (int i = 0; i < 8; ++i) {
+        truth.depth[i] = 1.0f;
+    }
+    const float h = 0.01f;
+    // rec ∩ truth = 2..7 (6 pixels): errors in h of 0, 1, 2, 3.5, 4, 10 (the last three behind).
+    const float errors[6] = {0, 1, 2, 3.5f, 4, 10};
+    for (int i = 2; i < 8; ++i) {
+        reconstruction.depth[i] = 1.0f + errors[i - 2] * h;
+    }
+    reconstruction.depth[8] = reconstruction.depth[9] = 2.0f;
+    const QualityMetrics m = compareToGroundTruth(reconstruction, truth, h);
+    EXPECT_DOUBLE_EQ(m.coverage, 6.0 / 8.0);
+    EXPECT_DOUBLE_EQ(m.leakage, 2.0 / 8.0);
+    // Median of 6 values (0 1 2 3.5 4 10): the element at index round(2.5) = 3 after sorting.
+    // Float depths make the errors inexact by ~1e-5 h.
+    EXPECT_NEAR(m.depthErrorMedianH, 3.5, 1e-3);
+    EXPECT_DOUBLE_EQ(m.occlusionErrorRate, 3.0 / 6.0);  // 3.5, 4 and 10 exceed 3 h
+    EXPECT_FALSE(m.normalErrorMeanDeg.has_value());     // no normals given
+}
+
+TEST(MetricsTest, NormalErrorsInDegrees) {
+    GroundTruthImages truth{4, 1, std::vector<float>(4, 1.0f), std::vector<glm::vec3>(4, {0, 0, 1}),
+                            std::vector<glm::vec3>(4)};
+    ReconstructionImages reconstruction{std::vector<float>(4, 1.0f), {}};
+    for (const double degrees : {0.0, 10.0, 20.0, 90.0}) {
+        const double radians = glm::radians(degrees);
+        // Unnormalised on purpose: the metric normalises the reconstruction.
+        reconstruction.normals.push_back(
+            glm::vec3(2.0 * std::sin(radians), 0.0, 2.0 * std::cos(radians)));
+    }
+    const QualityMetrics m = compareToGroundTruth(reconstruction, truth, 1.0);
+    // float normals: angles are exact to ~1e-5 degrees.
+    EXPECT_NEAR(*m.normalErrorMeanDeg, 30.0, 1e-3);
+    EXPECT_NEAR(*m.normalErrorP95Deg, 90.0, 1e-3);  // index round(0.95 * 3) = 3: the largest
+}
+
+TEST(MetricsTest, PsnrOfKnownDifferences) {
+    const std::vector<std::uint8_t> a(400, 100);
+    std::vector<std::uint8_t> b = a;
+    EXPECT_EQ(psnr(a, b), 100.0);  // identical: capped
+    for (std::size_t i = 0; i < b.size(); i += 4) {
+        b[i] = 110;    // red off by 10 everywhere: MSE over RGB = 100 / 3
+        b[i + 3] = 0;  // alpha ignored
+    }
+    EXPECT_NEAR(psnr(a, b), 10.0 * std::log10(255.0 * 255.0 / (100.0 / 3.0)), 1e-9);
+}
+
+TEST(MetricsTest, AverageOverViews) {
+    QualityMetrics a, b;
+    a.coverage = 0.9;
+    b.coverage = 1.0;
+    a.normalErrorMeanDeg = 4.0;
+    a.normalErrorP95Deg = 8.0;
+    b.normalErrorMeanDeg = 6.0;
+    b.normalErrorP95Deg = 10.0;
+    const QualityMetrics mean = average({a, b});
+    EXPECT_DOUBLE_EQ(mean.coverage, 0.95);
+    EXPECT_DOUBLE_EQ(*mean.normalErrorMeanDeg, 5.0);
+    EXPECT_DOUBLE_EQ(*mean.normalErrorP95Deg, 9.0);
+}
+
+}  // namespace
+}  // namespace subscan
