@@ -38,7 +38,9 @@ void main() {
             uint levels = uint(ceil(clamp(levelForRadius(surface.fill.x, depth), 1.0,
                                           float(levelCount() - 1u))));
             int enclosed = 0;
-            for (int k = 0; k < 8; ++k) {
+            // Stops as soon as the remaining directions can no longer reach the count: most
+            // background pixels fail on their first empty direction.
+            for (int k = 0; k < 8 && float(enclosed + 8 - k) >= surface.fill.y; ++k) {
                 bool found = false;
                 for (uint level = 0u; level <= levels && !found; ++level) {
                     ivec2 texel = (pixel >> level) + kDirections[k];

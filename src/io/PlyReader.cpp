@@ -430,7 +430,9 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
         } else {
             countValue = nextAsciiNumber(element, itemIndex);
         }
-        if (!(countValue >= 0.0 && countValue == std::floor(countValue))) {
+        // Lists longer than 2^32 entries cannot be real, and the bound keeps the cast defined.
+        if (!(countValue >= 0.0 && countValue <= 4294967295.0 &&
+              countValue == std::floor(countValue))) {
             throw Error(fmt::format("the PLY body has the invalid list length {} in {} {}",
                                     countValue, element.name, itemIndex + 1));
         }

@@ -191,6 +191,9 @@ int runRender(const RenderOptions& options) {
 
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
+#ifndef NDEBUG
+    contextOptions.debugOutput = true;  // debug builds turn GL errors into errors
+#endif
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
     if (options.verbose) {
         const GlCapabilities& caps = context->capabilities();

@@ -241,6 +241,11 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
          "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
              "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n-3 0\n",
          "invalid list length"},
+        {"huge list length",  // found by the fuzzer: 3.7e78 as a list count
+         "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n"
+             "3666666666666666666666666666666666666666666666666666666666666666666666666666666 0\n",
+         "invalid list length"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.name);

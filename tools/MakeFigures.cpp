@@ -1,0 +1,114 @@
+// Renders the README's figures: the stages of the surface pipeline side by side (like the
+// paper's Figure 2) and a points/surface comparison. Run by scripts/make-figures.sh.
+//   subscan_figures stages SCAN OUT.png [--yaw D --pitch D --size W H]
+//   subscan_figures compare SCAN OUT.png [--yaw D --pitch D --size W H]
+#include <cstdio>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/Camera.h"
+#include "core/Error.h"
+#include "gpu/GlContext.h"
+#include "io/Image.h"
+#include "io/ScanLoader.h"
+#include "render/Renderer.h"
+
+namespace subscan {
+namespace {
+
+struct Panel {
+    RenderMode mode;
+    Stage stage;
+};
+
+/// Side-by-side tiles, `columns` per row, separated by a `gap` of background.
+Image8 montage(const std::vector<std::vector<std::uint8_t>>& tiles, int width, int height,
+               int columns, int gap, std::uint8_t background) {
+    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
+    Image8 out{columns * width + (columns - 1) * gap, rows * height + (rows - 1) * gap, 4, {}};
+    out.pixels.assign(static_cast<std::size_t>(out.width * out.height * 4), background);
+    for (std::size_t t = 0; t < tiles.size(); ++t) {
+        const int x0 = static_cast<int>(t % columns) * (width + gap);
+        const int y0 = static_cast<int>(t / columns) * (height + gap);
+        for (int y = 0; y < height; ++y) {
+            std::copy_n(
+                tiles[t].begin() + static_cast<std::ptrdiff_t>(y * width * 4), width * 4,
+                out.pixels.begin() + static_cast<std::ptrdiff_t>(((y0 + y) * out.width + x0) * 4));
+        }
+    }
+    return out;
+}
+
+int run(int argc, char** argv) {
+    if (argc < 4) {
+        std::fprintf(stderr,
+                     "usage: subscan_figures stages|compare SCAN OUT.png [--yaw D] "
+                     "[--pitch D] [--size W H]\n");
+        return 2;
+    }
+    const std::string_view kind = argv[1];
+    OrbitView orbit;
+    int width = 480, height = 540;
+    for (int i = 4; i < argc; ++i) {
+        const std::string_view option = argv[i];
+        if (option == "--yaw" && i + 1 < argc) {
+            orbit.yawDegrees = std::stod(argv[++i]);
+        } else if (option == "--pitch" && i + 1 < argc) {
+            orbit.pitchDegrees = std::stod(argv[++i]);
+        } else if (option == "--size" && i + 2 < argc) {
+            width = std::stoi(argv[++i]);
+            height = std::stoi(argv[++i]);
+        } else {
+            std::fprintf(stderr, "subscan_figures: unknown option %s\n", argv[i]);
+            return 2;
+        }
+    }
+    std::vector<Panel> panels;
+    int columns = 2;
+    if (kind == "stages") {
+        panels = {{RenderMode::Points, Stage::Final}, {RenderMode::Surface, Stage::Visibility},
+                  {RenderMode::Surface, Stage::Pull}, {RenderMode::Surface, Stage::Push},
+                  {RenderMode::Surface, Stage::Fill}, {RenderMode::Surface, Stage::Normals},
+                  {RenderMode::Surface, Stage::Final}};
+        columns = 4;
+        panels.insert(panels.begin() + 4, {RenderMode::Surface, Stage::Depth});
+    } else if (kind == "compare") {
+        panels = {{RenderMode::Points, Stage::Final},
+                  {RenderMode::Splats, Stage::Final},
+                  {RenderMode::Surface, Stage::Final}};
+        columns = 3;
+    } else {
+        std::fprintf(stderr, "subscan_figures: unknown figure %s\n", argv[1]);
+        return 2;
+    }
+
+    const LoadedScan scan = loadScan(argv[2]);
+    const Camera camera = orbitCamera(scan.cloud.bounds, orbit, width, height, 40.0);
+    const auto context = createHeadlessContext();
+    Renderer renderer(*context, scan.cloud);
+    std::vector<std::vector<std::uint8_t>> tiles;
+    for (const Panel& panel : panels) {
+        RenderSettings settings;
+        settings.raster.mode = panel.mode;
+        settings.raster.stage = panel.stage;
+        settings.raster.pointSize = 3.0f;
+        settings.raster.backgroundSrgb = glm::vec3(0.12f);
+        renderer.render(camera, settings);
+        tiles.push_back(renderer.readImage());
+    }
+    writePng(argv[3], montage(tiles, width, height, columns, 4, 255));
+    return 0;
+}
+
+}  // namespace
+}  // namespace subscan
+
+int main(int argc, char** argv) {
+    try {
+        return subscan::run(argc, argv);
+    } catch (const subscan::Error& error) {
+        std::fprintf(stderr, "subscan_figures: %s\n", error.what());
+        return 1;
+    }
+}
