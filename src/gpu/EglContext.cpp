@@ -110,6 +110,16 @@ std::unique_ptr<GlContext> createHeadlessContext(const HeadlessContextOptions& o
             "libegl1 and Mesa's libegl-mesa0 and libgl1-mesa-dri)");
     }
     std::vector<std::string> failures;
+    // A context on `display`, or null with the reason recorded.
+    auto attempt = [&](EGLDisplay display) -> std::unique_ptr<GlContext> {
+        EGLContext context = EGL_NO_CONTEXT;
+        std::string failure = tryCreateContext(display, options.debugOutput, context);
+        if (failure.empty()) {
+            return std::make_unique<EglContext>(display, context, options.debugOutput);
+        }
+        failures.push_back(std::move(failure));
+        return nullptr;
+    };
 
     // 1. EGL devices, hardware first (EGL_MESA_device_software marks llvmpipe's device).
     if (hasWord(client, "EGL_EXT_device_enumeration") &&
@@ -128,27 +138,19 @@ std::unique_ptr<GlContext> createHeadlessContext(const HeadlessContextOptions& o
                 if (software != wantSoftware) {
                     continue;
                 }
-                EGLDisplay display =
-                    eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
-                EGLContext context = EGL_NO_CONTEXT;
-                const std::string failure = tryCreateContext(display, options.debugOutput, context);
-                if (failure.empty()) {
-                    return std::make_unique<EglContext>(display, context, options.debugOutput);
+                if (auto context = attempt(
+                        eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, nullptr))) {
+                    return context;
                 }
-                failures.push_back(failure);
             }
         }
     }
     // 2. Mesa's surfaceless platform.
     if (hasWord(client, "EGL_MESA_platform_surfaceless")) {
-        EGLDisplay display =
-            eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-        EGLContext context = EGL_NO_CONTEXT;
-        const std::string failure = tryCreateContext(display, options.debugOutput, context);
-        if (failure.empty()) {
-            return std::make_unique<EglContext>(display, context, options.debugOutput);
+        if (auto context = attempt(eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA,
+                                                            EGL_DEFAULT_DISPLAY, nullptr))) {
+            return context;
         }
-        failures.push_back(failure);
     }
     throw Error(
         fmt::format("no usable OpenGL 4.5: {} (for software rendering install Mesa's "

@@ -7,6 +7,7 @@
 #include "eval/Evaluation.h"
 #include "io/ScanLoader.h"
 #include "support/GlTestSupport.h"
+#include "support/QualityTargets.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
@@ -26,13 +27,7 @@ TEST(BunnyEvaluationDataTest, VerticesAsPointsMeetTheTargets) {
     settings.height = 512;
     const EvaluationReport report =
         evaluate(test::glTestContext(), *truth, points, settings, RenderSettings{});
-    const QualityMetrics& surface = report.surface;
-    EXPECT_GE(surface.coverage, 0.97);
-    EXPECT_LE(surface.leakage, 0.03);
-    EXPECT_LE(surface.occlusionErrorRate, 0.01);
-    EXPECT_LE(*surface.normalErrorMeanDeg, 10.0);
-    EXPECT_GT(surface.psnrDb, report.points1px.psnrDb);
-    EXPECT_GT(surface.psnrDb, report.splats.psnrDb);
+    test::expectQualityTargets(report);
 }
 
 }  // namespace

@@ -158,9 +158,9 @@ TEST(RealScansDataTest, EveryReadableFileRenders) {
         }
         SCOPED_TRACE(expected.file);
         const auto out = dir / "out.png";
-        const auto result = runSubscan({"render", (data / expected.file).string(), "-o",
-                                        out.string(), "--width", "96", "--height", "72",
-                                        "--background", "#000000"});
+        const auto result =
+            runSubscan({"render", (data / expected.file).string(), "-o", out.string(), "--width",
+                        "96", "--height", "72", "--background", "#000000"});
         ASSERT_EQ(result.exitCode, 0) << result.err;
         const Image8 image = readPng(out);
         int drawn = 0;

@@ -11,21 +11,11 @@
 #include "eval/Evaluation.h"
 #include "scan/SyntheticScenes.h"
 #include "support/GlTestSupport.h"
+#include "support/QualityTargets.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
 namespace {
-
-void expectTargets(const EvaluationReport& report) {
-    const QualityMetrics& surface = report.surface;
-    EXPECT_GE(surface.coverage, 0.97);
-    EXPECT_LE(surface.leakage, 0.03);
-    EXPECT_LE(surface.occlusionErrorRate, 0.01);
-    ASSERT_TRUE(surface.normalErrorMeanDeg.has_value());
-    EXPECT_LE(*surface.normalErrorMeanDeg, 10.0);
-    EXPECT_GT(surface.psnrDb, report.points1px.psnrDb);
-    EXPECT_GT(surface.psnrDb, report.splats.psnrDb);
-}
 
 TEST(EvaluationGLTest, SculptureScanWithNoiseMeetsTheTargets) {
     const auto truth = makeBuiltInScene("sculpture");
@@ -36,7 +26,7 @@ TEST(EvaluationGLTest, SculptureScanWithNoiseMeetsTheTargets) {
     settings.height = 512;
     const EvaluationReport report =
         evaluate(test::glTestContext(), *truth, points, settings, RenderSettings{});
-    expectTargets(report);
+    test::expectQualityTargets(report);
 }
 
 TEST(EvaluationGLTest, EvalCommandJsonHasTheDocumentedShape) {

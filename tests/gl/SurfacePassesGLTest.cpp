@@ -49,6 +49,22 @@ std::vector<Level> levels() {
     }
 }
 
+/// Bilinear interpolation on pyramid level `l` at full-resolution pixel (x, y), texel centres as
+/// sample points, clamped at the borders (the CPU twin of bilinearTexels in pyramid.glsl).
+template <class Fetch>
+auto bilinearOnLevel(const Level& level, int l, int x, int y, Fetch fetch) {
+    const double u = (x + 0.5) / (1 << l) - 0.5, v = (y + 0.5) / (1 << l) - 0.5;
+    const int bx = static_cast<int>(std::floor(u)), by = static_cast<int>(std::floor(v));
+    const double tx = u - bx, ty = v - by;
+    auto at = [&](int cx, int cy) {
+        cx = std::clamp(cx, 0, level.width - 1);
+        cy = std::clamp(cy, 0, level.height - 1);
+        return fetch(level.offset + cy * level.width + cx);
+    };
+    return (1 - tx) * (1 - ty) * at(bx, by) + tx * (1 - ty) * at(bx + 1, by) +
+           (1 - tx) * ty * at(bx, by + 1) + tx * ty * at(bx + 1, by + 1);
+}
+
 /// A frame of the pipeline outside the Renderer: uniforms, resources and a context for passes.
 class PassHarness {
   public:
@@ -368,6 +384,13 @@ void runUpToPullPush(PassHarness& harness, std::vector<float>& depth, std::vecto
     PullPushPass(harness.sources()).execute(frame);
 }
 
+void runUpToNormals(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color) {
+    runUpToPullPush(harness, depth, color);
+    FrameContext frame = harness.context();
+    FillRemovalPass(harness.sources()).execute(frame);
+    NormalsPass(harness.sources()).execute(frame);
+}
+
 TEST(SurfacePassesGLTest, PullPushMatchesToFloatPrecision) {
     PassHarness harness;
     std::vector<float> depth, color;
@@ -461,10 +484,7 @@ TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
 TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
     PassHarness harness;
     std::vector<float> depth, color;
-    runUpToPullPush(harness, depth, color);
-    FrameContext frame = harness.context();
-    FillRemovalPass(harness.sources()).execute(frame);
-    NormalsPass(harness.sources()).execute(frame);
+    runUpToNormals(harness, depth, color);
     const FrameResources& resources = harness.resources();
     const auto push = resources.buffer("pushValues").read<glm::vec4>();
     const auto normals = resources.buffer("normalPyramid").read<glm::vec4>();
@@ -528,10 +548,7 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
 TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
     PassHarness harness;
     std::vector<float> depth, color;
-    runUpToPullPush(harness, depth, color);
-    FrameContext frame = harness.context();
-    FillRemovalPass(harness.sources()).execute(frame);
-    NormalsPass(harness.sources()).execute(frame);
+    runUpToNormals(harness, depth, color);
     const FrameResources& resources = harness.resources();
     const auto pyramid = resources.buffer("normalPyramid").read<glm::vec4>();
     const auto surfaceDepth = resources.texture("surfaceDepth").readFloats();
@@ -549,18 +566,8 @@ TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
             const double level = std::clamp(std::log2(radius * harness.focal() / surfaceDepth[i]),
                                             1.0, static_cast<double>(all.size() - 1));
             auto bilinear = [&](int l) {
-                const Level& lv = all[l];
-                const double u = (x + 0.5) / (1 << l) - 0.5, v = (y + 0.5) / (1 << l) - 0.5;
-                const int bx = static_cast<int>(std::floor(u)),
-                          by = static_cast<int>(std::floor(v));
-                const double tx = u - bx, ty = v - by;
-                auto at = [&](int cx, int cy) {
-                    cx = std::clamp(cx, 0, lv.width - 1);
-                    cy = std::clamp(cy, 0, lv.height - 1);
-                    return glm::dvec3(pyramid[lv.offset + cy * lv.width + cx]);
-                };
-                return (1 - tx) * (1 - ty) * at(bx, by) + tx * (1 - ty) * at(bx + 1, by) +
-                       (1 - tx) * ty * at(bx, by + 1) + tx * ty * at(bx + 1, by + 1);
+                return bilinearOnLevel(all[l], l, x, y,
+                                       [&](int texel) { return glm::dvec3(pyramid[texel]); });
             };
             const int lower = static_cast<int>(level);
             const int upper = std::min(lower + 1, static_cast<int>(all.size() - 1));
@@ -579,10 +586,8 @@ TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
 TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
     PassHarness harness;
     std::vector<float> depth, color;
-    runUpToPullPush(harness, depth, color);
+    runUpToNormals(harness, depth, color);
     FrameContext frame = harness.context();
-    FillRemovalPass(harness.sources()).execute(frame);
-    NormalsPass(harness.sources()).execute(frame);
     ShadePass(harness.sources()).execute(frame);
     const FrameResources& resources = harness.resources();
     const auto surfaceDepth = resources.texture("surfaceDepth").readFloats();

@@ -54,6 +54,13 @@ LoadedScan decode(std::string_view bytes, std::string_view fileName) {
     return decodeScan(asBytes(bytes), detectFormat(asBytes(bytes), fileName));
 }
 
+void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, double z) {
+    const glm::dvec3 p = cloud.fileCoordinates(i);
+    EXPECT_NEAR(p.x, x, 2e-6) << "point " << i;
+    EXPECT_NEAR(p.y, y, 2e-6) << "point " << i;
+    EXPECT_NEAR(p.z, z, 2e-6) << "point " << i;
+}
+
 std::string decodeError(std::string_view bytes, std::string_view fileName) {
     try {
         decode(bytes, fileName);

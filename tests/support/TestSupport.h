@@ -55,6 +55,10 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
 /// or nullopt when it is absent (tests then GTEST_SKIP with a visible message).
 std::optional<std::filesystem::path> testDataDirectory();
 
+/// Expects point i of `cloud` at (x, y, z) in file coordinates. Positions are floats relative to
+/// the cloud's centre; the test clouds span less than 10 units, where float steps are ~1e-6.
+void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, double z);
+
 /// Appends the bytes of `value` in little- or big-endian order.
 template <class T>
 void appendBytes(std::string& out, T value, bool bigEndian = false) {

@@ -12,17 +12,8 @@ namespace {
 using test::appendBytes;
 using test::decode;
 using test::decodeError;
+using test::expectPosition;
 using ::testing::HasSubstr;
-
-/// Exact binary values are compared exactly: floats survive the float -> double -> float trip.
-void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, double z) {
-    const glm::dvec3 p = cloud.fileCoordinates(i);
-    // Positions are floats relative to the cloud centre; clouds here span < 10 units, so
-    // float steps near 10 bound the error (about 1e-6).
-    EXPECT_NEAR(p.x, x, 2e-6) << "point " << i;
-    EXPECT_NEAR(p.y, y, 2e-6) << "point " << i;
-    EXPECT_NEAR(p.z, z, 2e-6) << "point " << i;
-}
 
 std::string binaryHeader(const char* encoding, const std::string& body) {
     return std::string("ply\nformat ") + encoding + " 1.0\n" + body + "end_header\n";

@@ -20,19 +20,11 @@ namespace {
 using test::asBytes;
 using test::decode;
 using test::decodeError;
+using test::expectPosition;
 using ::testing::Contains;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
-
-void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, double z) {
-    const glm::dvec3 p = cloud.fileCoordinates(i);
-    // Positions are floats relative to the cloud centre; clouds here span < 10 units, so
-    // float steps near 10 bound the error (about 1e-6).
-    EXPECT_NEAR(p.x, x, 2e-6) << "point " << i;
-    EXPECT_NEAR(p.y, y, 2e-6) << "point " << i;
-    EXPECT_NEAR(p.z, z, 2e-6) << "point " << i;
-}
 
 TEST(XyzReaderTest, ThreeColumnsWithAnySeparatorsCrLfBlankLinesAndNoFinalNewline) {
     const std::string file =
