@@ -1,7 +1,6 @@
 // Renders the README's figures: the stages of the surface pipeline side by side (like the
 // paper's Figure 2) and a points/surface comparison. Run by scripts/make-figures.sh.
-//   subscan_figures stages SCAN OUT.png [--yaw D --pitch D --size W H]
-//   subscan_figures compare SCAN OUT.png [--yaw D --pitch D --size W H]
+//   subscan_figures stages|compare SCAN OUT.png [--yaw D] [--pitch D] [--distance F] [--size W H]
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -44,7 +43,7 @@ int run(int argc, char** argv) {
     if (argc < 4) {
         std::fprintf(stderr,
                      "usage: subscan_figures stages|compare SCAN OUT.png [--yaw D] "
-                     "[--pitch D] [--size W H]\n");
+                     "[--pitch D] [--distance F] [--size W H]\n");
         return 2;
     }
     const std::string_view kind = argv[1];
@@ -56,6 +55,8 @@ int run(int argc, char** argv) {
             orbit.yawDegrees = std::stod(argv[++i]);
         } else if (option == "--pitch" && i + 1 < argc) {
             orbit.pitchDegrees = std::stod(argv[++i]);
+        } else if (option == "--distance" && i + 1 < argc) {
+            orbit.distance = std::stod(argv[++i]);
         } else if (option == "--size" && i + 2 < argc) {
             width = std::stoi(argv[++i]);
             height = std::stoi(argv[++i]);
@@ -67,12 +68,11 @@ int run(int argc, char** argv) {
     std::vector<Panel> panels;
     int columns = 2;
     if (kind == "stages") {
-        panels = {{RenderMode::Points, Stage::Final}, {RenderMode::Surface, Stage::Visibility},
-                  {RenderMode::Surface, Stage::Pull}, {RenderMode::Surface, Stage::Push},
-                  {RenderMode::Surface, Stage::Fill}, {RenderMode::Surface, Stage::Normals},
-                  {RenderMode::Surface, Stage::Final}};
+        panels = {{RenderMode::Points, Stage::Final},     {RenderMode::Surface, Stage::Depth},
+                  {RenderMode::Surface, Stage::Visibility}, {RenderMode::Surface, Stage::Pull},
+                  {RenderMode::Surface, Stage::Push},       {RenderMode::Surface, Stage::Fill},
+                  {RenderMode::Surface, Stage::Normals},    {RenderMode::Surface, Stage::Final}};
         columns = 4;
-        panels.insert(panels.begin() + 4, {RenderMode::Surface, Stage::Depth});
     } else if (kind == "compare") {
         panels = {{RenderMode::Points, Stage::Final},
                   {RenderMode::Splats, Stage::Final},
