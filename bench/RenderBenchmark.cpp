@@ -26,16 +26,16 @@ std::filesystem::path dataDirectory() {
     return std::filesystem::path(SUBSCAN_SOURCE_DIR) / ".." / "shared" / "data";
 }
 
-/// One context and one uploaded cloud per source for the whole run.
+/// One uploaded cloud per source for the whole run.
 struct Fixture {
-    std::unique_ptr<GlContext> context;
     LoadedScan scan;
     std::unique_ptr<Renderer> renderer;
 };
 
 Fixture& fixture(const std::string& source) {
-    static std::map<std::string, Fixture> fixtures;
+    // The context is declared first so that it is destroyed last, after the renderers' GL objects.
     static std::unique_ptr<GlContext> context = createHeadlessContext();
+    static std::map<std::string, Fixture> fixtures;
     auto found = fixtures.find(source);
     if (found == fixtures.end()) {
         Fixture created;
