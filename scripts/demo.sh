@@ -10,5 +10,5 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build --target subscan >&2
 
 mkdir -p out
-build/src/subscan render synthetic:sculpture --mode surface -o out/demo.png --width 1280 --height 720 >&2
+build/src/subscan render synthetic:sculpture --mode sss --material marble-jimenez -o out/demo.png --width 1280 --height 720 >&2
 echo "$(pwd)/out/demo.png"

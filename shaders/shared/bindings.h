@@ -110,7 +110,16 @@ struct ShadeParams {
     uvec4 lightCount;  // x: how many of the directional lights are used
 };
 
+// SubsurfaceScattering: one dispatch of the blur chain (DESIGN.md §6.1).
+struct ScatterParams {
+    vec4 blur;    // x: standard deviation in scene units, y: most taps on each side,
+                  // z: 1 for the vertical pass, 0 for the horizontal one
+    vec4 weight;  // rgb: weight of the Gaussian this dispatch finishes (or starts, when unblurred)
+    uvec4 albedo; // x: where the albedo enters: 0 before the blur, 1 after it, 2 split (sqrt both)
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(ScatterParams) == 48);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
 static_assert(sizeof(SurfaceParams) == 64);
 static_assert(sizeof(ShadeParams) == 3 * 16 + 2 * SUBSCAN_MAX_LIGHTS * 16 + 16);

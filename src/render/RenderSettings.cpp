@@ -17,10 +17,9 @@ namespace subscan {
 namespace {
 
 constexpr std::pair<RenderMode, std::string_view> kModes[] = {
-    {RenderMode::Points, "points"},
-    {RenderMode::PointsGl, "points-gl"},
-    {RenderMode::Splats, "splats"},
-    {RenderMode::Surface, "surface"},
+    {RenderMode::Points, "points"}, {RenderMode::PointsGl, "points-gl"},
+    {RenderMode::Splats, "splats"}, {RenderMode::Surface, "surface"},
+    {RenderMode::Sss, "sss"},
 };
 constexpr std::pair<RasterPath, std::string_view> kPaths[] = {
     {RasterPath::Auto, "auto"},
@@ -40,60 +39,25 @@ constexpr std::pair<Stage, std::string_view> kStages[] = {
     {Stage::Shaded, "shaded"},
 };
 
-template <class Enum, std::size_t N>
-std::string nameOf(const std::pair<Enum, std::string_view> (&table)[N], Enum value) {
-    for (const auto& [candidate, name] : table) {
-        if (candidate == value) {
-            return std::string(name);
-        }
-    }
-    return "?";
-}
-
-template <class Enum, std::size_t N>
-Enum parse(const std::pair<Enum, std::string_view> (&table)[N], std::string_view text,
-           std::string_view what) {
-    std::string allowed;
-    for (const auto& [value, name] : table) {
-        if (name == text) {
-            return value;
-        }
-        allowed += allowed.empty() ? "" : ", ";
-        allowed += name;
-    }
-    throw Error(fmt::format("'{}' is not a {} (expected one of: {})", text, what, allowed));
-}
-
-template <class Enum, std::size_t N>
-void readEnum(const nlohmann::json& json, std::string_view key, Enum& value,
-              const std::pair<Enum, std::string_view> (&table)[N], std::string_view what) {
-    if (const auto found = json.find(key); found != json.end()) {
-        if (!found->is_string()) {
-            throw Error(fmt::format("the setting '{}' must be a string", key));
-        }
-        value = parse(table, found->get<std::string>(), what);
-    }
-}
-
 }  // namespace
 
 std::string toString(RenderMode mode) {
     return nameOf(kModes, mode);
 }
 RenderMode parseRenderMode(std::string_view text) {
-    return parse(kModes, text, "render mode");
+    return parseName(kModes, text, "render mode");
 }
 std::string toString(RasterPath path) {
     return nameOf(kPaths, path);
 }
 RasterPath parseRasterPath(std::string_view text) {
-    return parse(kPaths, text, "raster path");
+    return parseName(kPaths, text, "raster path");
 }
 std::string toString(Stage stage) {
     return nameOf(kStages, stage);
 }
 Stage parseStage(std::string_view text) {
-    return parse(kStages, text, "stage");
+    return parseName(kStages, text, "stage");
 }
 
 void to_json(nlohmann::json& json, const RasterSettings& settings) {
@@ -120,7 +84,11 @@ void from_json(const nlohmann::json& json, RasterSettings& settings) {
 
 void to_json(nlohmann::json& json, const RenderSettings& settings) {
     json = {
-        {"raster", settings.raster}, {"surface", settings.surface}, {"shading", settings.shading}};
+        {"raster", settings.raster},
+        {"surface", settings.surface},
+        {"shading", settings.shading},
+        {"scattering", settings.scattering},
+    };
 }
 
 void from_json(const nlohmann::json& json, RenderSettings& settings) {
@@ -128,16 +96,18 @@ void from_json(const nlohmann::json& json, RenderSettings& settings) {
         throw Error("the settings must be a JSON object");
     }
     for (const auto& [key, value] : json.items()) {
-        if (key != "raster" && key != "surface" && key != "shading") {
+        if (key != "raster" && key != "surface" && key != "shading" && key != "scattering") {
             throw Error(
                 fmt::format("unknown settings section '{}' (expected raster, surface, "
-                            "shading)",
+                            "shading, scattering)",
                             key));
         }
     }
     settings.raster = json.value("raster", nlohmann::json::object()).get<RasterSettings>();
     settings.surface = json.value("surface", nlohmann::json::object()).get<SurfaceSettings>();
     settings.shading = json.value("shading", nlohmann::json::object()).get<ShadingSettings>();
+    settings.scattering =
+        json.value("scattering", nlohmann::json::object()).get<ScatteringSettings>();
 }
 
 RenderSettings readSettingsFile(const std::filesystem::path& path) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "gpu/PassTimer.h"
+#include "render/ScatteringSettings.h"
 #include "render/SurfaceSettings.h"
 
 namespace subscan {
@@ -18,6 +19,7 @@ enum class RenderMode {
     PointsGl,  // baseline: GL_POINTS, 1 pixel
     Splats,    // baseline: GL_POINTS of pointSize pixels with depth test (common viewers)
     Surface,   // screen-space reconstruction, shaded
+    Sss,       // the surface with screen-space subsurface scattering
 };
 
 /// An intermediate buffer of the surface pipeline shown instead of the final image (the panels
@@ -40,11 +42,13 @@ struct RasterSettings {
 };
 
 /// Every setting of a frame, one struct per concern; the JSON the CLI's --settings and the
-/// viewer read and write: {"raster": {...}, "surface": {...}, "shading": {...}}.
+/// viewer read and write: {"raster": {...}, "surface": {...}, "shading": {...},
+/// "scattering": {...}}.
 struct RenderSettings {
     RasterSettings raster;
     SurfaceSettings surface;
     ShadingSettings shading;
+    ScatteringSettings scattering;
 };
 
 /// The settings file the CLI (--settings) and the viewer share; throws subscan::Error naming the

@@ -17,6 +17,7 @@
 #include "render/RasterizePointsPass.h"
 #include "render/ShadePass.h"
 #include "render/StageViewPass.h"
+#include "render/SubsurfaceScatteringPass.h"
 
 namespace subscan {
 
@@ -67,7 +68,8 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
         passes.push_back(&cached(rasterize_, sources_, capabilities()));
     }
     const bool stageView = raster.stage != Stage::Final && raster.stage != Stage::Shaded;
-    if (raster.mode == RenderMode::Surface) {
+    const bool surface = raster.mode == RenderMode::Surface || raster.mode == RenderMode::Sss;
+    if (surface) {
         passes.push_back(&cached(minDepthPyramid_, sources_));
         passes.push_back(&cached(hiddenPointRemoval_, sources_));
         passes.push_back(&cached(pullPush_, sources_));
@@ -75,13 +77,16 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
         passes.push_back(&cached(normals_, sources_));
         passes.push_back(&cached(shade_, sources_));
     } else if (stageView && raster.stage != Stage::Depth) {
-        throw Error(
-            fmt::format("the stage '{}' exists only in surface mode", toString(raster.stage)));
+        throw Error(fmt::format("the stage '{}' exists only in the surface and sss modes",
+                                toString(raster.stage)));
     }
     if (stageView) {
         passes.push_back(&cached(stageViews_[raster.stage], sources_, raster.stage));
         passes.push_back(&present("stage", ""));
-    } else if (raster.mode == RenderMode::Surface) {
+    } else if (raster.mode == RenderMode::Sss && raster.stage == Stage::Final) {
+        passes.push_back(&cached(subsurfaceScattering_, sources_));
+        passes.push_back(&present("scatteredRadiance", "surfaceDepth"));
+    } else if (surface) {
         passes.push_back(&present("radiance", "surfaceDepth"));
     } else {
         passes.push_back(&present("color", "depth"));

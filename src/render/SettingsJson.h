@@ -1,7 +1,9 @@
 #pragma once
 
 #include <array>
+#include <string>
 #include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 #include <glm/vec3.hpp>
@@ -62,6 +64,43 @@ inline void readSetting(const nlohmann::json& json, std::string_view key, glm::v
         }
     }
     value = {read[0], read[1], read[2]};
+}
+
+/// Enum <-> name tables: {value, "name"} pairs, the names as the CLI and JSON spell them.
+template <class Enum, std::size_t N>
+std::string nameOf(const std::pair<Enum, std::string_view> (&table)[N], Enum value) {
+    for (const auto& [candidate, name] : table) {
+        if (candidate == value) {
+            return std::string(name);
+        }
+    }
+    return "?";
+}
+
+/// Throws subscan::Error listing the allowed names.
+template <class Enum, std::size_t N>
+Enum parseName(const std::pair<Enum, std::string_view> (&table)[N], std::string_view text,
+               std::string_view what) {
+    std::string allowed;
+    for (const auto& [value, name] : table) {
+        if (name == text) {
+            return value;
+        }
+        allowed += allowed.empty() ? "" : ", ";
+        allowed += name;
+    }
+    throw Error(fmt::format("'{}' is not a {} (expected one of: {})", text, what, allowed));
+}
+
+template <class Enum, std::size_t N>
+void readEnum(const nlohmann::json& json, std::string_view key, Enum& value,
+              const std::pair<Enum, std::string_view> (&table)[N], std::string_view what) {
+    if (const auto found = json.find(key); found != json.end()) {
+        if (!found->is_string()) {
+            throw Error(fmt::format("the setting '{}' must be a string", key));
+        }
+        value = parseName(table, found->get<std::string>(), what);
+    }
 }
 
 inline nlohmann::json toJson(const glm::vec3& value) {

@@ -117,7 +117,7 @@ PointCloud testCloud(const Camera& camera, std::uint32_t seed) {
     return builder.finish(warnings);
 }
 
-void expectMatchesReference(Renderer& renderer, const PointCloud& cloud, const Camera& camera,
+void expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
                             const Reference& reference) {
     const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners();
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
@@ -162,7 +162,7 @@ TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
             RenderSettings settings;
             settings.raster.path = path;
             renderer.render(camera, settings);
-            expectMatchesReference(renderer, cloud, camera, reference);
+            expectMatchesReference(renderer, cloud, reference);
         }
     }
 }

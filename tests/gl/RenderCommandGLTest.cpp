@@ -196,11 +196,12 @@ TEST(RenderCommandGLTest, FarFromTheOriginRendersLikeAtTheOrigin) {
 
 TEST(RenderCommandGLTest, EveryModeDrawsTheObject) {
     const test::TempDir dir;
-    for (const char* mode : {"points", "points-gl", "splats"}) {
+    for (const char* mode : {"points", "points-gl", "splats", "surface", "sss"}) {
         const auto out = dir / (std::string(mode) + ".png");
         const auto result =
             runSubscan({"render", "synthetic:sphere?points=3000", "-o", out.string(), "--mode",
-                        mode, "--width", "64", "--height", "48", "--background", "#000000"});
+                        mode, "--width", "64", "--height", "48", "--background", "#000000",
+                        "--material", "skin-deon", "--unit", "cm"});
         ASSERT_EQ(result.exitCode, 0) << mode << ": " << result.err;
         const Image8 image = readPng(out);
         int lit = 0;
@@ -240,6 +241,10 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
          "outside what the GPU can render"},
         {{"render", scan.string(), "-o", out.string(), "--width", "0"}, {}, 2, ""},
         {{"render", scan.string(), "-o", out.string(), "--mode", "voxels"}, {}, 2, ""},
+        {{"render", scan.string(), "-o", out.string(), "--mode", "sss", "--material", "jade"},
+         {},
+         1,
+         "there is no material 'jade'"},
         // glvnd finds no EGL vendor: what a machine without any OpenGL driver looks like.
         {{"render", scan.string(), "-o", out.string()},
          {"__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl.json",

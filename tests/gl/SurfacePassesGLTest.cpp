@@ -23,6 +23,7 @@
 #include "render/PullPushPass.h"
 #include "render/ShadePass.h"
 #include "support/GlTestSupport.h"
+#include "support/PassHarness.h"
 
 namespace subscan {
 namespace {
@@ -65,52 +66,21 @@ auto bilinearOnLevel(const Level& level, int l, int x, int y, Fetch fetch) {
            (1 - tx) * ty * at(bx, by + 1) + tx * ty * at(bx + 1, by + 1);
 }
 
-/// A frame of the pipeline outside the Renderer: uniforms, resources and a context for passes.
-class PassHarness {
-  public:
-    PassHarness() : cloud_(dummyCloud(), test::glTestContext().capabilities()) {
-        camera_.width = kWidth;
-        camera_.height = kHeight;
-        camera_.fovyDegrees = 50.0;
-        camera_.nearPlane = 0.1;
-        camera_.farPlane = 100.0;
-        // A threshold amid the many mean omegas of this frame (0.6..0.9), so that a formula
-        // error flips flags instead of hiding between the two clusters.
-        settings_.surface.visibilityThreshold = 0.7f;
-        // Fewer than 8 directions, so the count itself is tested, not only "all".
-        settings_.surface.fillDirections = 7;
-        layout_ = uniforms_.update(camera_, settings_, kSpacing, cloud_.origin());
-    }
+using test::PassHarness;
 
-    FrameContext context() {
-        return {camera_,    cloud_,  settings_, test::glTestContext().capabilities(),
-                resources_, layout_, kSpacing};
-    }
-    FrameResources& resources() { return resources_; }
-    const Camera& camera() const { return camera_; }
-    const RenderSettings& settings() const { return settings_; }
-    const ShaderSources& sources() const { return sources_; }
-    double focal() const { return camera_.focalLengthPixels(); }
+// h: HPR looks up to ~log2(4 * 0.4 * 24.7 / 5) = 3 levels at depth 5.
+constexpr double kSpacing = 0.4;
 
-    // h: HPR looks up to ~log2(4 * 0.4 * 24.7 / 5) = 3 levels at depth 5.
-    static constexpr double kSpacing = 0.4;
-
-  private:
-    static PointCloud dummyCloud() {
-        PointCloudBuilder builder({}, 1);
-        builder.add({});
-        std::vector<std::string> warnings;
-        return builder.finish(warnings);
-    }
-
-    Camera camera_;
-    RenderSettings settings_;
-    GpuPointCloud cloud_;
-    FrameUniforms uniforms_;
-    gpu::PyramidLayout layout_{};
-    FrameResources resources_;
-    ShaderSources sources_;
-};
+/// The 37x23 frame of these tests.
+PassHarness makeHarness() {
+    RenderSettings settings;
+    // A threshold amid the many mean omegas of this frame (0.6..0.9), so that a formula
+    // error flips flags instead of hiding between the two clusters.
+    settings.surface.visibilityThreshold = 0.7f;
+    // Fewer than 8 directions, so the count itself is tested, not only "all".
+    settings.surface.fillDirections = 7;
+    return PassHarness(kWidth, kHeight, settings, kSpacing);
+}
 
 /// Depth: a curved surface at 4..6 with holes (+inf) and a few far "back" points showing
 /// through; colour random.
@@ -139,11 +109,6 @@ void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<f
     FrameResources& resources = harness.resources();
     resources.ensureTexture("depth", TextureFormat::R32F, kWidth, kHeight).uploadFloats(depth);
     resources.ensureTexture("color", TextureFormat::RGBA16F, kWidth, kHeight).uploadFloats(color);
-}
-
-glm::dvec3 viewPosition(const PassHarness& harness, double wx, double wy, double depth) {
-    const double f = harness.focal();
-    return {(wx - 0.5 * kWidth) * depth / f, (0.5 * kHeight - wy) * depth / f, -depth};
 }
 
 std::vector<double> cpuPyramid(const std::vector<float>& depth) {
@@ -175,7 +140,7 @@ std::vector<double> cpuPyramid(const std::vector<float>& depth) {
 }
 
 TEST(SurfacePassesGLTest, MinDepthPyramidIsExact) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     uploadInputs(harness, depth, color);
     MinDepthPyramidPass pass(harness.sources());
@@ -201,11 +166,11 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     const SurfaceSettings& surface = harness.settings().surface;
     const double tau = surface.visibilityThreshold;
     constexpr double kTie = 1e-4;  // float evaluation of omega differs from double by ~1e-6
-    const glm::dvec3 x = viewPosition(harness, px + 0.5, py + 0.5, depth);
+    const glm::dvec3 x = harness.viewPosition(px + 0.5, py + 0.5, depth);
     const glm::dvec3 toCamera = glm::normalize(-x);
-    const double levelValue = std::clamp(
-        std::log2(surface.visibilityRadius * PassHarness::kSpacing * harness.focal() / depth), 0.0,
-        static_cast<double>(all.size() - 1));
+    const double levelValue =
+        std::clamp(std::log2(surface.visibilityRadius * kSpacing * harness.focal() / depth), 0.0,
+                   static_cast<double>(all.size() - 1));
     if (std::abs(levelValue - std::round(levelValue)) < kTie) {
         return std::nullopt;
     }
@@ -229,7 +194,7 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
                 continue;
             }
             const double scale = 1 << l;
-            const glm::dvec3 y = viewPosition(harness, (qx + 0.5) * scale, (qy + 0.5) * scale, d);
+            const glm::dvec3 y = harness.viewPosition((qx + 0.5) * scale, (qy + 0.5) * scale, d);
             const double value = 1.0 - glm::dot(glm::normalize(y - x), toCamera);
             smallest = found ? std::min(smallest, value) : value;
             found = true;
@@ -256,7 +221,7 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
 }
 
 TEST(SurfacePassesGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     uploadInputs(harness, depth, color);
     FrameContext frame = harness.context();
@@ -392,7 +357,7 @@ void runUpToNormals(PassHarness& harness, std::vector<float>& depth, std::vector
 }
 
 TEST(SurfacePassesGLTest, PullPushMatchesToFloatPrecision) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     runUpToPullPush(harness, depth, color);
     const FrameResources& resources = harness.resources();
@@ -425,7 +390,7 @@ TEST(SurfacePassesGLTest, PullPushMatchesToFloatPrecision) {
 }
 
 TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     runUpToPullPush(harness, depth, color);
     FrameContext frame = harness.context();
@@ -445,8 +410,8 @@ TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
             const int i = y * kWidth + x;
             bool expected = weights[i] > 0.0f;  // a visible point of its own
             if (!expected) {
-                const double raw = std::log2(surface.fillRadius * PassHarness::kSpacing *
-                                             harness.focal() / filled[i]);
+                const double raw =
+                    std::log2(surface.fillRadius * kSpacing * harness.focal() / filled[i]);
                 const double level = std::clamp(raw, 1.0, static_cast<double>(all.size() - 1));
                 // float vs double: an unclamped level this close to an integer may round up
                 // either way.
@@ -482,7 +447,7 @@ TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
 }
 
 TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     runUpToNormals(harness, depth, color);
     const FrameResources& resources = harness.resources();
@@ -496,8 +461,8 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
         const Level& level = all[l];
         const double scale = 1 << l;
         auto position = [&](int x, int y) {
-            return viewPosition(harness, (x + 0.5) * scale, (y + 0.5) * scale,
-                                push[level.offset + y * level.width + x].x);
+            return harness.viewPosition((x + 0.5) * scale, (y + 0.5) * scale,
+                                        push[level.offset + y * level.width + x].x);
         };
         for (int y = 0; y < level.height; ++y) {
             for (int x = 0; x < level.width; ++x) {
@@ -546,7 +511,7 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
 }
 
 TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     runUpToNormals(harness, depth, color);
     const FrameResources& resources = harness.resources();
@@ -554,7 +519,7 @@ TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
     const auto surfaceDepth = resources.texture("surfaceDepth").readFloats();
     const auto normals = resources.texture("normals").readFloats();
     const auto all = levels();
-    const double radius = harness.settings().surface.normalRadius * PassHarness::kSpacing;
+    const double radius = harness.settings().surface.normalRadius * kSpacing;
     int checked = 0;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
@@ -584,7 +549,7 @@ TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
 }
 
 TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
-    PassHarness harness;
+    PassHarness harness = makeHarness();
     std::vector<float> depth, color;
     runUpToNormals(harness, depth, color);
     FrameContext frame = harness.context();
@@ -604,7 +569,7 @@ TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
                 continue;
             }
             const glm::dvec3 toEye =
-                glm::normalize(-viewPosition(harness, x + 0.5, y + 0.5, surfaceDepth[i]));
+                glm::normalize(-harness.viewPosition(x + 0.5, y + 0.5, surfaceDepth[i]));
             const glm::dvec3 n(normals[4 * i], normals[4 * i + 1], normals[4 * i + 2]);
             // Head light only (no directional lights in the defaults): L = V, so H = V too.
             const double cosine = std::max(0.0, glm::dot(n, toEye));

@@ -17,6 +17,7 @@
 #include "io/Image.h"
 #include "render/RenderSettings.h"
 #include "render/Renderer.h"
+#include "sss/MaterialLibrary.h"
 
 namespace subscan::cli {
 
@@ -39,6 +40,10 @@ struct RenderOptions {
     std::string exportDirectory;
     std::string raster;
     std::string stage;
+    std::string material;
+    std::string unit;
+    std::optional<float> sssScale;
+    std::string albedo;
     std::string settingsFile;
     std::string saveSettingsFile;
     bool timings = false;
@@ -105,8 +110,9 @@ ImageF channelsOf(const Texture& texture, int channels) {
     return image;
 }
 
-/// camera.json, depth.pfm and color.png always; in surface mode also normals.pfm, mask.png and
-/// radiance.pfm, with depth.pfm holding the reconstructed depth (+inf outside the mask).
+/// camera.json, depth.pfm and color.png always; in the surface and sss modes also normals.pfm,
+/// mask.png and radiance.pfm (after scattering in sss mode), with depth.pfm holding the
+/// reconstructed depth (+inf outside the mask).
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
                    const Camera& camera, RenderMode mode) {
     std::error_code error;
@@ -116,7 +122,7 @@ void exportBuffers(const std::filesystem::path& directory, const Renderer& rende
                                 error.message()));
     }
     const FrameResources& resources = renderer.resources();
-    const bool surface = mode == RenderMode::Surface;
+    const bool surface = mode == RenderMode::Surface || mode == RenderMode::Sss;
     writeCameraFile(directory / "camera.json", camera);
     const Texture& depthTexture = resources.texture(surface ? "surfaceDepth" : "depth");
     const std::vector<float> depth = depthTexture.readFloats();
@@ -136,7 +142,9 @@ void exportBuffers(const std::filesystem::path& directory, const Renderer& rende
         return;
     }
     writePfm(directory / "normals.pfm", channelsOf(resources.texture("normals"), 3));
-    writePfm(directory / "radiance.pfm", channelsOf(resources.texture("radiance"), 3));
+    const bool scattered = mode == RenderMode::Sss && resources.has("scatteredRadiance");
+    writePfm(directory / "radiance.pfm",
+             channelsOf(resources.texture(scattered ? "scatteredRadiance" : "radiance"), 3));
     Image8 mask{camera.width, camera.height, 1, std::vector<std::uint8_t>(depth.size())};
     for (std::size_t pixel = 0; pixel < depth.size(); ++pixel) {
         mask.pixels[pixel] = std::isinf(depth[pixel]) ? 0 : 255;
@@ -170,6 +178,19 @@ int runRender(const RenderOptions& options) {
     }
     if (!options.background.empty()) {
         raster.backgroundSrgb = parseBackground(options.background);
+    }
+    ScatteringSettings& scattering = settings.scattering;
+    if (!options.material.empty()) {
+        scattering.material = findMaterial(options.material).name;
+    }
+    if (!options.unit.empty()) {
+        scattering.unit = parseSceneUnit(options.unit);
+    }
+    if (options.sssScale) {
+        scattering.scale = *options.sssScale;
+    }
+    if (!options.albedo.empty()) {
+        scattering.albedo = parseAlbedoPlacement(options.albedo);
     }
     if (!options.saveSettingsFile.empty()) {
         writeSettingsFile(options.saveSettingsFile, settings);
@@ -231,14 +252,26 @@ Command addRenderCommand(CLI::App& parent) {
         ->check(CLI::Range(1, 65536));
     render->add_option("--height", options->height, "Image height in pixels")
         ->check(CLI::Range(1, 65536));
-    render->add_option("--mode", options->mode, "points (default) | points-gl | splats | surface")
-        ->check(CLI::IsMember({"points", "points-gl", "splats", "surface"}));
+    render
+        ->add_option("--mode", options->mode,
+                     "points (default) | points-gl | splats | surface | sss (surface with "
+                     "subsurface scattering)")
+        ->check(CLI::IsMember({"points", "points-gl", "splats", "surface", "sss"}));
     render
         ->add_option("--stage", options->stage,
                      "Show an intermediate: depth | pyramid | visibility | pull | push | fill | "
-                     "normals | shaded (surface mode; depth in any)")
+                     "normals | shaded (surface and sss modes; depth in any)")
         ->check(CLI::IsMember({"final", "depth", "pyramid", "visibility", "pull", "push", "fill",
                                "normals", "shaded"}));
+    render->add_option("--material", options->material,
+                       "Translucent material of the sss mode (see `subscan materials`)");
+    render->add_option("--unit", options->unit, "Length unit of the scan: mm | cm | m | in")
+        ->check(CLI::IsMember({"mm", "cm", "m", "in"}));
+    render->add_option("--sss-scale", options->sssScale, "Multiplies every scattering radius")
+        ->check(CLI::Range(0.0f, 1000.0f));
+    render->add_option("--albedo", options->albedo,
+                       "Where the colour enters the scattering: pre | post | split")
+        ->check(CLI::IsMember({"pre", "post", "split"}));
     render->add_option("--point-size", options->pointSize, "Splat size in pixels (splats mode)")
         ->check(CLI::Range(1.0f, 64.0f));
     render->add_option("--yaw", options->yaw, "Orbit angle around the up axis, degrees");
@@ -261,7 +294,8 @@ Command addRenderCommand(CLI::App& parent) {
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
     render
         ->add_option("--settings", options->settingsFile,
-                     "Settings JSON ({\"raster\", \"surface\", \"shading\"}); options given "
+                     "Settings JSON ({\"raster\", \"surface\", \"shading\", \"scattering\"}); "
+                     "options given "
                      "here override it")
         ->check(CLI::ExistingFile);
     render->add_option("--save-settings", options->saveSettingsFile,

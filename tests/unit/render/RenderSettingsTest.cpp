@@ -56,6 +56,34 @@ TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
     EXPECT_THROW(readSettingsFile(unknown), Error);
 }
 
+TEST(RenderSettingsTest, ScatteringSettingsRoundTripAndCheckTheMaterial) {
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Sss;
+    settings.scattering.material = "skin-deon";
+    settings.scattering.unit = SceneUnit::Inch;
+    settings.scattering.scale = 2.5f;
+    settings.scattering.albedo = AlbedoPlacement::PreScatter;
+    settings.scattering.maxTaps = 9;
+    const RenderSettings back = nlohmann::json(settings).get<RenderSettings>();
+    EXPECT_EQ(back.raster.mode, RenderMode::Sss);
+    EXPECT_EQ(back.scattering.material, "skin-deon");
+    EXPECT_EQ(back.scattering.unit, SceneUnit::Inch);
+    EXPECT_EQ(back.scattering.scale, 2.5f);
+    EXPECT_EQ(back.scattering.albedo, AlbedoPlacement::PreScatter);
+    EXPECT_EQ(back.scattering.maxTaps, 9);
+    try {
+        nlohmann::json({{"material", "jade"}}).get<ScatteringSettings>();
+        FAIL() << "accepted an unknown material";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("no material 'jade'"));
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("marble-jimenez"));
+    }
+    EXPECT_THROW(nlohmann::json({{"unit", "furlong"}}).get<ScatteringSettings>(), Error);
+    EXPECT_THROW(nlohmann::json({{"scale", -1}}).get<ScatteringSettings>(), Error);
+    EXPECT_DOUBLE_EQ(millimetresPerUnit(SceneUnit::Inch), 25.4);
+    EXPECT_DOUBLE_EQ(millimetresPerUnit(SceneUnit::Metre), 1000.0);
+}
+
 TEST(RenderSettingsTest, BadValuesAreNamed) {
     EXPECT_THROW(nlohmann::json({{"mode", "voxels"}}).get<RasterSettings>(), Error);
     EXPECT_THROW(nlohmann::json({{"point_size", 0}}).get<RasterSettings>(), Error);

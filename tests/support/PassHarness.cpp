@@ -1,0 +1,46 @@
+#include "support/PassHarness.h"
+
+#include <string>
+#include <vector>
+
+#include "support/GlTestSupport.h"
+
+namespace subscan::test {
+
+namespace {
+
+/// Passes after the rasterizer never read the cloud, but the frame context holds one.
+PointCloud onePointCloud() {
+    PointCloudBuilder builder({}, 1);
+    builder.add({});
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
+}  // namespace
+
+PassHarness::PassHarness(int width, int height, const RenderSettings& settings, double spacing,
+                         double fovyDegrees)
+    : settings_(settings),
+      spacing_(spacing),
+      cloud_(onePointCloud(), glTestContext().capabilities()) {
+    camera_.width = width;
+    camera_.height = height;
+    camera_.fovyDegrees = fovyDegrees;
+    camera_.nearPlane = 0.1;
+    camera_.farPlane = 100.0;
+    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_.origin());
+}
+
+FrameContext PassHarness::context() {
+    return {camera_,    cloud_,  settings_, glTestContext().capabilities(),
+            resources_, layout_, spacing_};
+}
+
+glm::dvec3 PassHarness::viewPosition(double wx, double wy, double depth) const {
+    const double f = focal();
+    return {(wx - 0.5 * camera_.width) * depth / f, (0.5 * camera_.height - wy) * depth / f,
+            -depth};
+}
+
+}  // namespace subscan::test

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include "core/Camera.h"
+#include "gpu/ShaderSources.h"
+#include "render/FrameResources.h"
+#include "render/FrameUniforms.h"
+#include "render/GpuPointCloud.h"
+#include "render/RenderPass.h"
+#include "render/RenderSettings.h"
+
+namespace subscan::test {
+
+/// A frame of the pipeline outside the Renderer, for testing one pass on inputs the test
+/// uploads itself: a camera looking down −z, the frame uniforms, named resources and the
+/// context a pass runs with.
+class PassHarness {
+  public:
+    PassHarness(int width, int height, const RenderSettings& settings, double spacing,
+                double fovyDegrees = 50.0);
+
+    FrameContext context();
+    FrameResources& resources() { return resources_; }
+    const Camera& camera() const { return camera_; }
+    const RenderSettings& settings() const { return settings_; }
+    const ShaderSources& sources() const { return sources_; }
+    double focal() const { return camera_.focalLengthPixels(); }
+    double spacing() const { return spacing_; }
+    /// The view-space point seen at window position (wx, wy) (pixel centres at index + 0.5,
+    /// row 0 at the top) at linear depth `depth`: the CPU twin of viewPositionAt in GLSL.
+    glm::dvec3 viewPosition(double wx, double wy, double depth) const;
+
+  private:
+    Camera camera_;
+    RenderSettings settings_;
+    double spacing_;
+    GpuPointCloud cloud_;
+    FrameUniforms uniforms_;
+    gpu::PyramidLayout layout_{};
+    FrameResources resources_;
+    ShaderSources sources_;
+};
+
+}  // namespace subscan::test
