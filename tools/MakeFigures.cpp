@@ -1,6 +1,7 @@
 // Renders the README's figures: the stages of the surface pipeline side by side (like the
-// paper's Figure 2) and a points/surface comparison. Run by scripts/make-figures.sh.
-//   subscan_figures stages|compare SCAN OUT.png [--yaw D] [--pitch D] [--distance F] [--size W H]
+// paper's Figure 2), a points/splats/surface comparison, and the surface beside marble and skin
+// (like the paper's Figure 8). Run by scripts/make-figures.sh.
+//   subscan_figures stages|compare|materials SCAN OUT.png [--yaw D] [--pitch D] [--distance F] [--size W H]
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -19,6 +20,7 @@ namespace {
 struct Panel {
     RenderMode mode;
     Stage stage;
+    std::string material = {};  // sss panels
 };
 
 /// Side-by-side tiles, `columns` per row, separated by a `gap` of background.
@@ -42,7 +44,7 @@ Image8 montage(const std::vector<std::vector<std::uint8_t>>& tiles, int width, i
 int run(int argc, char** argv) {
     if (argc < 4) {
         std::fprintf(stderr,
-                     "usage: subscan_figures stages|compare SCAN OUT.png [--yaw D] "
+                     "usage: subscan_figures stages|compare|materials SCAN OUT.png [--yaw D] "
                      "[--pitch D] [--distance F] [--size W H]\n");
         return 2;
     }
@@ -73,6 +75,11 @@ int run(int argc, char** argv) {
                   {RenderMode::Surface, Stage::Push},       {RenderMode::Surface, Stage::Fill},
                   {RenderMode::Surface, Stage::Normals},    {RenderMode::Surface, Stage::Final}};
         columns = 4;
+    } else if (kind == "materials") {
+        panels = {{RenderMode::Surface, Stage::Final},
+                  {RenderMode::Sss, Stage::Final, "marble-jimenez"},
+                  {RenderMode::Sss, Stage::Final, "skin-jimenez"}};
+        columns = 3;
     } else if (kind == "compare") {
         panels = {{RenderMode::Points, Stage::Final},
                   {RenderMode::Splats, Stage::Final},
@@ -94,6 +101,15 @@ int run(int argc, char** argv) {
         settings.raster.stage = panel.stage;
         settings.raster.pointSize = 3.0f;
         settings.raster.backgroundSrgb = glm::vec3(0.12f);
+        if (kind == "materials") {
+            // A key light from the upper left besides the head light: translucency shows where
+            // light and shadow meet.
+            settings.shading.headLight = glm::vec3(0.35f);
+            settings.shading.lights.push_back({{-1.0f, 1.0f, 0.6f}, glm::vec3(0.9f)});
+        }
+        if (!panel.material.empty()) {
+            settings.scattering.material = panel.material;
+        }
         renderer.render(camera, settings);
         tiles.push_back(renderer.readImage());
     }
