@@ -86,9 +86,11 @@ const std::string kLarge = "synthetic:sculpture?points=3400000";
 SUBSCAN_RENDER_BENCHMARK(happy_points_compute, kHappy, RenderMode::Points);
 SUBSCAN_RENDER_BENCHMARK(happy_points_gl, kHappy, RenderMode::PointsGl);
 SUBSCAN_RENDER_BENCHMARK(happy_surface, kHappy, RenderMode::Surface);
+SUBSCAN_RENDER_BENCHMARK(happy_sss, kHappy, RenderMode::Sss);
 SUBSCAN_RENDER_BENCHMARK(sculpture3M4_points_compute, kLarge, RenderMode::Points);
 SUBSCAN_RENDER_BENCHMARK(sculpture3M4_points_gl, kLarge, RenderMode::PointsGl);
 SUBSCAN_RENDER_BENCHMARK(sculpture3M4_surface, kLarge, RenderMode::Surface);
+SUBSCAN_RENDER_BENCHMARK(sculpture3M4_sss, kLarge, RenderMode::Sss);
 
 }  // namespace
 }  // namespace subscan

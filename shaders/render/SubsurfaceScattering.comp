@@ -55,50 +55,51 @@ void main() {
     }
     float depth = imageLoad(inSurfaceDepth, pixel).r;
     bool surface = !isinf(depth);
-#if STAGE_PREPARE
-    vec3 source = vec3(0.0);
-    if (surface) {
-        // "diffuse" is albedo x irradiance; the irradiance is recovered where the albedo is
-        // not zero (where it is, the diffuse light is zero whatever the irradiance).
-        vec3 albedo = imageLoad(inAlbedo, pixel).rgb;
-        vec3 diffuse = imageLoad(inDiffuse, pixel).rgb;
-        vec3 beforeFactor = albedoFactor(albedo, kAlbedoBefore);
-        source = mix(vec3(0.0), diffuse * beforeFactor / max(albedo, vec3(1e-6)),
-                     greaterThan(albedo, vec3(0.0)));
+#if !STAGE_COMBINE
+    // The chain never reads its images outside the surface (taps there are skipped), so
+    // background pixels need no writes: most of a frame costs one load.
+    if (!surface) {
+        return;
     }
+#endif
+#if STAGE_PREPARE
+    // "diffuse" is albedo x irradiance; the irradiance is recovered where the albedo is not
+    // zero (where it is, the diffuse light is zero whatever the irradiance).
+    vec3 albedo = imageLoad(inAlbedo, pixel).rgb;
+    vec3 diffuse = imageLoad(inDiffuse, pixel).rgb;
+    vec3 source =
+        mix(vec3(0.0), diffuse * albedoFactor(albedo, kAlbedoBefore) / max(albedo, vec3(1e-6)),
+            greaterThan(albedo, vec3(0.0)));
     imageStore(outSource, pixel, vec4(source, 1.0));
     imageStore(outSum, pixel, vec4(scatter.weight.rgb * source, 1.0));
 #elif STAGE_BLUR || STAGE_BLUR_ACCUMULATE
-    vec3 blurred = vec3(0.0);
-    if (surface) {
-        float sigma = scatter.blur.x;
-        float sigmaPixels = sigma * frame.depthRange.z / depth;
-        float reach = 3.0 * sigmaPixels;
-        int maxTaps = int(scatter.blur.y);
-        // Every pixel while the kernel fits the tap budget; a larger stride beyond it.
-        int taps = int(min(ceil(reach), float(maxTaps)));
-        float stride = taps > 0 && ceil(reach) > float(maxTaps) ? reach / float(taps) : 1.0;
-        ivec2 axis = scatter.blur.z > 0.5 ? ivec2(0, 1) : ivec2(1, 0);
-        vec3 centre = viewPositionAt(vec2(pixel) + 0.5, depth);
-        float inverseTwoVariance = 1.0 / (2.0 * sigma * sigma);
-        vec3 total = imageLoad(inSource, pixel).rgb;
-        float totalWeight = 1.0;
-        for (int k = -taps; k <= taps; ++k) {
-            ivec2 tap = pixel + axis * int(round(float(k) * stride));
-            if (k == 0 || any(lessThan(tap, ivec2(0))) || any(greaterThanEqual(tap, size))) {
-                continue;
-            }
-            float tapDepth = imageLoad(inSurfaceDepth, tap).r;
-            if (isinf(tapDepth)) {
-                continue;
-            }
-            vec3 offset = viewPositionAt(vec2(tap) + 0.5, tapDepth) - centre;
-            float weight = exp(-dot(offset, offset) * inverseTwoVariance);
-            total += weight * imageLoad(inSource, tap).rgb;
-            totalWeight += weight;
+    float sigma = scatter.blur.x;
+    float sigmaPixels = sigma * frame.depthRange.z / depth;
+    float reach = 3.0 * sigmaPixels;
+    int maxTaps = int(scatter.blur.y);
+    // Every pixel while the kernel fits the tap budget; a larger stride beyond it.
+    int taps = int(min(ceil(reach), float(maxTaps)));
+    float stride = taps > 0 && ceil(reach) > float(maxTaps) ? reach / float(taps) : 1.0;
+    ivec2 axis = scatter.blur.z > 0.5 ? ivec2(0, 1) : ivec2(1, 0);
+    vec3 centre = viewPositionAt(vec2(pixel) + 0.5, depth);
+    float inverseTwoVariance = 1.0 / (2.0 * sigma * sigma);
+    vec3 total = imageLoad(inSource, pixel).rgb;
+    float totalWeight = 1.0;
+    for (int k = -taps; k <= taps; ++k) {
+        ivec2 tap = pixel + axis * int(round(float(k) * stride));
+        if (k == 0 || any(lessThan(tap, ivec2(0))) || any(greaterThanEqual(tap, size))) {
+            continue;
         }
-        blurred = total / totalWeight;
+        float tapDepth = imageLoad(inSurfaceDepth, tap).r;
+        if (isinf(tapDepth)) {
+            continue;
+        }
+        vec3 offset = viewPositionAt(vec2(tap) + 0.5, tapDepth) - centre;
+        float weight = exp(-dot(offset, offset) * inverseTwoVariance);
+        total += weight * imageLoad(inSource, tap).rgb;
+        totalWeight += weight;
     }
+    vec3 blurred = total / totalWeight;
     imageStore(outBlurred, pixel, vec4(blurred, 1.0));
 #if STAGE_BLUR_ACCUMULATE
     vec4 accumulated = imageLoad(sum, pixel);
