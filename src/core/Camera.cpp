@@ -35,10 +35,11 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
     camera.height = height;
     camera.fovyDegrees = fovyDegrees;
 
-    const glm::dvec3 center = bounds.center();
+    const glm::dvec3 middle = bounds.center();
+    const glm::dvec3 center = orbit.center.value_or(middle);
     // A flat or single-point cloud still needs a finite radius to frame.
     const double radius =
-        std::max(0.5 * glm::length(bounds.extent()), 1e-9 * (1.0 + glm::length(center)));
+        std::max(0.5 * glm::length(bounds.extent()), 1e-9 * (1.0 + glm::length(middle)));
     const double halfFovy = 0.5 * glm::radians(fovyDegrees);
     const double halfFovx =
         std::atan(std::tan(halfFovy) * static_cast<double>(width) / static_cast<double>(height));
@@ -65,9 +66,11 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
     }
     camera.view = glm::lookAt(center + distance * direction, center, up);
 
+    // Near and far hug the bounding sphere, wherever the orbited point lies.
+    const double reach = radius + glm::length(center - middle);
     const double margin = 0.02 * radius;
-    camera.farPlane = distance + radius + margin;
-    camera.nearPlane = std::max(distance - radius - margin, 1e-4 * camera.farPlane);
+    camera.farPlane = distance + reach + margin;
+    camera.nearPlane = std::max(distance - reach - margin, 1e-4 * camera.farPlane);
     return camera;
 }
 

@@ -43,6 +43,8 @@ struct OrbitView {
     /// Eye distance from the centre; by default the bounds' sphere fills the view with a margin.
     std::optional<double> distance;
     UpAxis up = UpAxis::Y;
+    /// The point orbited, file coordinates; by default the middle of the bounds.
+    std::optional<glm::dvec3> center;
 };
 
 /// Frames `bounds` as `orbit` says; near and far hug the bounding sphere.

@@ -13,6 +13,7 @@ struct Command {
     std::function<int()> run;
 };
 
+Command addBenchCommand(CLI::App& parent);
 Command addEvalCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addRenderCommand(CLI::App& parent);

@@ -1,0 +1,185 @@
+// `subscan bench SCAN`: the paper's measurement (average and 1 % low FPS while a person turns
+// the scan around) as a repeatable benchmark: every mode replays the same camera path.
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "app/cli/CommandSupport.h"
+#include "app/cli/Commands.h"
+#include "core/CameraPath.h"
+#include "core/Error.h"
+#include "gpu/GlContext.h"
+#include "render/Renderer.h"
+
+namespace subscan::cli {
+
+namespace {
+
+struct BenchOptions {
+    std::string source;
+    int frames = 600;
+    int warmup = 10;
+    int width = 1920;
+    int height = 1080;
+    std::string modes = "points-gl,points,surface,sss";
+    std::string settingsFile;
+    std::string up = "auto";
+    bool json = false;
+    bool software = false;
+};
+
+std::vector<RenderMode> parseModes(const std::string& list) {
+    std::vector<RenderMode> modes;
+    std::stringstream stream(list);
+    std::string name;
+    while (std::getline(stream, name, ',')) {
+        modes.push_back(parseRenderMode(name));
+    }
+    if (modes.empty()) {
+        throw Error("--modes names no render mode");
+    }
+    return modes;
+}
+
+double median(std::vector<double> values) {
+    std::sort(values.begin(), values.end());
+    const std::size_t n = values.size();
+    return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+/// One mode's numbers over the camera path.
+nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSettings settings,
+                         RenderMode mode, const BenchOptions& options, UpAxis up) {
+    settings.raster.mode = mode;
+    settings.raster.stage = Stage::Final;
+    // A renderer of its own, so the memory it reports is this mode's alone.
+    Renderer renderer(context, scan.cloud);
+    auto cameraAt = [&](int frame) {
+        const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
+        return cameraForPose(scan.cloud.bounds, benchmarkPose(t), up, options.width, options.height,
+                             45.0);
+    };
+    for (int frame = 0; frame < options.warmup; ++frame) {
+        renderer.render(cameraAt(frame * options.frames / std::max(options.warmup, 1)), settings);
+    }
+    glFinish();
+    std::vector<double> frameMs;
+    std::map<std::string, std::vector<double>> passMs;
+    for (int frame = 0; frame < options.frames; ++frame) {
+        const auto start = std::chrono::steady_clock::now();
+        const FrameResult result = renderer.render(cameraAt(frame), settings);
+        glFinish();  // a frame is done when its image is: no overlap with the next one
+        frameMs.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count());
+        for (const PassTiming& pass : result.passes) {
+            passMs[pass.pass].push_back(pass.milliseconds);
+        }
+    }
+    const double totalMs = std::accumulate(frameMs.begin(), frameMs.end(), 0.0);
+    std::vector<double> slowest = frameMs;
+    std::sort(slowest.begin(), slowest.end(), std::greater<>());
+    const std::size_t lowCount = (slowest.size() + 99) / 100;  // the slowest 1 %, at least one
+    const double lowMs =
+        std::accumulate(slowest.begin(), slowest.begin() + static_cast<std::ptrdiff_t>(lowCount),
+                        0.0) /
+        static_cast<double>(lowCount);
+    const double averageFps = 1000.0 * static_cast<double>(frameMs.size()) / totalMs;
+    nlohmann::json perPass = nlohmann::json::object();
+    for (const auto& [pass, values] : passMs) {
+        perPass[pass] = median(values);
+    }
+    const std::size_t bytes = renderer.gpuCloud().bytes() + renderer.resources().bytes();
+    return {
+        {"avg_fps", averageFps},
+        {"low1_fps", 1000.0 / lowMs},
+        {"frame_ms_median", median(frameMs)},
+        {"per_pass_ms", perPass},
+        {"points_per_second", averageFps * static_cast<double>(scan.cloud.size())},
+        {"gpu_memory_mb", static_cast<double>(bytes) / (1024.0 * 1024.0)},
+    };
+}
+
+int runBench(const BenchOptions& options) {
+    const std::vector<RenderMode> modes = parseModes(options.modes);
+    RenderSettings settings;
+    if (!options.settingsFile.empty()) {
+        settings = readSettingsFile(options.settingsFile);
+    }
+    const LoadedScan scan = loadScanForCommand(options.source);
+    const UpAxis up =
+        options.up == "z" || (options.up == "auto" && scan.format == "las") ? UpAxis::Z : UpAxis::Y;
+    HeadlessContextOptions contextOptions;
+    contextOptions.preferHardware = !options.software;
+    const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
+
+    nlohmann::json report = {
+        {"renderer", context->capabilities().renderer},
+        {"points", scan.cloud.size()},
+        {"width", options.width},
+        {"height", options.height},
+        {"frames", options.frames},
+        {"modes", nlohmann::json::object()},
+    };
+    for (const RenderMode mode : modes) {
+        if (!options.json) {
+            fmt::print(stderr, "subscan: benchmarking {} ({} frames)\n", toString(mode),
+                       options.frames);
+        }
+        report["modes"][toString(mode)] = benchMode(*context, scan, settings, mode, options, up);
+    }
+    if (options.json) {
+        fmt::print("{}\n", report.dump(2));
+        return 0;
+    }
+    fmt::print("{} | {} points | {}x{} | {} frames\n", report["renderer"].get<std::string>(),
+               scan.cloud.size(), options.width, options.height, options.frames);
+    fmt::print("{:<10} {:>9} {:>9} {:>11} {:>14} {:>8}\n", "mode", "avg fps", "1% low", "median ms",
+               "points/s", "GPU MB");
+    for (const RenderMode mode : modes) {
+        const nlohmann::json& m = report["modes"][toString(mode)];
+        fmt::print("{:<10} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f}\n", toString(mode),
+                   m["avg_fps"].get<double>(), m["low1_fps"].get<double>(),
+                   m["frame_ms_median"].get<double>(), m["points_per_second"].get<double>(),
+                   m["gpu_memory_mb"].get<double>());
+    }
+    return 0;
+}
+
+}  // namespace
+
+Command addBenchCommand(CLI::App& parent) {
+    auto options = std::make_shared<BenchOptions>();
+    CLI::App* bench = parent.add_subcommand(
+        "bench", "Frame times of each render mode along a replayed camera path (headless)");
+    bench->add_option("scan", options->source, "Scan file, or synthetic:NAME")->required();
+    bench->add_option("--frames", options->frames, "Frames per mode (default 600)")
+        ->check(CLI::Range(1, 1000000));
+    bench->add_option("--warmup", options->warmup, "Untimed frames before each mode (default 10)")
+        ->check(CLI::Range(0, 100000));
+    bench->add_option("--width", options->width, "Image width (default 1920)")
+        ->check(CLI::Range(1, 65536));
+    bench->add_option("--height", options->height, "Image height (default 1080)")
+        ->check(CLI::Range(1, 65536));
+    bench->add_option("--modes", options->modes,
+                      "Comma-separated modes (default points-gl,points,surface,sss)");
+    bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
+        ->check(CLI::ExistingFile);
+    bench->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
+        ->check(CLI::IsMember({"auto", "y", "z"}));
+    bench->add_flag("--json", options->json, "Print the results as JSON");
+    bench->add_flag("--software", options->software,
+                    "Use Mesa's software rasterizer even when a GPU exists");
+    return {bench, [options] { return runBench(*options); }};
+}
+
+}  // namespace subscan::cli
