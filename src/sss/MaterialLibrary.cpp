@@ -1,6 +1,9 @@
 #include "sss/MaterialLibrary.h"
 
+#include <string_view>
+
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "core/Error.h"
 
@@ -8,8 +11,33 @@ namespace subscan {
 
 namespace {
 
+/// The 6-Gaussian set stored for a Jensen material by scripts/fit-materials.sh, or an empty set
+/// when there is none yet (the material library test then fails, asking for the script).
+GaussianSet storedFit(std::string_view material) {
+    struct StoredFit {
+        std::string_view material;
+        std::string_view json;  // `subscan fit-profile --json` output
+    };
+    static const std::vector<StoredFit> kStoredFits{
+#include "sss/JensenGaussians.inc"
+    };
+    for (const StoredFit& stored : kStoredFits) {
+        if (stored.material != material) {
+            continue;
+        }
+        const nlohmann::json fit = nlohmann::json::parse(stored.json);
+        GaussianSet set;
+        for (const nlohmann::json& term : fit.at("gaussians")) {
+            set.gaussians.push_back({term.at("variance_mm2").get<double>(),
+                                     term.at("weight").get<std::array<double, 3>>()});
+        }
+        return set;
+    }
+    return {};
+}
+
 /// Jensen et al. 2001's measured materials: σs′ and σa in mm⁻¹ and the total diffuse reflectance
-/// (DESIGN §6.2). Their Gaussian sets, fitted to their dipole profiles, are still to come.
+/// (DESIGN §6.2), each with a set fitted to its dipole profile.
 void appendJensenMaterials(std::vector<Material>& materials) {
     struct Measurement {
         const char* name;
@@ -34,8 +62,12 @@ void appendJensenMaterials(std::vector<Material>& materials) {
     };
     for (const Measurement& measured : kMeasurements) {
         materials.push_back(
-            {measured.name, fmt::format("{}, measured by Jensen et al. 2001", measured.name),
-             measured.eta, measured.sigmaSPrime, measured.sigmaA, measured.rd, GaussianSet{}});
+            {measured.name,
+             fmt::format("{}, measured by Jensen et al. 2001; 6 Gaussians fitted to its dipole "
+                         "profile",
+                         measured.name),
+             measured.eta, measured.sigmaSPrime, measured.sigmaA, measured.rd,
+             storedFit(measured.name)});
     }
 }
 

@@ -14,7 +14,9 @@ struct Command {
 };
 
 Command addEvalCommand(CLI::App& parent);
+Command addFitProfileCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
+Command addMaterialsCommand(CLI::App& parent);
 Command addRenderCommand(CLI::App& parent);
 Command addScanCommand(CLI::App& parent);
 
