@@ -15,7 +15,9 @@ struct Command {
 
 Command addBenchCommand(CLI::App& parent);
 Command addEvalCommand(CLI::App& parent);
+Command addFitProfileCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
+Command addMaterialsCommand(CLI::App& parent);
 Command addRenderCommand(CLI::App& parent);
 Command addScanCommand(CLI::App& parent);
 
