@@ -24,7 +24,8 @@ int run(int argc, char** argv) {
     app.set_version_flag("--version", "subscan 0.1.0");
 
     const std::vector<Command> commands{addInfoCommand(app), addRenderCommand(app),
-                                        addScanCommand(app), addEvalCommand(app)};
+                                        addScanCommand(app), addEvalCommand(app),
+                                        addViewCommand(app)};
 
     try {
         app.parse(argc, argv);
