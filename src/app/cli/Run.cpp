@@ -26,7 +26,7 @@ int run(int argc, char** argv) {
     const std::vector<Command> commands{addInfoCommand(app),      addRenderCommand(app),
                                         addScanCommand(app),      addEvalCommand(app),
                                         addBenchCommand(app),     addMaterialsCommand(app),
-                                        addFitProfileCommand(app)};
+                                        addFitProfileCommand(app), addViewCommand(app)};
 
     try {
         app.parse(argc, argv);

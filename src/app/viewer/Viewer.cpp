@@ -1,0 +1,646 @@
+#include "app/viewer/Viewer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <new>
+#include <utility>
+
+#include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <fmt/format.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "io/CameraJson.h"
+#include "io/Image.h"
+#include "render/Renderer.h"
+
+namespace subscan::viewer {
+
+namespace {
+
+// Two left presses this close in time and space are a double click.
+constexpr double kDoubleClickSeconds = 0.35;
+constexpr double kDoubleClickPixels = 4.0;
+// How far around the cursor a pick or zoom looks for the surface: 1-pixel points leave gaps.
+constexpr int kPickRadiusPixels = 3;
+// Fly speed: crossing the scene's bounding sphere takes 4 s (Shift: 1 s).
+constexpr double kFlyRadiiPerSecond = 0.5;
+constexpr double kFlyShiftFactor = 4.0;
+// A stalled frame (a slow software render) must not turn into a jump.
+constexpr double kMaxFlyStepSeconds = 0.25;
+// Idle: wake up now and then even without events; loading: redraw the progress bar smoothly.
+constexpr double kIdleWaitSeconds = 0.25;
+constexpr double kLoadingWaitSeconds = 1.0 / 30.0;
+// A script's resize waits this long for the window system.
+constexpr double kResizeTimeoutSeconds = 2.0;
+
+template <class... Visitors>
+struct Overloaded : Visitors... {
+    using Visitors::operator()...;
+};
+
+bool sameCamera(const Camera& a, const Camera& b) {
+    return a.width == b.width && a.height == b.height && a.fovyDegrees == b.fovyDegrees &&
+           a.nearPlane == b.nearPlane && a.farPlane == b.farPlane && a.view == b.view;
+}
+
+bool surfaceMode(RenderMode mode) {
+    return mode == RenderMode::Surface || mode == RenderMode::Sss;
+}
+
+/// NAME.png -> NAME.camera.json and the like.
+std::filesystem::path sidecarPath(const std::filesystem::path& image, std::string_view suffix) {
+    std::filesystem::path path = image;
+    path.replace_extension();
+    path += suffix;
+    return path;
+}
+
+WindowOptions windowOptions(const ViewerOptions& options) {
+    WindowOptions window;
+    window.width = options.width;
+    window.height = options.height;
+    window.title = "subscan: " + options.source;
+#ifndef NDEBUG
+    window.debugOutput = true;  // debug builds turn GL errors into errors, as the CLI does
+#endif
+    return window;
+}
+
+}  // namespace
+
+Viewer::Viewer(ViewerOptions options)
+    : options_(std::move(options)),
+      unattended_(!options_.script.empty() || options_.exitAfterFrames.has_value()),
+      context_(windowOptions(options_)),
+      imgui_(context_.window()),
+      settings_(options_.settings),
+      showPanel_(options_.showPanel) {
+    const GlCapabilities& capabilities = context_.capabilities();
+    status_.glRenderer = fmt::format("OpenGL {} | {}", capabilities.version, capabilities.renderer);
+    status_.int64Atomics = capabilities.int64Atomics;
+    installCallbacks();
+}
+
+Viewer::~Viewer() = default;
+
+int Viewer::run() {
+    startLoading(options_.source);
+    lastFrameTime_ = glfwGetTime();
+    for (;;) {
+        waitForEvents();
+        bool exiting = exitRequested_ || glfwWindowShouldClose(context_.window()) == GLFW_TRUE;
+        if (pendingOpen_) {
+            startLoading(*std::exchange(pendingOpen_, std::nullopt));
+        }
+        finishLoading();
+
+        const double now = glfwGetTime();
+        const double seconds = now - lastFrameTime_;
+        lastFrameTime_ = now;
+        const bool showing = renderer_ != nullptr;
+        if (showing && !exiting) {
+            runScript();
+            flyWithKeys(seconds);
+        }
+        exiting = exiting || exitRequested_ ||
+                  (showing && options_.exitAfterFrames && frame_ + 1 >= *options_.exitAfterFrames);
+
+        drawFrame();
+        for (const std::filesystem::path& path : std::exchange(pendingScreenshots_, {})) {
+            writeScreenshot(path);
+        }
+        if (exiting && !options_.screenshotAtExit.empty()) {
+            writeScreenshot(options_.screenshotAtExit);
+        }
+        context_.swapBuffers();
+        if (showing) {
+            ++frame_;
+        }
+        if (exiting) {
+            return 0;
+        }
+    }
+}
+
+// ---- events ----------------------------------------------------------------------------------
+
+Viewer& Viewer::of(GLFWwindow* window) {
+    return *static_cast<Viewer*>(glfwGetWindowUserPointer(window));
+}
+
+void Viewer::installCallbacks() {
+    GLFWwindow* window = context_.window();
+    glfwSetWindowUserPointer(window, this);
+    glfwSetMouseButtonCallback(window, onMouseButton);
+    glfwSetCursorPosCallback(window, onCursorPosition);
+    glfwSetScrollCallback(window, onScroll);
+    glfwSetKeyCallback(window, onKey);
+    glfwSetCharCallback(window, onChar);
+    glfwSetDropCallback(window, onDrop);
+    glfwSetWindowFocusCallback(window, onFocus);
+    glfwSetCursorEnterCallback(window, onCursorEnter);
+}
+
+void Viewer::waitForEvents() {
+    if (loading_) {
+        glfwWaitEventsTimeout(kLoadingWaitSeconds);
+    } else if (unattended_ || flying_ || frameIsStale()) {
+        // A change made while drawing the last frame (the panel, a script) shows at once.
+        glfwPollEvents();
+    } else {
+        glfwWaitEventsTimeout(kIdleWaitSeconds);
+    }
+    // Errors inside callbacks could not cross GLFW's C frames; they surface here.
+    if (callbackError_) {
+        throw Error(*std::exchange(callbackError_, std::nullopt));
+    }
+}
+
+template <class Handler>
+void Viewer::guarded(GLFWwindow* window, Handler&& handler) {
+    Viewer& viewer = of(window);
+    try {
+        handler(viewer);
+    } catch (const std::exception& error) {
+        viewer.callbackError_ = error.what();
+    }
+}
+
+void Viewer::onMouseButton(GLFWwindow* window, int button, int action, int mods) {
+    ImGui_ImplGlfw_MouseButtonCallback(window, button, action, mods);
+    guarded(window, [&](Viewer& viewer) {
+        if (action == GLFW_RELEASE) {
+            viewer.drag_ = DragButton::None;
+            return;
+        }
+        glm::dvec2 cursor;
+        glfwGetCursorPos(window, &cursor.x, &cursor.y);
+        if (action != GLFW_PRESS || viewer.panelTakes(cursor)) {
+            return;
+        }
+        viewer.lastCursor_ = cursor;
+        if (button == GLFW_MOUSE_BUTTON_LEFT) {
+            viewer.drag_ = DragButton::Orbit;
+            const double now = glfwGetTime();
+            if (now - viewer.lastClickTime_ < kDoubleClickSeconds &&
+                glm::length(cursor - viewer.lastClickPosition_) < kDoubleClickPixels) {
+                viewer.lastClickTime_ = -1.0;
+                viewer.pickCentreAt(cursor);
+            } else {
+                viewer.lastClickTime_ = now;
+                viewer.lastClickPosition_ = cursor;
+            }
+        } else if (button == GLFW_MOUSE_BUTTON_RIGHT || button == GLFW_MOUSE_BUTTON_MIDDLE) {
+            viewer.drag_ = DragButton::Pan;
+        }
+    });
+}
+
+void Viewer::onCursorPosition(GLFWwindow* window, double x, double y) {
+    guarded(window, [&](Viewer& viewer) {
+        const glm::dvec2 cursor(x, y);
+        const glm::dvec2 delta = cursor - viewer.lastCursor_;
+        viewer.lastCursor_ = cursor;
+        if (viewer.drag_ == DragButton::Orbit) {
+            if (viewer.navigation_ == Navigation::Fly) {
+                viewer.camera_.look(delta.x, delta.y);
+            } else {
+                viewer.camera_.orbit(delta.x, delta.y);
+            }
+        } else if (viewer.drag_ == DragButton::Pan) {
+            const glm::dvec2 pixels = delta * viewer.context_.windowToFramebufferScale();
+            viewer.camera_.pan(pixels.x, pixels.y, viewer.viewportSize().y);
+        }
+    });
+}
+
+void Viewer::onScroll(GLFWwindow* window, double dx, double dy) {
+    ImGui_ImplGlfw_ScrollCallback(window, dx, dy);
+    guarded(window, [&](Viewer& viewer) {
+        glm::dvec2 cursor;
+        glfwGetCursorPos(window, &cursor.x, &cursor.y);
+        if (!viewer.panelTakes(cursor)) {
+            viewer.zoomAt(cursor, dy);
+        }
+    });
+}
+
+void Viewer::onKey(GLFWwindow* window, int key, int scancode, int action, int mods) {
+    ImGui_ImplGlfw_KeyCallback(window, key, scancode, action, mods);
+    guarded(window, [&](Viewer& viewer) {
+        if (action == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard) {
+            viewer.handleKey(key);
+        }
+    });
+}
+
+void Viewer::onChar(GLFWwindow* window, unsigned int codepoint) {
+    ImGui_ImplGlfw_CharCallback(window, codepoint);
+}
+
+void Viewer::onDrop(GLFWwindow* window, int count, const char** paths) {
+    guarded(window, [&](Viewer& viewer) {
+        if (count > 0) {
+            viewer.pendingOpen_ = paths[0];
+        }
+    });
+}
+
+void Viewer::onFocus(GLFWwindow* window, int focused) {
+    ImGui_ImplGlfw_WindowFocusCallback(window, focused);
+}
+
+void Viewer::onCursorEnter(GLFWwindow* window, int entered) {
+    ImGui_ImplGlfw_CursorEnterCallback(window, entered);
+}
+
+bool Viewer::panelTakes(const glm::dvec2& cursor) const {
+    return ImGui::GetIO().WantCaptureMouse || (showPanel_ && panel_.covers(cursor));
+}
+
+void Viewer::handleKey(int key) {
+    const glm::ivec2 size = viewportSize();
+    switch (key) {
+        case GLFW_KEY_ESCAPE:
+            glfwSetWindowShouldClose(context_.window(), GLFW_TRUE);
+            break;
+        case GLFW_KEY_R:
+            camera_.reset(size.x, size.y);
+            break;
+        case GLFW_KEY_F:
+            camera_.frameAll(size.x, size.y);
+            break;
+        case GLFW_KEY_P:
+            pendingScreenshots_.push_back(nextScreenshotPath());
+            break;
+        case GLFW_KEY_TAB:
+            showPanel_ = !showPanel_;
+            break;
+        case GLFW_KEY_C:
+            navigation_ = navigation_ == Navigation::Orbit ? Navigation::Fly : Navigation::Orbit;
+            notify(navigation_ == Navigation::Fly ? "fly: WASD to move, Q/E down/up, drag to look"
+                                                  : "orbit: drag to turn around the centre");
+            break;
+        default:
+            break;
+    }
+}
+
+void Viewer::flyWithKeys(double seconds) {
+    flying_ = false;
+    if (navigation_ != Navigation::Fly || ImGui::GetIO().WantCaptureKeyboard) {
+        return;
+    }
+    GLFWwindow* window = context_.window();
+    const auto held = [window](int key) {
+        return glfwGetKey(window, key) == GLFW_PRESS ? 1.0 : 0.0;
+    };
+    const glm::dvec3 direction(held(GLFW_KEY_D) - held(GLFW_KEY_A),
+                               held(GLFW_KEY_E) - held(GLFW_KEY_Q),
+                               held(GLFW_KEY_S) - held(GLFW_KEY_W));
+    if (direction == glm::dvec3(0.0)) {
+        return;
+    }
+    flying_ = true;
+    const bool fast = held(GLFW_KEY_LEFT_SHIFT) > 0.0 || held(GLFW_KEY_RIGHT_SHIFT) > 0.0;
+    const double speed =
+        kFlyRadiiPerSecond * camera_.sceneRadius() * (fast ? kFlyShiftFactor : 1.0);
+    camera_.move(direction * speed * std::min(seconds, kMaxFlyStepSeconds));
+}
+
+// ---- loading ---------------------------------------------------------------------------------
+
+void Viewer::startLoading(const std::string& source) {
+    // Replacing a running job cancels it (its destructor waits for the thread).
+    loading_ = std::make_unique<ScanLoadJob>(source);
+    status_.loadingSource = source;
+}
+
+void Viewer::finishLoading() {
+    if (!loading_) {
+        return;
+    }
+    status_.loadingProgress = loading_->progress();
+    if (!loading_->finished()) {
+        return;
+    }
+    const std::unique_ptr<ScanLoadJob> job = std::move(loading_);
+    status_.loadingSource.reset();
+    try {
+        PreparedScan prepared = job->take();
+        for (const std::string& warning : prepared.scan.warnings) {
+            fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
+        }
+        const PointCloud& cloud = prepared.scan.cloud;
+        // Built before the old one goes, so a failure keeps the scan on screen.
+        auto renderer = std::make_unique<Renderer>(
+            context_, cloud,
+            prepared.spacing > 0.0 ? std::optional<double>(prepared.spacing) : std::nullopt);
+        renderer_ = std::move(renderer);
+        bounds_ = cloud.bounds;
+        status_.scanSource = prepared.source;
+        status_.scanFormat =
+            prepared.scan.formatDetail.empty() ? prepared.scan.format : prepared.scan.formatDetail;
+        status_.points = cloud.size();
+        status_.spacing = renderer_->spacing();
+        status_.loadMilliseconds = prepared.scan.loadMilliseconds;
+        const UpAxis up =
+            options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
+        const glm::ivec2 size = viewportSize();
+        camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1));
+        renderedCamera_.reset();
+        renderedImage_ = false;
+        glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());
+        initialScanShown_ = true;
+    } catch (const Error& error) {
+        if (!initialScanShown_) {
+            throw;  // nothing to show: the command fails as `subscan render` would
+        }
+        fail(error.what());
+    }
+}
+
+// ---- script ----------------------------------------------------------------------------------
+
+void Viewer::runScript() {
+    const std::vector<ScriptAction>& actions = options_.script;
+    while (nextAction_ < actions.size() && actions[nextAction_].frame <= frame_) {
+        runScriptCommand(actions[nextAction_].command);
+        ++nextAction_;
+    }
+}
+
+void Viewer::runScriptCommand(const ScriptCommand& command) {
+    const glm::ivec2 size = viewportSize();
+    std::visit(
+        Overloaded{
+            [&](const script::Orbit& orbit) { camera_.orbit(orbit.dx, orbit.dy); },
+            [&](const script::Pan& pan) {
+                const glm::dvec2 pixels =
+                    glm::dvec2(pan.dx, pan.dy) * context_.windowToFramebufferScale();
+                camera_.pan(pixels.x, pixels.y, size.y);
+            },
+            [&](const script::Zoom& zoom) {
+                // What the user would have seen under the cursor: the current view.
+                renderIfNeeded();
+                zoomAt(zoom.at.value_or(windowCentre()), zoom.amount);
+            },
+            [&](const script::Pick& pick) {
+                renderIfNeeded();
+                pickCentreAt(pick.at.value_or(windowCentre()));
+            },
+            [&](const script::Reset&) { camera_.reset(size.x, size.y); },
+            [&](const script::FrameAll&) { camera_.frameAll(size.x, size.y); },
+            [&](const script::Resize& resize) { resizeWindow(resize.width, resize.height); },
+            [&](const script::Screenshot& screenshot) {
+                pendingScreenshots_.push_back(screenshot.path);
+            },
+            [&](const script::SetMode& mode) {
+                settings_.raster.mode = mode.mode;
+                const Stage stage = settings_.raster.stage;
+                if (!surfaceMode(mode.mode) && stage != Stage::Final && stage != Stage::Depth) {
+                    settings_.raster.stage = Stage::Final;
+                }
+            },
+            [&](const script::ShowPanel& panel) { showPanel_ = panel.show; },
+            [&](const script::Exit&) { exitRequested_ = true; },
+        },
+        command);
+}
+
+void Viewer::resizeWindow(int width, int height) {
+    GLFWwindow* window = context_.window();
+    glfwSetWindowSize(window, width, height);
+    const double deadline = glfwGetTime() + kResizeTimeoutSeconds;
+    for (;;) {
+        int currentWidth = 0, currentHeight = 0;
+        glfwGetWindowSize(window, &currentWidth, &currentHeight);
+        if (currentWidth == width && currentHeight == height) {
+            return;
+        }
+        if (glfwGetTime() > deadline) {
+            fail(fmt::format("the window system kept the window at {}x{} instead of {}x{}",
+                             currentWidth, currentHeight, width, height));
+            return;
+        }
+        glfwWaitEventsTimeout(0.01);
+    }
+}
+
+// ---- drawing ---------------------------------------------------------------------------------
+
+bool Viewer::frameIsStale() const {
+    const glm::ivec2 size = viewportSize();
+    if (!renderer_ || size.x < 1 || size.y < 1) {
+        return false;
+    }
+    return redrawEveryFrame_ || !renderedCamera_ ||
+           !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
+           nlohmann::json(settings_).dump() != renderedSettings_;
+}
+
+void Viewer::renderIfNeeded() {
+    if (!frameIsStale()) {
+        return;
+    }
+    const glm::ivec2 size = viewportSize();
+    const Camera camera = camera_.camera(size.x, size.y);
+    // Recorded before rendering: a frame that fails is not retried until something changes.
+    renderedCamera_ = camera;
+    renderedSettings_ = nlohmann::json(settings_).dump();
+    renderedMode_ = settings_.raster.mode;
+    renderedImage_ = false;
+    try {
+        const FrameResult frame = renderer_->render(camera, settings_);
+        status_.passes = frame.passes;
+        status_.imageWidth = size.x;
+        status_.imageHeight = size.y;
+        renderedImage_ = true;
+    } catch (const Error& error) {
+        fail(error.what());
+    }
+}
+
+void Viewer::drawFrame() {
+    const glm::ivec2 size = viewportSize();
+    if (size.x < 1 || size.y < 1) {
+        return;  // minimised: nothing to draw into
+    }
+    renderIfNeeded();
+    if (renderer_ && renderedImage_) {
+        context_.presentImage(renderer_->resources().texture("image"));
+    } else {
+        context_.clearWindow(settings_.raster.backgroundSrgb);
+    }
+    drawPanel();
+}
+
+void Viewer::drawPanel() {
+    imgui_.beginFrame();
+    status_.windowFps = ImGui::GetIO().Framerate;
+    PanelRequests requests;
+    if (showPanel_) {
+        requests = panel_.draw(settings_, navigation_, redrawEveryFrame_, status_);
+    }
+    imgui_.endFrame();
+
+    const glm::ivec2 size = viewportSize();
+    if (requests.screenshot) {
+        pendingScreenshots_.push_back(nextScreenshotPath());
+    }
+    if (requests.resetView) {
+        camera_.reset(size.x, size.y);
+    }
+    if (requests.frameAll) {
+        camera_.frameAll(size.x, size.y);
+    }
+    if (requests.openScan) {
+        pendingOpen_ = requests.openScan;
+    }
+    try {
+        if (requests.saveSettings) {
+            writeSettingsFile(*requests.saveSettings, settings_);
+            notify("saved the settings to " + *requests.saveSettings);
+        }
+        if (requests.loadSettings) {
+            settings_ = readSettingsFile(*requests.loadSettings);
+            notify("loaded the settings from " + *requests.loadSettings);
+        }
+    } catch (const Error& error) {
+        fail(error.what());
+    }
+}
+
+void Viewer::writeScreenshot(const std::filesystem::path& path) {
+    const glm::ivec2 size = viewportSize();
+    const Camera camera = renderedCamera_ ? *renderedCamera_ : camera_.camera(size.x, size.y);
+    try {
+        writePng(path, context_.readBackBuffer());
+        writeCameraFile(sidecarPath(path, ".camera.json"), camera);
+        writeSettingsFile(sidecarPath(path, ".settings.json"), settings_);
+        notify("wrote " + path.string());
+    } catch (const Error& error) {
+        fail(error.what());
+    }
+}
+
+std::filesystem::path Viewer::nextScreenshotPath() const {
+    for (int number = 1;; ++number) {
+        std::filesystem::path path = fmt::format("subscan-screenshot-{:03}.png", number);
+        std::error_code ignored;
+        if (!std::filesystem::exists(path, ignored) &&
+            std::find(pendingScreenshots_.begin(), pendingScreenshots_.end(), path) ==
+                pendingScreenshots_.end()) {
+            return path;
+        }
+    }
+}
+
+// ---- picking ---------------------------------------------------------------------------------
+
+std::optional<glm::dvec3> Viewer::surfacePointAt(const glm::dvec2& windowPosition) const {
+    if (!renderer_ || !renderedCamera_ || !renderedImage_) {
+        return std::nullopt;
+    }
+    const FrameResources& resources = renderer_->resources();
+    const char* name =
+        surfaceMode(renderedMode_) && resources.has("surfaceDepth") ? "surfaceDepth" : "depth";
+    if (!resources.has(name)) {
+        return std::nullopt;
+    }
+    const Texture& depth = resources.texture(name);
+    const glm::dvec2 pixel = windowPosition * context_.windowToFramebufferScale();
+    const int x = static_cast<int>(std::floor(pixel.x));
+    const int y = static_cast<int>(std::floor(pixel.y));
+    if (x < 0 || y < 0 || x >= depth.width() || y >= depth.height()) {
+        return std::nullopt;
+    }
+    const int x0 = std::max(x - kPickRadiusPixels, 0);
+    const int y0 = std::max(y - kPickRadiusPixels, 0);
+    const int x1 = std::min(x + kPickRadiusPixels, depth.width() - 1);
+    const int y1 = std::min(y + kPickRadiusPixels, depth.height() - 1);
+    const int blockWidth = x1 - x0 + 1;
+    const int blockHeight = y1 - y0 + 1;
+    std::vector<float> block(static_cast<std::size_t>(blockWidth * blockHeight));
+    // Texel rows run from the top of the image, as the pipeline writes them.
+    glGetTextureSubImage(depth.id(), 0, x0, y0, 0, blockWidth, blockHeight, 1, GL_RED, GL_FLOAT,
+                         static_cast<GLsizei>(block.size() * sizeof(float)), block.data());
+
+    // The nearest texel with a surface; of equally near ones the frontmost.
+    std::optional<glm::dvec2> best;
+    double bestDepth = 0.0;
+    double bestDistance = std::numeric_limits<double>::infinity();
+    for (int row = 0; row < blockHeight; ++row) {
+        for (int column = 0; column < blockWidth; ++column) {
+            const double value = block[static_cast<std::size_t>(row * blockWidth + column)];
+            if (!(value > 0.0 && std::isfinite(value))) {
+                continue;
+            }
+            const glm::dvec2 centre(x0 + column + 0.5, y0 + row + 0.5);
+            const double distance = glm::length(centre - pixel);
+            if (distance < bestDistance || (distance == bestDistance && value < bestDepth)) {
+                best = centre;
+                bestDepth = value;
+                bestDistance = distance;
+            }
+        }
+    }
+    if (!best) {
+        return std::nullopt;
+    }
+    return ViewerCamera::unproject(*renderedCamera_, *best, bestDepth);
+}
+
+void Viewer::zoomAt(const glm::dvec2& windowPosition, double steps) {
+    const glm::ivec2 size = viewportSize();
+    const glm::dvec3 target =
+        surfacePointAt(windowPosition)
+            .value_or(camera_.pointAtCentreDepth(
+                windowPosition * context_.windowToFramebufferScale(), size.x, size.y));
+    camera_.zoomTowards(steps, target);
+}
+
+void Viewer::pickCentreAt(const glm::dvec2& windowPosition) {
+    if (const std::optional<glm::dvec3> point = surfacePointAt(windowPosition)) {
+        camera_.setCentre(*point);
+    } else {
+        notify("nothing under the cursor to orbit around");
+    }
+}
+
+glm::dvec2 Viewer::windowCentre() const {
+    int width = 0, height = 0;
+    glfwGetWindowSize(context_.window(), &width, &height);
+    return glm::dvec2(width, height) * 0.5;
+}
+
+glm::ivec2 Viewer::viewportSize() const {
+    return context_.framebufferSize();
+}
+
+// ---- messages --------------------------------------------------------------------------------
+
+void Viewer::notify(std::string message) {
+    fmt::print(stderr, "subscan: {}\n", message);
+    status_.message = std::move(message);
+    status_.messageIsError = false;
+}
+
+void Viewer::fail(std::string message) {
+    if (unattended_) {
+        throw Error(message);
+    }
+    fmt::print(stderr, "subscan: {}\n", message);
+    status_.message = std::move(message);
+    status_.messageIsError = true;
+}
+
+}  // namespace subscan::viewer

@@ -1,0 +1,154 @@
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/vec2.hpp>
+
+#include "app/viewer/ImGuiSession.h"
+#include "app/viewer/ScanLoadJob.h"
+#include "app/viewer/ViewerCamera.h"
+#include "app/viewer/ViewerPanel.h"
+#include "app/viewer/ViewerScript.h"
+#include "core/Camera.h"
+#include "gpu/GlfwContext.h"
+#include "render/RenderSettings.h"
+
+struct GLFWwindow;
+
+namespace subscan {
+class Renderer;
+}
+
+namespace subscan::viewer {
+
+struct ViewerOptions {
+    std::string source;  // a scan file or synthetic:NAME
+    int width = 1280;    // window size
+    int height = 800;
+    RenderSettings settings;
+    std::optional<UpAxis> up;  // default: Z for LAS, Y otherwise
+    std::vector<ScriptAction> script;
+    std::filesystem::path screenshotAtExit;  // empty: none
+    std::optional<int> exitAfterFrames;      // frames that show the scan
+    bool showPanel = true;
+};
+
+/// `subscan view`: a window showing the frame pipeline's image of a scan, live, with a camera
+/// driven by mouse and keys (ViewerCamera), the ImGui panel (ViewerPanel) over it, scans loaded
+/// off the render thread (ScanLoadJob) and scripted input for unattended runs (ViewerScript).
+/// The pipeline renders only when the camera, the settings or the window size changed.
+class Viewer {
+  public:
+    /// Opens the window; throws subscan::Error when there is no display or no OpenGL 4.5.
+    explicit Viewer(ViewerOptions options);
+    ~Viewer();
+    Viewer(const Viewer&) = delete;
+    Viewer& operator=(const Viewer&) = delete;
+
+    /// Runs until the window is closed, Esc, the script's exit or --exit-after-frames. Throws
+    /// subscan::Error when the scan given on the command line cannot be shown, and, in
+    /// unattended runs (a script or a frame limit), for any error a user would otherwise see
+    /// in the panel.
+    int run();
+
+  private:
+    enum class DragButton { None, Orbit, Pan };
+
+    // GLFW callbacks: reach the viewer through the window's user pointer and forward the event
+    // to ImGui, which may take it.
+    static Viewer& of(GLFWwindow* window);
+    /// Runs `handler(viewer)`; an exception is kept for waitForEvents to throw, since it must
+    /// not unwind through GLFW's C code.
+    template <class Handler>
+    static void guarded(GLFWwindow* window, Handler&& handler);
+    static void onMouseButton(GLFWwindow* window, int button, int action, int mods);
+    static void onCursorPosition(GLFWwindow* window, double x, double y);
+    static void onScroll(GLFWwindow* window, double dx, double dy);
+    static void onKey(GLFWwindow* window, int key, int scancode, int action, int mods);
+    static void onChar(GLFWwindow* window, unsigned int codepoint);
+    static void onDrop(GLFWwindow* window, int count, const char** paths);
+    static void onFocus(GLFWwindow* window, int focused);
+    static void onCursorEnter(GLFWwindow* window, int entered);
+    void installCallbacks();
+    void handleKey(int key);
+    /// The mouse at `cursor` belongs to the panel (or one of its popups), not to the camera.
+    bool panelTakes(const glm::dvec2& cursor) const;
+
+    void waitForEvents();
+    void startLoading(const std::string& source);
+    void finishLoading();
+    void runScript();
+    void runScriptCommand(const ScriptCommand& command);
+    void resizeWindow(int width, int height);
+    void flyWithKeys(double seconds);
+
+    /// The camera, the settings or the window size differ from what the last pipeline frame
+    /// showed (or every frame is to be rendered).
+    bool frameIsStale() const;
+    /// Renders the pipeline for the current camera and settings when the frame is stale.
+    void renderIfNeeded();
+    /// Scene (or background) and panel into the back buffer.
+    void drawFrame();
+    void drawPanel();
+    void writeScreenshot(const std::filesystem::path& path);
+    std::filesystem::path nextScreenshotPath() const;
+
+    /// The scene point under a window position in the last rendered frame (reconstructed depth
+    /// in the surface modes, the points' depth otherwise), searched a few pixels around it.
+    std::optional<glm::dvec3> surfacePointAt(const glm::dvec2& windowPosition) const;
+    void zoomAt(const glm::dvec2& windowPosition, double steps);
+    void pickCentreAt(const glm::dvec2& windowPosition);
+    glm::dvec2 windowCentre() const;
+    glm::ivec2 viewportSize() const;
+
+    /// A notice for the panel (and stderr).
+    void notify(std::string message);
+    /// An error: thrown in unattended runs, shown in the panel otherwise.
+    void fail(std::string message);
+
+    ViewerOptions options_;
+    bool unattended_;
+    GlfwContext context_;
+    ImGuiSession imgui_;
+    ViewerPanel panel_;
+    RenderSettings settings_;
+    bool showPanel_;
+    bool redrawEveryFrame_ = false;
+    Navigation navigation_ = Navigation::Orbit;
+
+    // The scan on screen.
+    std::unique_ptr<Renderer> renderer_;
+    PanelStatus status_;
+    Bounds bounds_;
+    ViewerCamera camera_;
+    std::unique_ptr<ScanLoadJob> loading_;
+    bool initialScanShown_ = false;
+    std::optional<std::string> pendingOpen_;
+
+    // The last pipeline frame: what it showed (to skip identical frames) and whether it worked.
+    std::optional<Camera> renderedCamera_;
+    std::string renderedSettings_;
+    RenderMode renderedMode_ = RenderMode::Points;
+    bool renderedImage_ = false;
+
+    // Input.
+    DragButton drag_ = DragButton::None;
+    glm::dvec2 lastCursor_{0.0};
+    double lastClickTime_ = -1.0;
+    glm::dvec2 lastClickPosition_{0.0};
+    bool flying_ = false;  // a fly key is held: draw continuously
+    std::optional<std::string> callbackError_;
+
+    // Frames and the script.
+    int frame_ = 0;  // frames that showed the scan
+    std::size_t nextAction_ = 0;
+    bool exitRequested_ = false;
+    std::vector<std::filesystem::path> pendingScreenshots_;
+    double lastFrameTime_ = 0.0;
+};
+
+}  // namespace subscan::viewer

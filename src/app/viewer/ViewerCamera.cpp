@@ -1,0 +1,167 @@
+#include "app/viewer/ViewerCamera.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+#include <glm/trigonometric.hpp>
+
+namespace subscan::viewer {
+
+namespace {
+
+// orbitCamera's defaults: the auto-framed view `R` returns to.
+const OrbitView kDefaultOrbit;
+
+// The closest and farthest the eye may come to its centre, in scene radii: zooming stops
+// before the view matrix loses precision or the scene shrinks to nothing.
+constexpr double kMinDistanceRadii = 1e-5;
+constexpr double kMaxDistanceRadii = 1e4;
+
+glm::dvec3 upAxisVector(UpAxis up) {
+    return up == UpAxis::Y ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
+}
+
+double focalLengthPixels(int height) {
+    return 0.5 * static_cast<double>(height) /
+           std::tan(0.5 * glm::radians(ViewerCamera::kFovyDegrees));
+}
+
+}  // namespace
+
+ViewerCamera::ViewerCamera(const Bounds& bounds, UpAxis up, int width, int height)
+    : bounds_(bounds), up_(up) {
+    // orbitCamera's radius, so that reset() reproduces it exactly.
+    sceneRadius_ =
+        std::max(0.5 * glm::length(bounds.extent()), 1e-9 * (1.0 + glm::length(bounds.center())));
+    reset(width, height);
+}
+
+void ViewerCamera::reset(int width, int height) {
+    yawDegrees_ = kDefaultOrbit.yawDegrees;
+    pitchDegrees_ = kDefaultOrbit.pitchDegrees;
+    frameAll(width, height);
+}
+
+void ViewerCamera::frameAll(int width, int height) {
+    const double halfFovy = 0.5 * glm::radians(kFovyDegrees);
+    const double halfFovx = std::atan(std::tan(halfFovy) * static_cast<double>(std::max(width, 1)) /
+                                      static_cast<double>(std::max(height, 1)));
+    // orbitCamera's margin: the bounding sphere fills the narrower field of view with 5% to
+    // spare.
+    constexpr double kMargin = 1.05;
+    centre_ = bounds_.empty() ? glm::dvec3(0.0) : bounds_.center();
+    distance_ = kMargin * sceneRadius_ / std::sin(std::min(halfFovy, halfFovx));
+}
+
+glm::dvec3 ViewerCamera::towardsEye() const {
+    const double yaw = glm::radians(yawDegrees_);
+    const double pitch = glm::radians(pitchDegrees_);
+    if (up_ == UpAxis::Y) {
+        return {std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch)};
+    }
+    return {std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch), std::sin(pitch)};
+}
+
+glm::dvec3 ViewerCamera::eye() const {
+    return centre_ + distance_ * towardsEye();
+}
+
+glm::dvec3 ViewerCamera::forward() const {
+    return -towardsEye();
+}
+
+glm::dvec3 ViewerCamera::right() const {
+    return glm::normalize(glm::cross(forward(), upAxisVector(up_)));
+}
+
+glm::dvec3 ViewerCamera::up() const {
+    return glm::cross(right(), forward());
+}
+
+void ViewerCamera::clampDistance() {
+    distance_ =
+        std::clamp(distance_, kMinDistanceRadii * sceneRadius_, kMaxDistanceRadii * sceneRadius_);
+}
+
+void ViewerCamera::orbit(double dxPixels, double dyPixels) {
+    yawDegrees_ = std::remainder(yawDegrees_ - dxPixels * kDegreesPerPixel, 360.0);
+    pitchDegrees_ = std::clamp(pitchDegrees_ + dyPixels * kDegreesPerPixel, -kMaxPitchDegrees,
+                               kMaxPitchDegrees);
+}
+
+void ViewerCamera::pan(double dxPixels, double dyPixels, int viewportHeight) {
+    const double unitsPerPixel = distance_ / focalLengthPixels(std::max(viewportHeight, 1));
+    centre_ += (-dxPixels * right() + dyPixels * up()) * unitsPerPixel;
+}
+
+void ViewerCamera::zoomTowards(double steps, const glm::dvec3& target) {
+    // Clamped as a factor: a huge step count underflows pow() to 0 or overflows it to inf.
+    const double factor =
+        std::clamp(std::pow(kZoomPerStep, steps), kMinDistanceRadii * sceneRadius_ / distance_,
+                   kMaxDistanceRadii * sceneRadius_ / distance_);
+    // Scaling eye and centre about the target keeps the direction and the target's pixel.
+    centre_ = target + (centre_ - target) * factor;
+    distance_ *= factor;
+}
+
+void ViewerCamera::look(double dxPixels, double dyPixels) {
+    const glm::dvec3 fixedEye = eye();
+    orbit(dxPixels, dyPixels);
+    centre_ = fixedEye - distance_ * towardsEye();
+}
+
+void ViewerCamera::move(const glm::dvec3& rightUpBack) {
+    centre_ += rightUpBack.x * right() + rightUpBack.y * up() + rightUpBack.z * towardsEye();
+}
+
+void ViewerCamera::setCentre(const glm::dvec3& point) {
+    const glm::dvec3 fromPoint = eye() - point;
+    const double length = glm::length(fromPoint);
+    if (!(length > kMinDistanceRadii * sceneRadius_)) {
+        return;
+    }
+    const glm::dvec3 direction = fromPoint / length;
+    const double along = up_ == UpAxis::Y ? direction.y : direction.z;
+    pitchDegrees_ = std::clamp(glm::degrees(std::asin(std::clamp(along, -1.0, 1.0))),
+                               -kMaxPitchDegrees, kMaxPitchDegrees);
+    yawDegrees_ = up_ == UpAxis::Y ? glm::degrees(std::atan2(direction.x, direction.z))
+                                   : glm::degrees(std::atan2(direction.x, -direction.y));
+    centre_ = point;
+    distance_ = length;
+    clampDistance();
+}
+
+Camera ViewerCamera::camera(int width, int height) const {
+    Camera camera;
+    camera.width = width;
+    camera.height = height;
+    camera.fovyDegrees = kFovyDegrees;
+    const glm::dvec3 eyePosition = eye();
+    camera.view = glm::lookAt(eyePosition, centre_, upAxisVector(up_));
+    // orbitCamera's depth range, measured from wherever the eye is now.
+    const double toScene =
+        bounds_.empty() ? distance_ : glm::length(eyePosition - bounds_.center());
+    const double margin = 0.02 * sceneRadius_;
+    camera.farPlane = toScene + sceneRadius_ + margin;
+    camera.nearPlane = std::max(toScene - sceneRadius_ - margin, 1e-4 * camera.farPlane);
+    return camera;
+}
+
+glm::dvec3 ViewerCamera::pointAtCentreDepth(const glm::dvec2& pixel, int width, int height) const {
+    const double focal = focalLengthPixels(std::max(height, 1));
+    const double x = (pixel.x - 0.5 * width) / focal;
+    const double y = (0.5 * height - pixel.y) / focal;
+    return eye() + distance_ * (forward() + x * right() + y * up());
+}
+
+glm::dvec3 ViewerCamera::unproject(const Camera& camera, const glm::dvec2& pixel, double depth) {
+    const double focal = camera.focalLengthPixels();
+    const glm::dvec4 inView(depth * (pixel.x - 0.5 * camera.width) / focal,
+                            depth * (0.5 * camera.height - pixel.y) / focal, -depth, 1.0);
+    return glm::dvec3(glm::inverse(camera.view) * inView);
+}
+
+}  // namespace subscan::viewer

@@ -1,0 +1,314 @@
+// `subscan view` end to end: a real window on a virtual X server (Xvfb) rendered by Mesa, driven
+// by --script. Each test starts its own Xvfb on a free display (Xvfb -displayfd picks it), so
+// tests can run in parallel; a test is skipped with a message only when Xvfb is not installed.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "io/Image.h"
+#include "support/TestSupport.h"
+
+extern char** environ;
+
+namespace subscan::test {
+namespace {
+
+using ::testing::HasSubstr;
+
+// 50,000 points load in a fraction of a second and still cover a 320x240 view.
+constexpr const char* kScan = "synthetic:sculpture?points=50000";
+// Every viewer run gets a frame limit, so a broken script cannot hang the test.
+constexpr const char* kFrameLimit = "40";
+
+std::optional<std::filesystem::path> findProgram(const std::string& name) {
+    const char* path = std::getenv("PATH");
+    std::string directories = path != nullptr ? path : "/usr/bin:/bin";
+    std::size_t start = 0;
+    while (start <= directories.size()) {
+        const std::size_t end = std::min(directories.find(':', start), directories.size());
+        const std::filesystem::path candidate =
+            std::filesystem::path(directories.substr(start, end - start)) / name;
+        if (access(candidate.c_str(), X_OK) == 0) {
+            return candidate;
+        }
+        start = end + 1;
+    }
+    return std::nullopt;
+}
+
+/// An Xvfb server on a display it chose itself, stopped on destruction.
+class VirtualDisplay {
+  public:
+    explicit VirtualDisplay(const std::filesystem::path& xvfb) {
+        int fds[2];
+        if (pipe(fds) != 0) {
+            throw std::runtime_error("pipe failed");
+        }
+        const std::string writeFd = std::to_string(fds[1]);
+        std::vector<std::string> arguments{xvfb.string(), "-displayfd",  writeFd,     "-screen",
+                                           "0",           "1280x800x24", "-nolisten", "tcp"};
+        std::vector<char*> argv;
+        for (std::string& argument : arguments) {
+            argv.push_back(argument.data());
+        }
+        argv.push_back(nullptr);
+        posix_spawn_file_actions_t actions;
+        posix_spawn_file_actions_init(&actions);
+        posix_spawn_file_actions_addclose(&actions, fds[0]);
+        posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+        posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+        const int spawned = posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ);
+        posix_spawn_file_actions_destroy(&actions);
+        close(fds[1]);
+        if (spawned != 0) {
+            close(fds[0]);
+            throw std::runtime_error("cannot start " + xvfb.string());
+        }
+        // Xvfb writes the display number once it accepts connections.
+        std::string number;
+        pollfd ready{fds[0], POLLIN, 0};
+        char byte = 0;
+        while (poll(&ready, 1, 20000) > 0 && read(fds[0], &byte, 1) == 1 && byte != '\n') {
+            number += byte;
+        }
+        close(fds[0]);
+        if (number.empty()) {
+            stop();
+            throw std::runtime_error("Xvfb did not report a display within 20 s");
+        }
+        display_ = ":" + number;
+    }
+    ~VirtualDisplay() { stop(); }
+    VirtualDisplay(const VirtualDisplay&) = delete;
+    VirtualDisplay& operator=(const VirtualDisplay&) = delete;
+
+    const std::string& display() const { return display_; }
+
+  private:
+    void stop() {
+        if (pid_ > 0) {
+            kill(pid_, SIGTERM);
+            waitpid(pid_, nullptr, 0);
+            pid_ = 0;
+        }
+    }
+
+    pid_t pid_ = 0;
+    std::string display_;
+};
+
+class ViewerTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const std::optional<std::filesystem::path> xvfb = findProgram("Xvfb");
+        if (!xvfb) {
+            GTEST_SKIP() << "Xvfb not found: install xvfb (scripts/setup-deps.sh) to run the "
+                            "viewer tests";
+        }
+        display_.emplace(*xvfb);
+    }
+
+    /// `subscan view` on this test's display.
+    CommandResult view(std::vector<std::string> arguments) const {
+        arguments.insert(arguments.begin(), "view");
+        return runSubscan(arguments, {"DISPLAY=" + display_->display()});
+    }
+
+    std::filesystem::path writeScript(const nlohmann::json& script) const {
+        return directory_.write("script.json", script.dump(2));
+    }
+
+    std::string path(std::string_view name) const { return (directory_ / name).string(); }
+
+    TempDir directory_;
+    std::optional<VirtualDisplay> display_;
+};
+
+/// The viewer's default background, sRGB 0.19 as 8 bits.
+constexpr int kBackground = 48;
+
+/// Share of pixels that are not the background (more than a small step away in any channel).
+double foregroundFraction(const Image8& image) {
+    std::size_t foreground = 0;
+    const std::size_t pixels = image.pixels.size() / 4;
+    for (std::size_t i = 0; i < pixels; ++i) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            if (std::abs(image.pixels[4 * i + c] - kBackground) > 6) {
+                ++foreground;
+                break;
+            }
+        }
+    }
+    return static_cast<double>(foreground) / static_cast<double>(pixels);
+}
+
+/// Share of pixels where a and b differ by more than `threshold` in some channel, within the
+/// rectangle [x0, x1) x [y0, y1).
+double differingFraction(const Image8& a, const Image8& b, int threshold, int x0 = 0, int y0 = 0,
+                         int x1 = -1, int y1 = -1) {
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    x1 = x1 < 0 ? a.width : x1;
+    y1 = y1 < 0 ? a.height : y1;
+    std::size_t differing = 0;
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            const std::size_t i = 4 * (static_cast<std::size_t>(y) * a.width + x);
+            for (std::size_t c = 0; c < 3; ++c) {
+                if (std::abs(a.pixels[i + c] - b.pixels[i + c]) > threshold) {
+                    ++differing;
+                    break;
+                }
+            }
+        }
+    }
+    return static_cast<double>(differing) / static_cast<double>((x1 - x0) * (y1 - y0));
+}
+
+TEST_F(ViewerTest, ScriptedOrbitAndZoomMoveTheCameraAndScreenshotsShowIt) {
+    const auto script = writeScript(nlohmann::json::array({
+        {{"frame", 0}, {"action", "screenshot"}, {"path", path("start.png")}},
+        {{"frame", 1}, {"action", "orbit"}, {"dx", 150}, {"dy", 0}},
+        {{"frame", 1}, {"action", "screenshot"}, {"path", path("orbited.png")}},
+        {{"frame", 2}, {"action", "pick"}},
+        {{"frame", 2}, {"action", "zoom"}, {"amount", 3}},
+        {{"frame", 2}, {"action", "screenshot"}, {"path", path("zoomed.png")}},
+        {{"frame", 3}, {"action", "panel"}, {"show", true}},
+        {{"frame", 3}, {"action", "screenshot"}, {"path", path("panel.png")}},
+        {{"frame", 3}, {"action", "exit"}},
+    }));
+    const CommandResult result =
+        view({kScan, "--mode", "surface", "--width", "320", "--height", "240", "--hide-panel",
+              "--script", script.string(), "--exit-after-frames", kFrameLimit});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+
+    const Image8 start = readPng(path("start.png"));
+    const Image8 orbited = readPng(path("orbited.png"));
+    const Image8 zoomed = readPng(path("zoomed.png"));
+    const Image8 panel = readPng(path("panel.png"));
+    for (const Image8* image : {&start, &orbited, &zoomed, &panel}) {
+        EXPECT_EQ(image->width, 320);
+        EXPECT_EQ(image->height, 240);
+    }
+    // The framed sculpture covers about a sixth of the view; a blank or black window would not.
+    EXPECT_GT(foregroundFraction(start), 0.08);
+    EXPECT_GT(foregroundFraction(orbited), 0.08);
+    // Half a turn around the sculpture changes much of what is on screen.
+    EXPECT_GT(differingFraction(start, orbited, 24), 0.03);
+    // Three wheel steps at the middle of the window bring the surface there closer: it grows.
+    EXPECT_GT(foregroundFraction(zoomed), 1.5 * foregroundFraction(orbited));
+    // The panel covers the top left corner, and only the panel changed.
+    EXPECT_GT(differingFraction(zoomed, panel, 24, 8, 8, 120, 40), 0.3);
+    EXPECT_LT(differingFraction(zoomed, panel, 0, 240, 0, 320, 240), 0.001);
+
+    // Each screenshot has its camera and settings beside it: `subscan render` makes the same
+    // picture headless (EGL) with the same pipeline.
+    ASSERT_TRUE(std::filesystem::exists(path("orbited.camera.json")));
+    ASSERT_TRUE(std::filesystem::exists(path("orbited.settings.json")));
+    const CommandResult render =
+        runSubscan({"render", kScan, "-o", path("rendered.png"), "--camera",
+                    path("orbited.camera.json"), "--settings", path("orbited.settings.json")});
+    ASSERT_EQ(render.exitCode, 0) << render.err;
+    // Both run on llvmpipe; a pixel may only differ where atomics resolve a tie differently.
+    EXPECT_LT(differingFraction(orbited, readPng(path("rendered.png")), 8), 0.005);
+}
+
+TEST_F(ViewerTest, ResizingTheWindowReallocatesThePipeline) {
+    const auto script = writeScript(nlohmann::json::array({
+        {{"frame", 0}, {"action", "screenshot"}, {"path", path("small.png")}},
+        {{"frame", 1}, {"action", "resize"}, {"width", 400}, {"height", 300}},
+        {{"frame", 1}, {"action", "screenshot"}, {"path", path("larger.png")}},
+        {{"frame", 2}, {"action", "resize"}, {"width", 200}, {"height", 260}},
+        {{"frame", 2}, {"action", "frame"}},
+        {{"frame", 2}, {"action", "screenshot"}, {"path", path("narrow.png")}},
+    }));
+    const CommandResult result =
+        view({kScan, "--mode", "surface", "--width", "320", "--height", "240", "--hide-panel",
+              "--script", script.string(), "--exit-after-frames", "4", "--screenshot",
+              path("exit.png")});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.err, ::testing::Not(HasSubstr("error")));
+
+    const Image8 small = readPng(path("small.png"));
+    const Image8 larger = readPng(path("larger.png"));
+    const Image8 narrow = readPng(path("narrow.png"));
+    const Image8 exit = readPng(path("exit.png"));
+    EXPECT_EQ(small.width, 320);
+    EXPECT_EQ(small.height, 240);
+    EXPECT_EQ(larger.width, 400);
+    EXPECT_EQ(larger.height, 300);
+    EXPECT_EQ(narrow.width, 200);
+    EXPECT_EQ(narrow.height, 260);
+    EXPECT_EQ(exit.width, 200);
+    EXPECT_EQ(exit.height, 260);
+    for (const Image8* image : {&small, &larger, &narrow}) {
+        EXPECT_GT(foregroundFraction(*image), 0.08);
+    }
+}
+
+TEST_F(ViewerTest, MissingScanFailsWithOneSentence) {
+    const CommandResult result = view({path("absent.ply")});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_THAT(result.err, HasSubstr("absent.ply: cannot open the file"));
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+TEST_F(ViewerTest, SceneThatCannotBeMadeFailsOnceTheWindowIsOpen) {
+    // Synthetic scenes are made by the loading thread, after the window opened.
+    const CommandResult result = view({"synthetic:teapot", "--exit-after-frames", kFrameLimit});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_THAT(result.err, HasSubstr("synthetic:teapot"));
+    EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+TEST(ViewerWithoutDisplayTest, NoDisplayFailsWithTheClearSentence) {
+    // An empty DISPLAY is how runSubscan unsets it: X11 treats both alike.
+    const CommandResult unset = runSubscan({"view", kScan}, {"DISPLAY="});
+    EXPECT_EQ(unset.exitCode, 1);
+    EXPECT_EQ(unset.err,
+              "subscan: cannot open a window: no display (set DISPLAY, or use `subscan render` "
+              "headless)\n");
+
+    const CommandResult unreachable = runSubscan({"view", kScan}, {"DISPLAY=:64999"});
+    EXPECT_EQ(unreachable.exitCode, 1);
+    EXPECT_THAT(unreachable.err,
+                HasSubstr("subscan: cannot open a window: cannot connect to the display ':64999'"));
+    EXPECT_EQ(std::count(unreachable.err.begin(), unreachable.err.end(), '\n'), 1)
+        << unreachable.err;
+}
+
+TEST(ViewerWithoutDisplayTest, BadScriptOrOptionsFailBeforeAnyWindow) {
+    const TempDir directory;
+    const auto script =
+        directory.write("script.json", R"([{"frame": 0, "action": "zoom", "amout": 2}])");
+    const CommandResult badScript =
+        runSubscan({"view", kScan, "--script", script.string()}, {"DISPLAY="});
+    EXPECT_EQ(badScript.exitCode, 1);
+    EXPECT_THAT(badScript.err, HasSubstr("script.json: action 1: unknown argument 'amout'"));
+
+    const CommandResult badMaterial =
+        runSubscan({"view", kScan, "--material", "cheese"}, {"DISPLAY="});
+    EXPECT_EQ(badMaterial.exitCode, 1);
+    EXPECT_THAT(badMaterial.err, HasSubstr("cheese"));
+
+    const CommandResult badUsage = runSubscan({"view", kScan, "--mode", "mesh"});
+    EXPECT_EQ(badUsage.exitCode, 2);
+}
+
+}  // namespace
+}  // namespace subscan::test
