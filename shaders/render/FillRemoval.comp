@@ -8,6 +8,7 @@
 // at equal coverage (bench/README.md). Writes "mask" (1 = surface) and "surfaceDepth" (the
 // filled depth there, +inf elsewhere).
 #include "shared/pyramid.glsl"
+#include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
@@ -24,7 +25,7 @@ const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec
                                      ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = dispatchTexel();
     if (!insideLevel(0u, pixel)) {
         return;
     }

@@ -7,6 +7,7 @@
 // smallest omegas reaches tau, or (the paper's edge rule) when 3 consecutive directions occlude
 // while at least 3 others are open: x then lies just beyond an occluder's silhouette.
 #include "shared/pyramid.glsl"
+#include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
@@ -21,7 +22,7 @@ const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec
                                      ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = dispatchTexel();
     if (!insideLevel(0u, pixel)) {
         return;
     }

@@ -3,6 +3,8 @@
 // minimum of its 2x2 children on level R-1 (children past an odd edge simply do not exist).
 //   STAGE_COPY    level 0 from the "depth" image
 //   STAGE_REDUCE  level `level` from level `level` - 1
+//   STAGE_BOUNDS  the bounds of the texels of level `level` that hold a depth (min x, min y,
+//                 max x, max y): a coarse level keeps the atomics few
 #include "shared/pyramid.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
@@ -13,6 +15,11 @@ layout(std430, binding = SUBSCAN_SSBO_PYRAMID) buffer Pyramid {
 #if STAGE_COPY
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 #endif
+#if STAGE_BOUNDS
+layout(std430, binding = SUBSCAN_SSBO_POINT_BOUNDS) buffer PointBounds {
+    ivec4 pointBounds;
+};
+#endif
 
 void main() {
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
@@ -21,6 +28,13 @@ void main() {
     }
 #if STAGE_COPY
     minDepth[texelIndex(0u, texel)] = imageLoad(inDepth, texel).r;
+#elif STAGE_BOUNDS
+    if (!isinf(minDepth[texelIndex(level, texel)])) {
+        atomicMin(pointBounds.x, texel.x);
+        atomicMin(pointBounds.y, texel.y);
+        atomicMax(pointBounds.z, texel.x);
+        atomicMax(pointBounds.w, texel.y);
+    }
 #else
     float nearest = kInfinity;
     for (int dy = 0; dy < 2; ++dy) {

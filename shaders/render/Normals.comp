@@ -6,6 +6,7 @@
 //   STAGE_LEVEL  normals of level `level` into the normal pyramid
 //   STAGE_BLEND  the per-pixel blend into the "normals" image (view space)
 #include "shared/pyramid.glsl"
+#include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
@@ -58,7 +59,7 @@ vec3 normalOnLevel(uint normalLevel, vec2 window) {
 #endif
 
 void main() {
-    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 texel = dispatchTexel();
 #if STAGE_LEVEL
     if (!insideLevel(level, texel)) {
         return;

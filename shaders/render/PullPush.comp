@@ -9,6 +9,7 @@
 //                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 also
 //                    writes the "filledDepth" and "filledColor" images.
 #include "shared/pyramid.glsl"
+#include "shared/region.glsl"
 
 
 
@@ -39,7 +40,7 @@ layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor
 const float kPullKernel[4] = float[](1.0 / 3.0, 1.0, 1.0, 1.0 / 3.0);
 
 void main() {
-    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 texel = dispatchTexel();
     if (!insideLevel(level, texel)) {
         return;
     }

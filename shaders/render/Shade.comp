@@ -4,6 +4,7 @@
 // passes: "diffuse" (radiance leaving by diffuse reflection), "specular", "albedo", and their
 // sum "radiance". Background pixels are zero in all of them.
 #include "shared/common.glsl"
+#include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform ShadeBlock {
@@ -30,7 +31,7 @@ void addLight(vec3 direction, vec3 radiance, vec3 normal, vec3 toEye, inout vec3
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = dispatchTexel();
     if (any(greaterThanEqual(pixel, imageSizeOfFrame()))) {
         return;
     }

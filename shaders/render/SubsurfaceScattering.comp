@@ -13,6 +13,7 @@
 // ignores whatever lies at another depth, so nothing bleeds across silhouettes. Taps outside the
 // surface are skipped and the weights renormalised, so a uniformly lit surface stays uniform.
 #include "shared/common.glsl"
+#include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform ScatterBlock {
@@ -48,7 +49,7 @@ vec3 albedoFactor(vec3 albedo, uint side) {
 }
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = dispatchTexel();
     ivec2 size = imageSizeOfFrame();
     if (any(greaterThanEqual(pixel, size))) {
         return;

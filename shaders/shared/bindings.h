@@ -24,7 +24,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UBO_SURFACE 3
 
 // ---- plain uniforms ----
-#define SUBSCAN_UNIFORM_LEVEL 0  // uint: the pyramid level a per-level dispatch works on
+#define SUBSCAN_UNIFORM_LEVEL 0   // uint: the pyramid level a per-level dispatch works on
+#define SUBSCAN_UNIFORM_ORIGIN 1  // ivec2: the texel of invocation (0, 0) (shared/region.glsl)
 
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_POSITIONS 0     // float x, y, z per point (cloud-relative)
@@ -37,6 +38,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_PULL_WEIGHTS 7  // float per texel, all levels: clamped weight w
 #define SUBSCAN_SSBO_PUSH_VALUES 8   // vec4 per texel, all levels: complete (depth, r, g, b)
 #define SUBSCAN_SSBO_NORMALS 9       // vec4 per texel, all levels: view-space normal, w unused
+#define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0

@@ -4,10 +4,18 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/vec2.hpp>
+
 #include "gpu/GlObjects.h"
 #include "gpu/ShaderSources.h"
 
 namespace subscan {
+
+/// A rectangle of texels on one image or pyramid level.
+struct TexelRegion {
+    glm::ivec2 origin{0};
+    glm::ivec2 size{0};
+};
 
 /// The variants of one compute shader, one per STAGE_* macro: `names` {"COPY", "REDUCE"} build
 /// the shader once with STAGE_COPY 1 (others 0), once with STAGE_REDUCE 1, and so on.
@@ -20,10 +28,14 @@ class ComputeStages {
     /// Runs `stage` over a width x height grid of image-sized work groups, with the per-level
     /// uniform set to `level` where the stage declares it.
     void runOverImage(std::size_t stage, int width, int height, unsigned level = 0) const;
+    /// The same over `region` only; the stage must take its texel from dispatchTexel()
+    /// (shared/region.glsl).
+    void runOverRegion(std::size_t stage, const TexelRegion& region, unsigned level = 0) const;
 
   private:
     std::vector<Program> programs_;
     std::vector<bool> hasLevelUniform_;
+    std::vector<bool> hasOriginUniform_;
 };
 
 }  // namespace subscan

@@ -1,5 +1,7 @@
 #include "render/FillRemovalPass.h"
 
+#include <limits>
+
 namespace subscan {
 
 FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
@@ -15,7 +17,13 @@ void FillRemovalPass::execute(FrameContext& frame) {
     resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    stages_.runOverImage(0, frame.width(), frame.height());
+    if (frame.restricted()) {
+        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        const float infinity[4] = {std::numeric_limits<float>::infinity(), 0.0f, 0.0f, 0.0f};
+        mask.clear(none);
+        surfaceDepth.clear(infinity);
+    }
+    stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

@@ -10,7 +10,7 @@ void HiddenPointRemovalPass::execute(FrameContext& frame) {
                                                         frame.width(), frame.height());
     frame.resources.buffer("pyramid").bindStorage(SUBSCAN_SSBO_PYRAMID);
     visibility.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    stages_.runOverImage(0, frame.width(), frame.height());
+    stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

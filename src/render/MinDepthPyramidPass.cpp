@@ -1,11 +1,15 @@
 #include "render/MinDepthPyramidPass.h"
 
+#include <algorithm>
+#include <limits>
+
 #include "render/Pyramid.h"
 
 namespace subscan {
 
 MinDepthPyramidPass::MinDepthPyramidPass(const ShaderSources& sources)
-    : stages_(sources, "render/MinDepthPyramid.comp", {"COPY", "REDUCE"}) {}
+    : stages_(sources, "render/MinDepthPyramid.comp", {"COPY", "REDUCE", "BOUNDS"}),
+      bounds_(sizeof(glm::ivec4), nullptr, "MinDepthPyramid.bounds") {}
 
 void MinDepthPyramidPass::execute(FrameContext& frame) {
     Buffer& pyramid =
@@ -19,6 +23,30 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
         stages_.runOverImage(Reduce, static_cast<int>(size.y), static_cast<int>(size.z), level);
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    frame.pointBounds.reset();
+    if (surfaceBoundsAllowed(frame.settings)) {
+        frame.pointBounds = measureBounds(frame);
+    }
+}
+
+glm::ivec4 MinDepthPyramidPass::measureBounds(const FrameContext& frame) {
+    // Level 4 texels are 16 pixels wide: few atomics, and bounds at most 15 pixels too wide.
+    const unsigned level = std::min(4u, frame.pyramid.info.x - 1);
+    const glm::ivec4 empty(std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), -1,
+                           -1);
+    bounds_.upload(0, sizeof(empty), &empty);
+    bounds_.bindStorage(SUBSCAN_SSBO_POINT_BOUNDS);
+    const auto& size = frame.pyramid.levels[level];
+    stages_.runOverImage(Bounds, static_cast<int>(size.y), static_cast<int>(size.z), level);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glm::ivec4 texels;
+    bounds_.download(0, sizeof(texels), &texels);
+    if (texels.z < 0) {
+        return glm::ivec4(0);
+    }
+    const int scale = 1 << level;
+    return {texels.x * scale, texels.y * scale, std::min((texels.z + 1) * scale, frame.width()),
+            std::min((texels.w + 1) * scale, frame.height())};
 }
 
 }  // namespace subscan

@@ -6,7 +6,8 @@
 namespace subscan {
 
 /// The min-depth pyramid of the rasterized depth (paper Fig. 3), every level in the buffer
-/// "pyramid" (see PyramidLayout).
+/// "pyramid" (see PyramidLayout). Where surfaceBoundsAllowed(), it also measures the bounds of
+/// the rasterized points into FrameContext::pointBounds for the passes after it.
 class MinDepthPyramidPass final : public RenderPass {
   public:
     explicit MinDepthPyramidPass(const ShaderSources& sources);
@@ -17,8 +18,11 @@ class MinDepthPyramidPass final : public RenderPass {
     void execute(FrameContext& frame) override;
 
   private:
-    enum Stage { Copy, Reduce };
+    enum Stage { Copy, Reduce, Bounds };
+    glm::ivec4 measureBounds(const FrameContext& frame);
+
     ComputeStages stages_;
+    Buffer bounds_;
 };
 
 }  // namespace subscan

@@ -15,13 +15,16 @@ void NormalsPass::execute(FrameContext& frame) {
     Texture& normals =
         resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
     for (unsigned level = 0; level < frame.pyramid.info.x; ++level) {
-        const auto& size = frame.pyramid.levels[level];
-        stages_.runOverImage(Level, static_cast<int>(size.y), static_cast<int>(size.z), level);
+        stages_.runOverRegion(Level, frame.region(level), level);
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    stages_.runOverImage(Blend, frame.width(), frame.height());
+    if (frame.restricted()) {
+        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        normals.clear(none);
+    }
+    stages_.runOverRegion(Blend, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

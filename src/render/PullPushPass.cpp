@@ -12,8 +12,12 @@ void PullPushPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
     resources.ensureBuffer("pullValues", texels * 4 * sizeof(float))
         .bindStorage(SUBSCAN_SSBO_PULL_VALUES);
-    resources.ensureBuffer("pullWeights", texels * sizeof(float))
-        .bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
+    Buffer& pullWeights = resources.ensureBuffer("pullWeights", texels * sizeof(float));
+    pullWeights.bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
+    if (frame.restricted()) {
+        // Pull and fill removal read weights around their region: there they must be zero.
+        pullWeights.fill(0);
+    }
     resources.ensureBuffer("pushValues", texels * 4 * sizeof(float))
         .bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
     Texture& filledDepth =
@@ -28,8 +32,7 @@ void PullPushPass::execute(FrameContext& frame) {
 
     const unsigned levels = frame.pyramid.info.x;
     auto run = [&](Stage stage, unsigned level) {
-        const auto& size = frame.pyramid.levels[level];
-        stages_.runOverImage(stage, static_cast<int>(size.y), static_cast<int>(size.z), level);
+        stages_.runOverRegion(stage, frame.region(level), level);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     };
     run(PullInit, 0);

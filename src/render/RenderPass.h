@@ -1,10 +1,12 @@
 #pragma once
 
+#include <optional>
 #include <string_view>
 #include <vector>
 
 #include "core/Camera.h"
 #include "gpu/GlContext.h"
+#include "render/ComputeStages.h"
 #include "render/FrameResources.h"
 #include "render/GpuPointCloud.h"
 #include "render/RenderSettings.h"
@@ -22,10 +24,23 @@ struct FrameContext {
     FrameResources& resources;
     const gpu::PyramidLayout& pyramid;
     double spacing;  // the point spacing h, scene units
+    /// Pixels [x, y, z, w) holding rasterized points, measured by MinDepthPyramidPass when
+    /// `surfaceBoundsAllowed(settings)`; unset, the passes after it work on the whole frame.
+    std::optional<glm::ivec4> pointBounds;
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }
+    bool restricted() const { return pointBounds.has_value(); }
+    /// The texels of pyramid `level` (0: the image) a pass must compute: those around the
+    /// points, with a margin for the 4x4 pull and the bilinear push and normal reads.
+    TexelRegion region(unsigned level) const;
 };
+
+/// Whether the passes after rasterization may skip the screen outside the points' bounds: when
+/// no pixel there can become surface (fill removal needs 6 or more of the 8 directions, and a
+/// pixel beside the bounds finds points in at most 5) and the frame shows no intermediate
+/// stage (those show pull-push's fill of the whole screen).
+bool surfaceBoundsAllowed(const RenderSettings& settings);
 
 /// One step of the frame pipeline: one class and one shader of the same name (Falcor's
 /// RenderPass). It declares the images it reads and writes by name so the runner can check the

@@ -42,7 +42,12 @@ void ShadePass::execute(FrameContext& frame) {
     specular.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     albedo.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
     radiance.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
-    stages_.runOverImage(0, width, height);
+    if (frame.restricted()) {
+        // The other outputs are read only on the surface; the radiance is exported whole.
+        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        radiance.clear(none);
+    }
+    stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

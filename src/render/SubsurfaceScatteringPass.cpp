@@ -72,6 +72,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     // The sum gathers one term per Gaussian: in half floats their roundings would add up.
     Texture& sum = resources.ensureTexture("sssSum", TextureFormat::RGBA32F, width, height);
     Texture& radiance = image("scatteredRadiance");
+    const TexelRegion region = frame.region(0);
 
     gpu::ScatterParams params{};
     params.blur.y = static_cast<float>(settings.maxTaps);
@@ -84,7 +85,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     resources.texture("albedo").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
     source.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     sum.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    stages_.runOverImage(Prepare, width, height);
+    stages_.runOverRegion(Prepare, region);
     glMemoryBarrier(kImageBarriers);
 
     for (const BlurStep& step : chain.steps) {
@@ -93,7 +94,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
         params_.set(params);
         (step.fromPrevious ? blurred : source).bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
         half.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-        stages_.runOverImage(Blur, width, height);
+        stages_.runOverRegion(Blur, region);
         glMemoryBarrier(kImageBarriers);
 
         params.blur.z = 1.0f;
@@ -102,7 +103,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
         half.bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
         blurred.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
         sum.bindImage(SUBSCAN_IMAGE_OUT1, GL_READ_WRITE);
-        stages_.runOverImage(BlurAccumulate, width, height);
+        stages_.runOverRegion(BlurAccumulate, region);
         glMemoryBarrier(kImageBarriers);
     }
 
@@ -110,7 +111,11 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     resources.texture("albedo").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
     resources.texture("specular").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
     radiance.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    stages_.runOverImage(Combine, width, height);
+    if (frame.restricted()) {
+        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+        radiance.clear(none);
+    }
+    stages_.runOverRegion(Combine, region);
     glMemoryBarrier(kImageBarriers);
 }
 

@@ -14,6 +14,7 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
         {"fill_radius", settings.fillRadius},
         {"fill_directions", settings.fillDirections},
         {"normal_radius", settings.normalRadius},
+        {"restrict_to_points", settings.restrictToPoints},
     };
 }
 
@@ -25,6 +26,7 @@ void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
     readSetting(json, "fill_radius", settings.fillRadius, 0.1f, 1000.0f);
     readSetting(json, "fill_directions", settings.fillDirections, 1, 8);
     readSetting(json, "normal_radius", settings.normalRadius, 0.1f, 1000.0f);
+    readSetting(json, "restrict_to_points", settings.restrictToPoints);
 }
 
 void to_json(nlohmann::json& json, const ShadingSettings& settings) {

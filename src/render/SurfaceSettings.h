@@ -19,6 +19,7 @@ struct SurfaceSettings {
     float fillRadius = 1.0f;           // the expected gap between points (x h)
     int fillDirections = 8;            // of 8 directions, how many must find points
     float normalRadius = 1.5f;         // normal smoothing (x h)
+    bool restrictToPoints = true;      // passes skip the screen outside the points' bounds
 };
 
 struct DirectionalLight {

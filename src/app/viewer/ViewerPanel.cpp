@@ -282,6 +282,10 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
     ImGui::SliderInt("fill directions", &surface.fillDirections, 1, 8);
     ImGui::SliderFloat("normal radius (h)", &surface.normalRadius, 0.25f, 16.0f, "%.2f",
                        kLogarithmic);
+    ImGui::Checkbox("skip the screen around the points", &surface.restrictToPoints);
+    helpTooltip(
+        "Passes after rasterization work only inside the points' bounds (the same "
+        "picture, faster when the scan covers part of the window).");
 }
 
 void ViewerPanel::drawShading(ShadingSettings& shading) {

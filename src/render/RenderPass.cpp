@@ -1,0 +1,39 @@
+#include "render/RenderPass.h"
+
+#include <algorithm>
+
+namespace subscan {
+
+namespace {
+
+/// Texels around the points' bounds on every level: pull reads children up to 2 texels
+/// beyond a texel's own footprint, so a level's non-zero weights reach at most 2 texels past
+/// the bounds scaled to it; push and normals read 1 texel around what they serve.
+constexpr int kRegionMargin = 2;
+
+}  // namespace
+
+TexelRegion FrameContext::region(unsigned level) const {
+    const glm::ivec2 size(static_cast<int>(pyramid.levels[level].y),
+                          static_cast<int>(pyramid.levels[level].z));
+    if (!pointBounds) {
+        return {glm::ivec2(0), size};
+    }
+    const glm::ivec4& bounds = *pointBounds;
+    if (bounds.z <= bounds.x || bounds.w <= bounds.y) {
+        return {glm::ivec2(0), glm::ivec2(0)};
+    }
+    const glm::ivec2 first =
+        glm::max(glm::ivec2(bounds.x, bounds.y) / (1 << level) - kRegionMargin, glm::ivec2(0));
+    const glm::ivec2 last =
+        glm::min((glm::ivec2(bounds.z, bounds.w) - 1) / (1 << level) + kRegionMargin, size - 1);
+    return {first, last - first + 1};
+}
+
+bool surfaceBoundsAllowed(const RenderSettings& settings) {
+    const Stage stage = settings.raster.stage;
+    return settings.surface.restrictToPoints && settings.surface.fillDirections >= 6 &&
+           (stage == Stage::Final || stage == Stage::Shaded);
+}
+
+}  // namespace subscan
