@@ -39,6 +39,8 @@ glm::ivec4 MinDepthPyramidPass::measureBounds(const FrameContext& frame) {
     const auto& size = frame.pyramid.levels[level];
     stages_.runOverImage(Bounds, static_cast<int>(size.y), static_cast<int>(size.z), level);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    // Reading back waits for the frame so far: free on llvmpipe, which finishes every pass
+    // anyway; on a GPU an indirect dispatch would avoid the stall.
     glm::ivec4 texels;
     bounds_.download(0, sizeof(texels), &texels);
     if (texels.z < 0) {
