@@ -171,8 +171,8 @@ void Texture::bindSampler(GLuint unit) const {
     glBindTextureUnit(unit, id());
 }
 
-void Texture::clear(const float value[4]) {
-    glClearTexImage(id(), 0, info(format_).pixelFormat, GL_FLOAT, value);
+void Texture::clear(const glm::vec4& value) {
+    glClearTexImage(id(), 0, info(format_).pixelFormat, GL_FLOAT, &value.x);
 }
 
 namespace {

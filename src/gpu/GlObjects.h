@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <epoxy/gl.h>
+#include <glm/vec4.hpp>
 
 namespace subscan {
 
@@ -132,7 +133,7 @@ class Texture {
     void bindImage(GLuint unit, GLenum access) const;
     void bindSampler(GLuint unit) const;
     /// Sets every texel to `value` (as many components as the format has).
-    void clear(const float value[4]);
+    void clear(const glm::vec4& value = glm::vec4(0.0f));
 
     /// Texel values, row 0 first, `channels()` per texel (RGBA8 and R8 come back normalised to
     /// 0..1 by readFloats).

@@ -18,10 +18,8 @@ void FillRemovalPass::execute(FrameContext& frame) {
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-        const float infinity[4] = {std::numeric_limits<float>::infinity(), 0.0f, 0.0f, 0.0f};
-        mask.clear(none);
-        surfaceDepth.clear(infinity);
+        mask.clear();
+        surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
     }
     stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -21,8 +21,7 @@ void NormalsPass::execute(FrameContext& frame) {
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-        normals.clear(none);
+        normals.clear();
     }
     stages_.runOverRegion(Blend, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -44,8 +44,7 @@ void ShadePass::execute(FrameContext& frame) {
     radiance.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
     if (frame.restricted()) {
         // The other outputs are read only on the surface; the radiance is exported whole.
-        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-        radiance.clear(none);
+        radiance.clear();
     }
     stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

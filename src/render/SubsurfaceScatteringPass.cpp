@@ -112,8 +112,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     resources.texture("specular").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
     radiance.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        const float none[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-        radiance.clear(none);
+        radiance.clear();
     }
     stages_.runOverRegion(Combine, region);
     glMemoryBarrier(kImageBarriers);
