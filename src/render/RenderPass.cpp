@@ -31,9 +31,8 @@ TexelRegion FrameContext::region(unsigned level) const {
 }
 
 bool surfaceBoundsAllowed(const RenderSettings& settings) {
-    const Stage stage = settings.raster.stage;
     return settings.surface.restrictToPoints && settings.surface.fillDirections >= 6 &&
-           (stage == Stage::Final || stage == Stage::Shaded);
+           isFinalImage(settings.raster.stage);
 }
 
 }  // namespace subscan

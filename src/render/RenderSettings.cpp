@@ -60,6 +60,13 @@ Stage parseStage(std::string_view text) {
     return parseName(kStages, text, "stage");
 }
 
+bool reconstructsSurface(RenderMode mode) {
+    return mode == RenderMode::Surface || mode == RenderMode::Sss;
+}
+bool isFinalImage(Stage stage) {
+    return stage == Stage::Final || stage == Stage::Shaded;
+}
+
 void to_json(nlohmann::json& json, const RasterSettings& settings) {
     json = {
         {"mode", toString(settings.mode)},

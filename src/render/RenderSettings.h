@@ -69,4 +69,9 @@ RasterPath parseRasterPath(std::string_view text);
 std::string toString(Stage stage);
 Stage parseStage(std::string_view text);
 
+/// Whether `mode` reconstructs a surface (the surface and sss modes).
+bool reconstructsSurface(RenderMode mode);
+/// Whether `stage` is a finished picture rather than an intermediate image of the pipeline.
+bool isFinalImage(Stage stage);
+
 }  // namespace subscan

@@ -67,8 +67,8 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
     } else {
         passes.push_back(&cached(rasterize_, sources_, capabilities()));
     }
-    const bool stageView = raster.stage != Stage::Final && raster.stage != Stage::Shaded;
-    const bool surface = raster.mode == RenderMode::Surface || raster.mode == RenderMode::Sss;
+    const bool stageView = !isFinalImage(raster.stage);
+    const bool surface = reconstructsSurface(raster.mode);
     if (surface) {
         passes.push_back(&cached(minDepthPyramid_, sources_));
         passes.push_back(&cached(hiddenPointRemoval_, sources_));

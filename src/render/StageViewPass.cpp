@@ -20,7 +20,7 @@ std::string stageMacro(Stage stage) {
 
 StageViewPass::StageViewPass(const ShaderSources& sources, Stage stage)
     : stage_(stage), stages_(sources, "render/StageView.comp", {stageMacro(stage)}) {
-    if (stage == Stage::Final || stage == Stage::Shaded) {
+    if (isFinalImage(stage)) {
         throw Error(
             fmt::format("the stage '{}' is a final image, not a stage view", toString(stage)));
     }

@@ -122,7 +122,7 @@ void exportBuffers(const std::filesystem::path& directory, const Renderer& rende
                                 error.message()));
     }
     const FrameResources& resources = renderer.resources();
-    const bool surface = mode == RenderMode::Surface || mode == RenderMode::Sss;
+    const bool surface = reconstructsSurface(mode);
     writeCameraFile(directory / "camera.json", camera);
     const Texture& depthTexture = resources.texture(surface ? "surfaceDepth" : "depth");
     const std::vector<float> depth = depthTexture.readFloats();
@@ -269,8 +269,9 @@ Command addRenderCommand(CLI::App& parent) {
         ->check(CLI::IsMember({"mm", "cm", "m", "in"}));
     render->add_option("--sss-scale", options->sssScale, "Multiplies every scattering radius")
         ->check(CLI::Range(0.0f, 1000.0f));
-    render->add_option("--albedo", options->albedo,
-                       "Where the colour enters the scattering: pre | post | split")
+    render
+        ->add_option("--albedo", options->albedo,
+                     "Where the colour enters the scattering: pre | post | split")
         ->check(CLI::IsMember({"pre", "post", "split"}));
     render->add_option("--point-size", options->pointSize, "Splat size in pixels (splats mode)")
         ->check(CLI::Range(1.0f, 64.0f));

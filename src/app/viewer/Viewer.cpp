@@ -51,10 +51,6 @@ bool sameCamera(const Camera& a, const Camera& b) {
            a.nearPlane == b.nearPlane && a.farPlane == b.farPlane && a.view == b.view;
 }
 
-bool surfaceMode(RenderMode mode) {
-    return mode == RenderMode::Surface || mode == RenderMode::Sss;
-}
-
 /// NAME.png -> NAME.camera.json and the like.
 std::filesystem::path sidecarPath(const std::filesystem::path& image, std::string_view suffix) {
     std::filesystem::path path = image;
@@ -380,40 +376,38 @@ void Viewer::runScript() {
 
 void Viewer::runScriptCommand(const ScriptCommand& command) {
     const glm::ivec2 size = viewportSize();
-    std::visit(
-        Overloaded{
-            [&](const script::Orbit& orbit) { camera_.orbit(orbit.dx, orbit.dy); },
-            [&](const script::Pan& pan) {
-                const glm::dvec2 pixels =
-                    glm::dvec2(pan.dx, pan.dy) * context_.windowToFramebufferScale();
-                camera_.pan(pixels.x, pixels.y, size.y);
-            },
-            [&](const script::Zoom& zoom) {
-                // What the user would have seen under the cursor: the current view.
-                renderIfNeeded();
-                zoomAt(zoom.at.value_or(windowCentre()), zoom.amount);
-            },
-            [&](const script::Pick& pick) {
-                renderIfNeeded();
-                pickCentreAt(pick.at.value_or(windowCentre()));
-            },
-            [&](const script::Reset&) { camera_.reset(size.x, size.y); },
-            [&](const script::FrameAll&) { camera_.frameAll(size.x, size.y); },
-            [&](const script::Resize& resize) { resizeWindow(resize.width, resize.height); },
-            [&](const script::Screenshot& screenshot) {
-                pendingScreenshots_.push_back(screenshot.path);
-            },
-            [&](const script::SetMode& mode) {
-                settings_.raster.mode = mode.mode;
-                const Stage stage = settings_.raster.stage;
-                if (!surfaceMode(mode.mode) && stage != Stage::Final && stage != Stage::Depth) {
-                    settings_.raster.stage = Stage::Final;
-                }
-            },
-            [&](const script::ShowPanel& panel) { showPanel_ = panel.show; },
-            [&](const script::Exit&) { exitRequested_ = true; },
-        },
-        command);
+    std::visit(Overloaded{
+                   [&](const script::Orbit& orbit) { camera_.orbit(orbit.dx, orbit.dy); },
+                   [&](const script::Pan& pan) {
+                       const glm::dvec2 pixels =
+                           glm::dvec2(pan.dx, pan.dy) * context_.windowToFramebufferScale();
+                       camera_.pan(pixels.x, pixels.y, size.y);
+                   },
+                   [&](const script::Zoom& zoom) {
+                       // What the user would have seen under the cursor: the current view.
+                       renderIfNeeded();
+                       zoomAt(zoom.at.value_or(windowCentre()), zoom.amount);
+                   },
+                   [&](const script::Pick& pick) {
+                       renderIfNeeded();
+                       pickCentreAt(pick.at.value_or(windowCentre()));
+                   },
+                   [&](const script::Reset&) { camera_.reset(size.x, size.y); },
+                   [&](const script::FrameAll&) { camera_.frameAll(size.x, size.y); },
+                   [&](const script::Resize& resize) { resizeWindow(resize.width, resize.height); },
+                   [&](const script::Screenshot& screenshot) {
+                       pendingScreenshots_.push_back(screenshot.path);
+                   },
+                   [&](const script::SetMode& mode) {
+                       settings_.raster.mode = mode.mode;
+                       if (!stageAvailable(settings_.raster.stage, mode.mode)) {
+                           settings_.raster.stage = Stage::Final;
+                       }
+                   },
+                   [&](const script::ShowPanel& panel) { showPanel_ = panel.show; },
+                   [&](const script::Exit&) { exitRequested_ = true; },
+               },
+               command);
 }
 
 void Viewer::resizeWindow(int width, int height) {
@@ -551,8 +545,9 @@ std::optional<glm::dvec3> Viewer::surfacePointAt(const glm::dvec2& windowPositio
         return std::nullopt;
     }
     const FrameResources& resources = renderer_->resources();
-    const char* name =
-        surfaceMode(renderedMode_) && resources.has("surfaceDepth") ? "surfaceDepth" : "depth";
+    const char* name = reconstructsSurface(renderedMode_) && resources.has("surfaceDepth")
+                           ? "surfaceDepth"
+                           : "depth";
     if (!resources.has(name)) {
         return std::nullopt;
     }

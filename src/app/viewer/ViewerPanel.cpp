@@ -35,15 +35,6 @@ constexpr ImGuiSliderFlags kLogarithmic = ImGuiSliderFlags_Logarithmic;
 // Colours that are radiances: linear and allowed above 1.
 constexpr ImGuiColorEditFlags kRadiance = ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR;
 
-bool surfaceMode(RenderMode mode) {
-    return mode == RenderMode::Surface || mode == RenderMode::Sss;
-}
-
-/// The stages the Renderer can show in `mode` (the others need the surface passes).
-bool stageAvailable(Stage stage, RenderMode mode) {
-    return surfaceMode(mode) || stage == Stage::Final || stage == Stage::Depth;
-}
-
 /// A combo over `choices`, labelled by `name`; true when the user picked another one.
 template <class T, class Name>
 bool choiceCombo(const char* label, T& value, std::span<const T> choices, Name name,
@@ -88,6 +79,10 @@ void helpTooltip(const char* text) {
 }
 
 }  // namespace
+
+bool stageAvailable(Stage stage, RenderMode mode) {
+    return reconstructsSurface(mode) || stage == Stage::Final || stage == Stage::Depth;
+}
 
 PanelRequests ViewerPanel::draw(RenderSettings& settings, Navigation& navigation,
                                 bool& redrawEveryFrame, const PanelStatus& status) {

@@ -14,6 +14,9 @@ namespace subscan::viewer {
 
 enum class Navigation { Orbit, Fly };
 
+/// The stages the Renderer can show in `mode` (the others need the surface passes).
+bool stageAvailable(Stage stage, RenderMode mode);
+
 /// What the panel shows but does not change.
 struct PanelStatus {
     std::string scanSource;  // empty until the first scan is shown
