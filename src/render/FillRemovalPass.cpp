@@ -1,11 +1,14 @@
 #include "render/FillRemovalPass.h"
 
+#include <cstdint>
 #include <limits>
+
+#include "render/Pyramid.h"
 
 namespace subscan {
 
 FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
-    : stages_(sources, "render/FillRemoval.comp", {"ALL"}) {}
+    : stages_(sources, "render/FillRemoval.comp", {"REACH", "MASK"}) {}
 
 void FillRemovalPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
@@ -14,6 +17,8 @@ void FillRemovalPass::execute(FrameContext& frame) {
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
     resources.buffer("pullWeights").bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
+    resources.ensureBuffer("fillReach", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t))
+        .bindStorage(SUBSCAN_SSBO_FILL_REACH);
     resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
@@ -21,7 +26,12 @@ void FillRemovalPass::execute(FrameContext& frame) {
         mask.clear();
         surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
     }
-    stages_.runOverRegion(0, frame.region(0));
+    // Coarsest first: every level reads its parent's answer. Level 0 is part of the mask stage.
+    for (unsigned level = frame.pyramid.info.x; level-- > 1;) {
+        stages_.runOverRegion(Reach, frame.region(level), level);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    stages_.runOverRegion(Mask, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

@@ -6,7 +6,8 @@
 namespace subscan {
 
 /// Separates surface from filled background (DESIGN.md §5.4, "fill removal"): "mask" is 1 where
-/// the pull weight on the level of the expected point gap reaches the threshold, and
+/// visible points surround the pixel up to the level of the expected point gap (found through
+/// the per-direction "fillReach" pyramid), and
 /// "surfaceDepth" holds the filled depth there (+inf elsewhere).
 class FillRemovalPass final : public RenderPass {
   public:
@@ -14,10 +15,13 @@ class FillRemovalPass final : public RenderPass {
 
     std::string_view name() const override { return "FillRemoval"; }
     std::vector<std::string_view> inputs() const override { return {"filledDepth", "pullWeights"}; }
-    std::vector<std::string_view> outputs() const override { return {"mask", "surfaceDepth"}; }
+    std::vector<std::string_view> outputs() const override {
+        return {"fillReach", "mask", "surfaceDepth"};
+    }
     void execute(FrameContext& frame) override;
 
   private:
+    enum Stage { Reach, Mask };
     ComputeStages stages_;
 };
 
