@@ -21,16 +21,13 @@ layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility
 const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
                                      ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
 
-void main() {
-    ivec2 pixel = dispatchTexel();
-    if (!insideLevel(0u, pixel)) {
-        return;
-    }
-    float depth = minDepth[texelIndex(0u, pixel)];
-    if (isinf(depth)) {
-        imageStore(outVisibility, pixel, vec4(0.0));
-        return;
-    }
+// The pixels of this work group that hold a point, gathered so that the first invocations test
+// them together: llvmpipe runs 8 invocations in lock-step, and on close-ups, where points are
+// sparse and L(x) is large, most lanes would otherwise idle through their neighbours' walks.
+shared uint occupied[gl_WorkGroupSize.x * gl_WorkGroupSize.y];
+shared uint occupiedCount;
+
+bool visibleAt(ivec2 pixel, float depth) {
     vec3 x = viewPositionAt(vec2(pixel) + 0.5, depth);
     vec3 toCamera = normalize(-x);
     float maxLevel = clamp(levelForRadius(surface.visibility.x, depth), 0.0,
@@ -72,5 +69,28 @@ void main() {
             visible = run && open >= 3;
         }
     }
-    imageStore(outVisibility, pixel, vec4(visible ? 1.0 : 0.0));
+    return visible;
+}
+
+void main() {
+    if (gl_LocalInvocationIndex == 0u) {
+        occupiedCount = 0u;
+    }
+    barrier();
+    ivec2 pixel = dispatchTexel();
+    if (insideLevel(0u, pixel)) {
+        if (isinf(minDepth[texelIndex(0u, pixel)])) {
+            imageStore(outVisibility, pixel, vec4(0.0));
+        } else {
+            occupied[atomicAdd(occupiedCount, 1u)] = gl_LocalInvocationIndex;
+        }
+    }
+    barrier();
+    if (gl_LocalInvocationIndex < occupiedCount) {
+        uint local = occupied[gl_LocalInvocationIndex];
+        ivec2 target = pixel - ivec2(gl_LocalInvocationID.xy) +
+                       ivec2(local % gl_WorkGroupSize.x, local / gl_WorkGroupSize.x);
+        bool visible = visibleAt(target, minDepth[texelIndex(0u, target)]);
+        imageStore(outVisibility, target, vec4(visible ? 1.0 : 0.0));
+    }
 }
