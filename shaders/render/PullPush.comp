@@ -6,8 +6,8 @@
 //                    Kraus: only children on the front-most surface take part (see below).
 //   STAGE_PUSH_TOP   the coarsest level: complete value a / w
 //   STAGE_PUSH       level R from R+1: m = bilinear of the complete coarser level with the
-//                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 also
-//                    writes the "filledDepth" and "filledColor" images.
+//                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 goes to
+//                    the "filledDepth" and "filledColor" images instead of the buffer.
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
 
@@ -56,36 +56,34 @@ void main() {
     // more than `slope` texel widths (at that depth) belongs to a surface behind and is left out.
     // Plain pull-push would blend both, and at an occluder's edge fill its gaps with depths from
     // behind it; a surface steeper than the slope (atan 8 = 83 degrees by default) is cut.
+    // The 16 children are read once into registers; both loops below are unrolled.
+    float weights[16];
+    vec4 values[16];
+    float depths[16];
     float front = kInfinity;
-    for (int j = 0; j < 4; ++j) {
-        for (int i = 0; i < 4; ++i) {
-            ivec2 child = 2 * texel + ivec2(i - 1, j - 1);
-            if (insideLevel(level - 1u, child)) {
-                uint childIndex = texelIndex(level - 1u, child);
-                float w = pullWeight[childIndex];
-                if (w > 0.0) {
-                    front = min(front, pullValue[childIndex].x / w);
-                }
+    for (int c = 0; c < 16; ++c) {
+        ivec2 child = 2 * texel + ivec2(c % 4 - 1, c / 4 - 1);
+        weights[c] = 0.0;
+        values[c] = vec4(0.0);
+        depths[c] = kInfinity;
+        if (insideLevel(level - 1u, child)) {
+            uint childIndex = texelIndex(level - 1u, child);
+            weights[c] = pullWeight[childIndex];
+            if (weights[c] > 0.0) {
+                values[c] = pullValue[childIndex];
+                depths[c] = values[c].x / weights[c];
+                front = min(front, depths[c]);
             }
         }
     }
     float tolerance = surface.fill.z * float(1u << level) * front / frame.depthRange.z;
     float weightSum = 0.0;
     vec4 valueSum = vec4(0.0);
-    for (int j = 0; j < 4; ++j) {
-        for (int i = 0; i < 4; ++i) {
-            ivec2 child = 2 * texel + ivec2(i - 1, j - 1);
-            if (!insideLevel(level - 1u, child)) {
-                continue;
-            }
-            uint childIndex = texelIndex(level - 1u, child);
-            float w = pullWeight[childIndex];
-            if (w <= 0.0 || pullValue[childIndex].x / w > front + tolerance) {
-                continue;
-            }
-            float h = kPullKernel[i] * kPullKernel[j];
-            weightSum += h * w;
-            valueSum += h * pullValue[childIndex];
+    for (int c = 0; c < 16; ++c) {
+        if (weights[c] > 0.0 && depths[c] <= front + tolerance) {
+            float h = kPullKernel[c % 4] * kPullKernel[c / 4];
+            weightSum += h * weights[c];
+            valueSum += h * values[c];
         }
     }
     float clamped = min(1.0, weightSum);
@@ -107,10 +105,12 @@ void main() {
     // 0 * inf = NaN).
     float weight = pullWeight[index];
     vec4 complete = weight >= 1.0 ? pullValue[index] : pullValue[index] + (1.0 - weight) * m;
-    pushValue[index] = complete;
+    // Level 0 lives only in the images: nothing reads it from the buffer.
     if (level == 0u) {
         imageStore(outDepth, texel, vec4(complete.x));
         imageStore(outColor, texel, vec4(complete.yzw, 1.0));
+    } else {
+        pushValue[index] = complete;
     }
 #endif
 }

@@ -36,10 +36,10 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_PYRAMID 5       // float per texel, all levels: min depth
 #define SUBSCAN_SSBO_PULL_VALUES 6   // vec4 per texel, all levels: w * (depth, r, g, b)
 #define SUBSCAN_SSBO_PULL_WEIGHTS 7  // float per texel, all levels: clamped weight w
-#define SUBSCAN_SSBO_PUSH_VALUES 8   // vec4 per texel, all levels: complete (depth, r, g, b)
-#define SUBSCAN_SSBO_NORMALS 9       // vec4 per texel, all levels: view-space normal, w unused
+#define SUBSCAN_SSBO_PUSH_VALUES 8   // vec4 per texel, levels >= 1: complete (depth, r, g, b)
+#define SUBSCAN_SSBO_NORMALS 9       // vec4 per texel, levels >= 1: view-space normal, w unused
 #define SUBSCAN_SSBO_POINT_BOUNDS 10 // ivec4: min x, min y, max x, max y of occupied texels
-#define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: 8 x 4-bit nearest level with weight
+#define SUBSCAN_SSBO_FILL_REACH 11   // uint per texel, all levels: 8 x 4-bit nearest level with weight
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0

@@ -14,7 +14,9 @@ void NormalsPass::execute(FrameContext& frame) {
     resources.buffer("pushValues").bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
     Texture& normals =
         resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
-    for (unsigned level = 0; level < frame.pyramid.info.x; ++level) {
+    // From level 1: the blend never reads level 0 (its smoothing level is at least 1), and the
+    // push leaves level 0 in the filled images only.
+    for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
         stages_.runOverRegion(Level, frame.region(level), level);
     }
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

@@ -5,7 +5,7 @@
 
 namespace subscan {
 
-/// Normals of the reconstructed surface (DESIGN.md §5.5): per push level into the buffer
+/// Normals of the reconstructed surface (DESIGN.md §5.5): per push level from 1 into the buffer
 /// "normalPyramid", then blended per pixel between the two levels around its smoothing level
 /// into "normals" (view space, zero outside the mask).
 class NormalsPass final : public RenderPass {
