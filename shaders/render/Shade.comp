@@ -1,8 +1,8 @@
 #version 450
 // Deferred shading of the reconstructed surface: Lambert + Blinn-Phong under a light at the eye
-// and optional directional lights, plus ambient. The outputs stay apart for the scattering
-// passes: "diffuse" (radiance leaving by diffuse reflection), "specular", "albedo", and their
-// sum "radiance". Background pixels are zero in all of them.
+// and optional directional lights, plus ambient. Writes "radiance"; STAGE_SPLIT also writes its
+// parts for the scattering passes: "diffuse" (radiance leaving by diffuse reflection),
+// "specular" and "albedo". Background pixels are zero in all of them.
 #include "shared/common.glsl"
 #include "shared/region.glsl"
 
@@ -13,9 +13,11 @@ layout(std140, binding = SUBSCAN_UBO_PASS) uniform ShadeBlock {
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
 layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inNormals;
 layout(binding = SUBSCAN_IMAGE_IN2, rgba16f) readonly uniform image2D inFilledColor;
+#if STAGE_SPLIT
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outDiffuse;
 layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outSpecular;
 layout(binding = SUBSCAN_IMAGE_OUT2, rgba16f) writeonly uniform image2D outAlbedo;
+#endif
 layout(binding = SUBSCAN_IMAGE_OUT3, rgba16f) writeonly uniform image2D outRadiance;
 
 void addLight(vec3 direction, vec3 radiance, vec3 normal, vec3 toEye, inout vec3 diffuse,
@@ -37,9 +39,11 @@ void main() {
     }
     float depth = imageLoad(inSurfaceDepth, pixel).r;
     if (isinf(depth)) {
+#if STAGE_SPLIT
         imageStore(outDiffuse, pixel, vec4(0.0));
         imageStore(outSpecular, pixel, vec4(0.0));
         imageStore(outAlbedo, pixel, vec4(0.0));
+#endif
         imageStore(outRadiance, pixel, vec4(0.0));
         return;
     }
@@ -56,8 +60,10 @@ void main() {
                  specular);
     }
     vec3 diffuse = albedo * irradiance;
+#if STAGE_SPLIT
     imageStore(outDiffuse, pixel, vec4(diffuse, 1.0));
     imageStore(outSpecular, pixel, vec4(specular, 1.0));
     imageStore(outAlbedo, pixel, vec4(albedo, 1.0));
+#endif
     imageStore(outRadiance, pixel, vec4(diffuse + specular, 1.0));
 }

@@ -30,7 +30,7 @@ class ImageShader {
     ImageShader(GlContext& context, const GpuPointCloud& cloud)
         : context_(context),
           cloud_(cloud),
-          shade_(sources_),
+          shade_(sources_, ShadeOutputs::Radiance),
           present_(sources_, "radiance", "surfaceDepth") {}
 
     std::vector<std::uint8_t> shade(const Camera& camera, const RenderSettings& settings,

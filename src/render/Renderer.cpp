@@ -69,13 +69,15 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
     }
     const bool stageView = !isFinalImage(raster.stage);
     const bool surface = reconstructsSurface(raster.mode);
+    const bool scatters = raster.mode == RenderMode::Sss && raster.stage == Stage::Final;
     if (surface) {
         passes.push_back(&cached(minDepthPyramid_, sources_));
         passes.push_back(&cached(hiddenPointRemoval_, sources_));
         passes.push_back(&cached(pullPush_, sources_));
         passes.push_back(&cached(fillRemoval_, sources_));
         passes.push_back(&cached(normals_, sources_));
-        passes.push_back(&cached(shade_, sources_));
+        passes.push_back(scatters ? &cached(shadeSplit_, sources_, ShadeOutputs::Split)
+                                  : &cached(shade_, sources_, ShadeOutputs::Radiance));
     } else if (stageView && raster.stage != Stage::Depth) {
         throw Error(fmt::format("the stage '{}' exists only in the surface and sss modes",
                                 toString(raster.stage)));
@@ -83,7 +85,7 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
     if (stageView) {
         passes.push_back(&cached(stageViews_[raster.stage], sources_, raster.stage));
         passes.push_back(&present("stage", ""));
-    } else if (raster.mode == RenderMode::Sss && raster.stage == Stage::Final) {
+    } else if (scatters) {
         passes.push_back(&cached(subsurfaceScattering_, sources_));
         passes.push_back(&present("scatteredRadiance", "surfaceDepth"));
     } else if (surface) {

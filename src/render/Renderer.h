@@ -80,6 +80,7 @@ class Renderer {
     std::unique_ptr<FillRemovalPass> fillRemoval_;
     std::unique_ptr<NormalsPass> normals_;
     std::unique_ptr<ShadePass> shade_;
+    std::unique_ptr<ShadePass> shadeSplit_;
     std::unique_ptr<SubsurfaceScatteringPass> subsurfaceScattering_;
     std::map<Stage, std::unique_ptr<StageViewPass>> stageViews_;
     std::map<std::pair<std::string, std::string>, std::unique_ptr<PresentPass>> presents_;

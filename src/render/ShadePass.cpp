@@ -6,8 +6,17 @@
 
 namespace subscan {
 
-ShadePass::ShadePass(const ShaderSources& sources)
-    : stages_(sources, "render/Shade.comp", {"ALL"}) {}
+ShadePass::ShadePass(const ShaderSources& sources, ShadeOutputs outputs)
+    : outputs_(outputs),
+      stages_(sources, "render/Shade.comp",
+              {outputs == ShadeOutputs::Split ? "SPLIT" : "RADIANCE"}) {}
+
+std::vector<std::string_view> ShadePass::outputs() const {
+    if (outputs_ == ShadeOutputs::Split) {
+        return {"diffuse", "specular", "albedo", "radiance"};
+    }
+    return {"radiance"};
+}
 
 gpu::ShadeParams ShadePass::parameters(const ShadingSettings& settings, const Camera& camera) {
     gpu::ShadeParams params{};
@@ -29,18 +38,20 @@ void ShadePass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
     const int width = frame.width();
     const int height = frame.height();
-    Texture& diffuse = resources.ensureTexture("diffuse", TextureFormat::RGBA16F, width, height);
-    Texture& specular = resources.ensureTexture("specular", TextureFormat::RGBA16F, width, height);
-    Texture& albedo = resources.ensureTexture("albedo", TextureFormat::RGBA16F, width, height);
     Texture& radiance = resources.ensureTexture("radiance", TextureFormat::RGBA16F, width, height);
     params_.set(parameters(frame.settings.shading, frame.camera));
     params_.bind(SUBSCAN_UBO_PASS);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     resources.texture("normals").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     resources.texture("filledColor").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
-    diffuse.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    specular.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    albedo.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    if (outputs_ == ShadeOutputs::Split) {
+        resources.ensureTexture("diffuse", TextureFormat::RGBA16F, width, height)
+            .bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+        resources.ensureTexture("specular", TextureFormat::RGBA16F, width, height)
+            .bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+        resources.ensureTexture("albedo", TextureFormat::RGBA16F, width, height)
+            .bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    }
     radiance.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
     if (frame.restricted()) {
         // The other outputs are read only on the surface; the radiance is exported whole.

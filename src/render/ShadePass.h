@@ -7,25 +7,27 @@
 namespace subscan {
 
 /// Deferred shading of the reconstructed surface (DESIGN.md §5.6): Lambert + Blinn-Phong under
-/// a head light and optional directional lights, plus ambient. Writes "diffuse", "specular",
-/// "albedo" (kept apart for subsurface scattering) and their sum "radiance".
+/// a head light and optional directional lights, plus ambient. Writes "radiance", and with
+/// ShadeOutputs::Split also its parts "diffuse", "specular" and "albedo" for subsurface
+/// scattering (three more full-screen writes that the surface mode does not need).
+enum class ShadeOutputs { Radiance, Split };
+
 class ShadePass final : public RenderPass {
   public:
-    explicit ShadePass(const ShaderSources& sources);
+    ShadePass(const ShaderSources& sources, ShadeOutputs outputs);
 
     std::string_view name() const override { return "Shade"; }
     std::vector<std::string_view> inputs() const override {
         return {"surfaceDepth", "normals", "filledColor"};
     }
-    std::vector<std::string_view> outputs() const override {
-        return {"diffuse", "specular", "albedo", "radiance"};
-    }
+    std::vector<std::string_view> outputs() const override;
     void execute(FrameContext& frame) override;
 
     /// The shader's parameters for these settings and camera (directions into view space).
     static gpu::ShadeParams parameters(const ShadingSettings& settings, const Camera& camera);
 
   private:
+    ShadeOutputs outputs_;
     ComputeStages stages_;
     UniformBlock<gpu::ShadeParams> params_{"Shade.params"};
 };

@@ -76,7 +76,7 @@ std::optional<glm::ivec4> runFrame(PassHarness& harness) {
     PullPushPass(sources).execute(frame);
     FillRemovalPass(sources).execute(frame);
     NormalsPass(sources).execute(frame);
-    ShadePass(sources).execute(frame);
+    ShadePass(sources, ShadeOutputs::Split).execute(frame);
     SubsurfaceScatteringPass(sources).execute(frame);
     return frame.pointBounds;
 }

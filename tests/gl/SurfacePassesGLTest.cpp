@@ -561,19 +561,25 @@ TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
     std::vector<float> depth, color;
     runUpToNormals(harness, depth, color);
     FrameContext frame = harness.context();
-    ShadePass(harness.sources()).execute(frame);
     const FrameResources& resources = harness.resources();
+    ShadePass(harness.sources(), ShadeOutputs::Radiance).execute(frame);
+    const auto radianceOnly = resources.texture("radiance").readFloats();
+    EXPECT_FALSE(resources.has("diffuse"));  // the surface mode's shading writes no parts
+    ShadePass(harness.sources(), ShadeOutputs::Split).execute(frame);
     const auto surfaceDepth = resources.texture("surfaceDepth").readFloats();
     const auto normals = resources.texture("normals").readFloats();
     const auto albedo = resources.texture("filledColor").readFloats();
     const auto diffuse = resources.texture("diffuse").readFloats();
     const auto specular = resources.texture("specular").readFloats();
+    const auto radiance = resources.texture("radiance").readFloats();
+    const auto splitAlbedo = resources.texture("albedo").readFloats();
     const ShadingSettings& shading = harness.settings().shading;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
             if (std::isinf(surfaceDepth[i])) {
                 EXPECT_EQ(diffuse[4 * i], 0.0f);
+                EXPECT_EQ(radianceOnly[4 * i], 0.0f);
                 continue;
             }
             const glm::dvec3 toEye =
@@ -590,6 +596,11 @@ TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
                 // RGBA16F outputs: 11 significant bits, ~5e-4 relative.
                 EXPECT_NEAR(diffuse[4 * i + c], expectedDiffuse, 2e-3 * (1 + expectedDiffuse));
                 EXPECT_NEAR(specular[4 * i + c], expectedSpecular, 2e-3 * (1 + expectedSpecular));
+                const double expectedRadiance = expectedDiffuse + expectedSpecular;
+                EXPECT_NEAR(radiance[4 * i + c], expectedRadiance, 2e-3 * (1 + expectedRadiance));
+                EXPECT_NEAR(radianceOnly[4 * i + c], expectedRadiance,
+                            2e-3 * (1 + expectedRadiance));
+                EXPECT_NEAR(splitAlbedo[4 * i + c], a, 2e-3);
             }
         }
     }

@@ -129,13 +129,15 @@ void exportBuffers(const std::filesystem::path& directory, const Renderer& rende
     writePfm(directory / "depth.pfm", {camera.width, camera.height, 1, depth});
 
     // color.png: the point (or filled) colour, sRGB, alpha 0 where nothing is.
-    const std::vector<float> color = resources.texture(surface ? "albedo" : "color").readFloats();
+    const std::vector<float> color =
+        resources.texture(surface ? "filledColor" : "color").readFloats();
     Image8 png{camera.width, camera.height, 4, std::vector<std::uint8_t>(color.size())};
     for (std::size_t pixel = 0; pixel < depth.size(); ++pixel) {
+        const bool empty = std::isinf(depth[pixel]);  // the fill's colour reaches past the mask
         for (std::size_t c = 0; c < 3; ++c) {
-            png.pixels[4 * pixel + c] = srgb8Channel(color[4 * pixel + c]);
+            png.pixels[4 * pixel + c] = empty ? 0 : srgb8Channel(color[4 * pixel + c]);
         }
-        png.pixels[4 * pixel + 3] = std::isinf(depth[pixel]) ? 0 : 255;
+        png.pixels[4 * pixel + 3] = empty ? 0 : 255;
     }
     writePng(directory / "color.png", png);
     if (!surface) {
