@@ -1,5 +1,6 @@
 #include "render/PresentPass.h"
 
+#include "core/Srgb.h"
 #include "shared/bindings.h"
 
 namespace subscan {
@@ -8,9 +9,7 @@ PresentPass::PresentPass(const ShaderSources& sources, std::string colorInput,
                          std::string depthInput)
     : colorInput_(std::move(colorInput)),
       depthInput_(std::move(depthInput)),
-      program_(Program::compute(
-          sources, "render/Present.comp",
-          depthInput_.empty() ? "#define HAS_DEPTH 0\n" : "#define HAS_DEPTH 1\n")) {}
+      stages_(sources, "render/Present.comp", {depthInput_.empty() ? "COLOR" : "DEPTH"}) {}
 
 std::vector<std::string_view> PresentPass::inputs() const {
     if (depthInput_.empty()) {
@@ -27,9 +26,16 @@ void PresentPass::execute(FrameContext& frame) {
         frame.resources.texture(depthInput_).bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     }
     image.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    program_.use();
-    Program::dispatch2D(frame.width(), frame.height(), SUBSCAN_IMAGE_GROUP_SIZE,
-                        SUBSCAN_IMAGE_GROUP_SIZE);
+    if (depthInput_.empty() || !frame.restricted()) {
+        stages_.runOverImage(0, frame.width(), frame.height());
+    } else {
+        // The background exactly as the shader encodes it: linear (the frame uniform) to sRGB.
+        const glm::vec3& background = frame.settings.raster.backgroundSrgb;
+        image.clear(glm::vec4(linearToSrgb(srgbToLinear(background.r)),
+                              linearToSrgb(srgbToLinear(background.g)),
+                              linearToSrgb(srgbToLinear(background.b)), 1.0f));
+        stages_.runOverRegion(0, frame.region(0));
+    }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

@@ -2,14 +2,14 @@
 
 #include <string>
 
-#include "gpu/GlObjects.h"
-#include "gpu/ShaderSources.h"
+#include "render/ComputeStages.h"
 #include "render/RenderPass.h"
 
 namespace subscan {
 
 /// The final picture "image": the linear colour input encoded to sRGB 8-bit. When a depth input
-/// is named, pixels where it is +inf show the background.
+/// is named, pixels where it is +inf show the background, and a frame restricted to the points'
+/// bounds is encoded only there (the rest is cleared to the background).
 class PresentPass final : public RenderPass {
   public:
     PresentPass(const ShaderSources& sources, std::string colorInput, std::string depthInput);
@@ -22,7 +22,7 @@ class PresentPass final : public RenderPass {
   private:
     std::string colorInput_;
     std::string depthInput_;
-    Program program_;
+    ComputeStages stages_;
 };
 
 }  // namespace subscan
