@@ -14,6 +14,7 @@
 #include "render/HiddenPointRemovalPass.h"
 #include "render/MinDepthPyramidPass.h"
 #include "render/NormalsPass.h"
+#include "render/PresentPass.h"
 #include "render/PullPushPass.h"
 #include "render/ShadePass.h"
 #include "render/SubsurfaceScatteringPass.h"
@@ -78,6 +79,7 @@ std::optional<glm::ivec4> runFrame(PassHarness& harness) {
     NormalsPass(sources).execute(frame);
     ShadePass(sources, ShadeOutputs::Split).execute(frame);
     SubsurfaceScatteringPass(sources).execute(frame);
+    PresentPass(sources, "scatteredRadiance", "surfaceDepth").execute(frame);
     return frame.pointBounds;
 }
 
@@ -165,6 +167,9 @@ TEST(PointBoundsGLTest, RestrictedFrameEqualsTheWholeFrame) {
             }
         }
     }
+    // The final picture too, background included.
+    EXPECT_EQ(restricted.resources().texture("image").readRgba8(),
+              whole.resources().texture("image").readRgba8());
     // The patch's gaps are filled: more surface than points.
     EXPECT_GT(surfacePixels, 0.7 * (kPatch.x1 - kPatch.x0) * (kPatch.y1 - kPatch.y0));
 }
