@@ -1,7 +1,8 @@
 #version 450
 // Min-depth pyramid (paper Fig. 3): level 0 is the rasterized depth, a texel of level R the
 // minimum of its 2x2 children on level R-1 (children past an odd edge simply do not exist).
-//   STAGE_COPY    level 0 from the "depth" image
+//   STAGE_FIRST   levels 0 (a copy of the "depth" image) and 1 at once, one invocation per
+//                 level-1 texel: a quarter of the invocations of a separate copy
 //   STAGE_REDUCE  level `level` from level `level` - 1
 //   STAGE_BOUNDS  the bounds of the texels of level `level` that hold a depth (min x, min y,
 //                 max x, max y): a coarse level keeps the atomics few
@@ -12,7 +13,7 @@ layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
 layout(std430, binding = SUBSCAN_SSBO_PYRAMID) buffer Pyramid {
     float minDepth[];
 };
-#if STAGE_COPY
+#if STAGE_FIRST
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 #endif
 #if STAGE_BOUNDS
@@ -23,12 +24,17 @@ layout(std430, binding = SUBSCAN_SSBO_POINT_BOUNDS) buffer PointBounds {
 
 void main() {
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+#if STAGE_FIRST
+    // A one-pixel image has no level 1 but still needs its level 0.
+    if (any(greaterThanEqual(2 * texel, levelSize(0u)))) {
+        return;
+    }
+#else
     if (!insideLevel(level, texel)) {
         return;
     }
-#if STAGE_COPY
-    minDepth[texelIndex(0u, texel)] = imageLoad(inDepth, texel).r;
-#elif STAGE_BOUNDS
+#endif
+#if STAGE_BOUNDS
     if (!isinf(minDepth[texelIndex(level, texel)])) {
         atomicMin(pointBounds.x, texel.x);
         atomicMin(pointBounds.y, texel.y);
@@ -41,10 +47,18 @@ void main() {
         for (int dx = 0; dx < 2; ++dx) {
             ivec2 child = 2 * texel + ivec2(dx, dy);
             if (insideLevel(level - 1u, child)) {
+#if STAGE_FIRST
+                float depth = imageLoad(inDepth, child).r;
+                minDepth[texelIndex(0u, child)] = depth;
+                nearest = min(nearest, depth);
+#else
                 nearest = min(nearest, minDepth[texelIndex(level - 1u, child)]);
+#endif
             }
         }
     }
-    minDepth[texelIndex(level, texel)] = nearest;
+    if (level < levelCount()) {
+        minDepth[texelIndex(level, texel)] = nearest;
+    }
 #endif
 }

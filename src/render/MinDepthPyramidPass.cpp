@@ -8,7 +8,7 @@
 namespace subscan {
 
 MinDepthPyramidPass::MinDepthPyramidPass(const ShaderSources& sources)
-    : stages_(sources, "render/MinDepthPyramid.comp", {"COPY", "REDUCE", "BOUNDS"}),
+    : stages_(sources, "render/MinDepthPyramid.comp", {"FIRST", "REDUCE", "BOUNDS"}),
       bounds_(sizeof(glm::ivec4), nullptr, "MinDepthPyramid.bounds") {}
 
 void MinDepthPyramidPass::execute(FrameContext& frame) {
@@ -16,8 +16,8 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
         frame.resources.ensureBuffer("pyramid", pyramidTexels(frame.pyramid) * sizeof(float));
     pyramid.bindStorage(SUBSCAN_SSBO_PYRAMID);
     frame.resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    stages_.runOverImage(Copy, frame.width(), frame.height());
-    for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
+    stages_.runOverImage(First, (frame.width() + 1) / 2, (frame.height() + 1) / 2, 1);
+    for (unsigned level = 2; level < frame.pyramid.info.x; ++level) {
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         const auto& size = frame.pyramid.levels[level];
         stages_.runOverImage(Reduce, static_cast<int>(size.y), static_cast<int>(size.z), level);

@@ -18,7 +18,7 @@ class MinDepthPyramidPass final : public RenderPass {
     void execute(FrameContext& frame) override;
 
   private:
-    enum Stage { Copy, Reduce, Bounds };
+    enum Stage { First, Reduce, Bounds };
     glm::ivec4 measureBounds(const FrameContext& frame);
 
     ComputeStages stages_;
