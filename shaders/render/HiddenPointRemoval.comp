@@ -38,23 +38,19 @@ bool visibleAt(ivec2 pixel, float depth) {
     float omega[8];
     float sum = 0.0;
     for (int k = 0; k < 8; ++k) {
-        // A direction without any neighbour counts as open sideways (omega = 1).
-        float smallest = 1.0;
-        bool found = false;
+        // Branch-free: lanes in lock-step all take every step anyway. A missing neighbour
+        // gives +inf, and a direction without any counts as open sideways (omega = 1).
+        float smallest = kInfinity;
         for (uint level = 0u; level <= levels; ++level) {
             ivec2 texel = (pixel >> level) + kDirections[k];
-            if (!insideLevel(level, texel)) {
-                continue;
-            }
-            float neighbourDepth = minDepth[texelIndex(level, texel)];
-            if (isinf(neighbourDepth)) {
-                continue;
-            }
+            bool inside = insideLevel(level, texel);
+            float neighbourDepth =
+                minDepth[texelIndex(level, clamp(texel, ivec2(0), levelSize(level) - 1))];
             vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
             float value = 1.0 - dot(normalize(y - x), toCamera);
-            smallest = found ? min(smallest, value) : value;
-            found = true;
+            smallest = inside && !isinf(neighbourDepth) ? min(smallest, value) : smallest;
         }
+        smallest = isinf(smallest) ? 1.0 : smallest;
         omega[k] = smallest;
         sum += smallest;
     }
