@@ -62,19 +62,16 @@ void main() {
     float depths[16];
     float front = kInfinity;
     for (int c = 0; c < 16; ++c) {
+        // Branch-free, clamped reads: lanes in lock-step would take both sides anyway.
         ivec2 child = 2 * texel + ivec2(c % 4 - 1, c / 4 - 1);
-        weights[c] = 0.0;
-        values[c] = vec4(0.0);
-        depths[c] = kInfinity;
-        if (insideLevel(level - 1u, child)) {
-            uint childIndex = texelIndex(level - 1u, child);
-            weights[c] = pullWeight[childIndex];
-            if (weights[c] > 0.0) {
-                values[c] = pullValue[childIndex];
-                depths[c] = values[c].x / weights[c];
-                front = min(front, depths[c]);
-            }
-        }
+        uint childIndex =
+            texelIndex(level - 1u, clamp(child, ivec2(0), levelSize(level - 1u) - 1));
+        float weight = insideLevel(level - 1u, child) ? pullWeight[childIndex] : 0.0;
+        vec4 value = pullValue[childIndex];
+        weights[c] = weight;
+        values[c] = weight > 0.0 ? value : vec4(0.0);
+        depths[c] = weight > 0.0 ? value.x / weight : kInfinity;
+        front = min(front, depths[c]);
     }
     float tolerance = surface.fill.z * float(1u << level) * front / frame.depthRange.z;
     float weightSum = 0.0;
