@@ -10,7 +10,7 @@
 //                in 4 bits, the finest level l' >= level whose texel (t >> (l' - level)) + d_k
 //                has pull weight (15: none). A texel takes its own neighbour's level or else its
 //                parent's answer, so the mask stage reads 9 values per pixel instead of
-//                walking up to 8 (L(x) + 1) levels: on close-ups, where L(x) is large, that
+//                walking up to 8 x (L(x) + 1) texels: on close-ups, where L(x) is large, that
 //                walk dominated the frame.
 //   STAGE_MASK   writes "mask" (1 = surface) and "surfaceDepth" (the filled depth there, +inf
 //                elsewhere).

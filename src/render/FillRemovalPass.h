@@ -6,9 +6,9 @@
 namespace subscan {
 
 /// Separates surface from filled background (DESIGN.md §5.4, "fill removal"): "mask" is 1 where
-/// visible points surround the pixel up to the level of the expected point gap (found through
-/// the per-direction "fillReach" pyramid), and
-/// "surfaceDepth" holds the filled depth there (+inf elsewhere).
+/// visible points surround the pixel up to the level of the expected point gap (looked up in
+/// the per-direction "fillReach" pyramid), and "surfaceDepth" holds the filled depth there
+/// (+inf elsewhere).
 class FillRemovalPass final : public RenderPass {
   public:
     explicit FillRemovalPass(const ShaderSources& sources);
