@@ -49,6 +49,22 @@ bool looksLikePcd(std::span<const std::byte> file) {
     return false;
 }
 
+/// OFF meshes open with a keyword: OFF, optionally prefixed by ST, C, N, 4 or n (COFF, NOFF,
+/// STCNOFF...), then whitespace or the vertex counts. Their lines of numbers would otherwise
+/// pass for a point list and fail on the first face line.
+bool looksLikeOff(std::span<const std::byte> file) {
+    const std::string_view text(reinterpret_cast<const char*>(file.data()),
+                                std::min<std::size_t>(file.size(), 16));
+    const std::size_t keyword = text.find("OFF");
+    if (keyword == std::string_view::npos ||
+        text.substr(0, keyword).find_first_not_of("STCN4n") != std::string_view::npos) {
+        return false;
+    }
+    const std::size_t after = keyword + 3;
+    return after == text.size() || std::isspace(static_cast<unsigned char>(text[after])) != 0 ||
+           text.substr(after).starts_with("BINARY");
+}
+
 std::string lowerExtension(const std::filesystem::path& path) {
     std::string extension = path.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
@@ -71,6 +87,9 @@ ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::
     if (looksLikePcd(file)) {
         return ScanFormat::Pcd;
     }
+    if (looksLikeOff(file)) {
+        return ScanFormat::Off;
+    }
     // Content was not conclusive: the extension decides, and that reader explains what is wrong.
     const std::string extension = lowerExtension(path);
     if (extension == ".ply") {
@@ -84,6 +103,9 @@ ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::
     }
     if (extension == ".e57") {
         return ScanFormat::E57;
+    }
+    if (extension == ".off") {
+        return ScanFormat::Off;
     }
     if (extension == ".xyz" || extension == ".pts" || extension == ".txt" || extension == ".csv" ||
         extension == ".asc") {
@@ -124,6 +146,10 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
             throw Error(
                 "E57 files are not supported yet; convert the scan to PLY, LAS or PCD "
                 "(e.g. with CloudCompare or PDAL)");
+        case ScanFormat::Off:
+            throw Error(
+                "OFF meshes are not supported yet; convert the file to PLY (e.g. with MeshLab, "
+                "CloudCompare or Open3D), whose vertices subscan reads as points");
         case ScanFormat::Unknown:
             throw Error(
                 "its format is unknown: it is not PLY, LAS, PCD, E57 or a text list of "

@@ -12,7 +12,7 @@
 
 namespace subscan {
 
-enum class ScanFormat { Ply, Las, Pcd, Xyz, E57, Unknown };
+enum class ScanFormat { Ply, Las, Pcd, Xyz, E57, Off, Unknown };
 
 /// Picks the reader: by content (magic bytes) first, by file extension second.
 ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::path& path);

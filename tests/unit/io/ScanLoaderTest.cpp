@@ -33,6 +33,13 @@ TEST(ScanLoaderTest, ContentWinsOverExtension) {
     EXPECT_EQ(detectFormat(asBytes("# .PCD v.7 - Point Cloud Data\nVERSION .7\n"), "a.txt"),
               ScanFormat::Pcd);
     EXPECT_EQ(detectFormat(asBytes("VERSION 0.7\nFIELDS x y z\n"), "noext"), ScanFormat::Pcd);
+    for (const char* off :
+         {"OFF\n4 2 0\n", "COFF\r\n", "STCNOFF 4 2 0\n", "OFF", "OFF BINARY\n", "OFFBINARY\n"}) {
+        EXPECT_EQ(detectFormat(asBytes(off), "mesh.txt"), ScanFormat::Off) << off;
+    }
+    // Not OFF: other text that merely contains the letters.
+    EXPECT_EQ(detectFormat(asBytes("OFFSET 1 2 3\n"), "a.txt"), ScanFormat::Xyz);
+    EXPECT_EQ(detectFormat(asBytes("x OFF\n"), "a.txt"), ScanFormat::Xyz);
 }
 
 TEST(ScanLoaderTest, ExtensionDecidesWhenContentIsUnclear) {
@@ -40,6 +47,7 @@ TEST(ScanLoaderTest, ExtensionDecidesWhenContentIsUnclear) {
     EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.laz"), ScanFormat::Las);
     EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.pcd"), ScanFormat::Pcd);
     EXPECT_EQ(detectFormat(asBytes("garbage"), "scan.e57"), ScanFormat::E57);
+    EXPECT_EQ(detectFormat(asBytes("garbage"), "mesh.OFF"), ScanFormat::Off);
     for (const char* name : {"a.xyz", "a.pts", "a.txt", "a.csv", "a.asc"}) {
         EXPECT_EQ(detectFormat(asBytes("garbage"), name), ScanFormat::Xyz) << name;
     }
@@ -55,6 +63,10 @@ TEST(ScanLoaderTest, ErrorsNameTheFile) {
                 AllOf(StartsWith(unknown.string() + ": "), HasSubstr("format is unknown")));
     const auto e57 = dir.write("scan.e57", "ASTM-E57 and more");
     EXPECT_THAT(loadError(e57.string()), HasSubstr("E57 files are not supported yet"));
+    // An OFF mesh: before, its face lines were reported as a malformed point list.
+    const auto off = dir.write("mesh.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n");
+    EXPECT_THAT(loadError(off.string()),
+                AllOf(StartsWith(off.string() + ": "), HasSubstr("OFF meshes are not supported")));
     EXPECT_THAT(loadError((dir / "missing.ply").string()),
                 HasSubstr("missing.ply: cannot open the file: No such file"));
     EXPECT_THAT(loadError(dir.path().string()), HasSubstr("is a directory"));
