@@ -28,18 +28,18 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_ORIGIN 1  // ivec2: the texel of invocation (0, 0) (shared/region.glsl)
 
 // ---- shader storage blocks (std430) ----
-#define SUBSCAN_SSBO_POSITIONS 0     // float x, y, z per point (cloud-relative)
-#define SUBSCAN_SSBO_COLORS 1        // uint RGBA8, sRGB-encoded, per point
-#define SUBSCAN_SSBO_DEPTH_BITS 2    // uint per pixel: floatBitsToUint(linear depth)
-#define SUBSCAN_SSBO_POINT_INDEX 3   // uint per pixel: the winning point
-#define SUBSCAN_SSBO_DEPTH_INDEX 4   // uint64 per pixel: depth bits << 32 | point index
-#define SUBSCAN_SSBO_PYRAMID 5       // float per texel, all levels: min depth
-#define SUBSCAN_SSBO_PULL_VALUES 6   // vec4 per texel, all levels: w * (depth, r, g, b)
-#define SUBSCAN_SSBO_PULL_WEIGHTS 7  // float per texel, all levels: clamped weight w
-#define SUBSCAN_SSBO_PUSH_VALUES 8   // vec4 per texel, levels >= 1: complete (depth, r, g, b)
-#define SUBSCAN_SSBO_NORMALS 9       // vec4 per texel, levels >= 1: view-space normal, w unused
-#define SUBSCAN_SSBO_POINT_BOUNDS 10 // ivec4: min x, min y, max x, max y of occupied texels
-#define SUBSCAN_SSBO_FILL_REACH 11   // uint per texel, all levels: 8 x 4-bit nearest level with weight
+#define SUBSCAN_SSBO_POSITIONS 0      // float x, y, z per point (cloud-relative)
+#define SUBSCAN_SSBO_COLORS 1         // uint RGBA8, sRGB-encoded, per point
+#define SUBSCAN_SSBO_DEPTH_BITS 2     // uint per pixel: floatBitsToUint(linear depth)
+#define SUBSCAN_SSBO_POINT_INDEX 3    // uint per pixel: the winning point
+#define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
+#define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
+#define SUBSCAN_SSBO_PULL_VALUES 6    // vec4 per texel, all levels: w * (depth, r, g, b)
+#define SUBSCAN_SSBO_PULL_WEIGHTS 7   // float per texel, all levels: clamped weight w
+#define SUBSCAN_SSBO_PUSH_VALUES 8    // vec4 per texel, levels >= 1: complete (depth, r, g, b)
+#define SUBSCAN_SSBO_NORMALS 9        // vec4 per texel, levels >= 1: view-space normal, w unused
+#define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
+#define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0
@@ -115,10 +115,10 @@ struct ShadeParams {
 
 // SubsurfaceScattering: one dispatch of the blur chain (DESIGN.md §6.1).
 struct ScatterParams {
-    vec4 blur;    // x: standard deviation in scene units, y: most taps on each side,
-                  // z: 1 for the vertical pass, 0 for the horizontal one
-    vec4 weight;  // rgb: weight of the Gaussian this dispatch finishes (or starts, when unblurred)
-    uvec4 albedo; // x: where the albedo enters: 0 before the blur, 1 after it, 2 split (sqrt both)
+    vec4 blur;     // x: standard deviation in scene units, y: most taps on each side,
+                   // z: 1 for the vertical pass, 0 for the horizontal one
+    vec4 weight;   // rgb: weight of the Gaussian this dispatch finishes (or starts, when unblurred)
+    uvec4 albedo;  // x: where the albedo enters: 0 before the blur, 1 after it, 2 split (sqrt both)
 };
 
 #ifdef __cplusplus
