@@ -41,11 +41,12 @@ bool visibleAt(ivec2 pixel, float depth) {
         // Branch-free: lanes in lock-step all take every step anyway. A missing neighbour
         // gives +inf, and a direction without any counts as open sideways (omega = 1).
         float smallest = kInfinity;
-        for (uint level = 0u; level <= levels; ++level) {
+        LevelLayout place = levelLayout(0u);
+        for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
             ivec2 texel = (pixel >> level) + kDirections[k];
-            bool inside = insideLevel(level, texel);
+            bool inside = insideLevel(place, texel);
             float neighbourDepth =
-                minDepth[texelIndex(level, clamp(texel, ivec2(0), levelSize(level) - 1))];
+                minDepth[texelIndex(place, clamp(texel, ivec2(0), place.size - 1))];
             vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
             float value = 1.0 - dot(normalize(y - x), toCamera);
             smallest = inside && !isinf(neighbourDepth) ? min(smallest, value) : smallest;

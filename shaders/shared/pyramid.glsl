@@ -13,6 +13,28 @@ bool insideLevel(uint level, ivec2 texel) {
 uint texelIndex(uint level, ivec2 texel) {
     return pyramid.levels[level].x + uint(texel.y) * pyramid.levels[level].y + uint(texel.x);
 }
+/// One level's place in the buffer, for loops over levels: where the level is not a uniform,
+/// every read of the layout block is a gather (on llvmpipe, a load per invocation), so a walk up
+/// the pyramid derives each level's place from the one below instead (nextLevel).
+struct LevelLayout {
+    uint first;
+    ivec2 size;
+};
+LevelLayout levelLayout(uint level) {
+    uvec4 entry = pyramid.levels[level];
+    return LevelLayout(entry.x, ivec2(entry.yz));
+}
+/// The level above `below`, laid out as PyramidLayout does (render/Pyramid.cpp).
+LevelLayout nextLevel(LevelLayout below) {
+    return LevelLayout(below.first + uint(below.size.x * below.size.y), (below.size + 1) >> 1);
+}
+bool insideLevel(LevelLayout place, ivec2 texel) {
+    return all(greaterThanEqual(texel, ivec2(0))) && all(lessThan(texel, place.size));
+}
+uint texelIndex(LevelLayout place, ivec2 texel) {
+    return place.first + uint(texel.y) * uint(place.size.x) + uint(texel.x);
+}
+
 /// Centre of a level texel in full-resolution window coordinates.
 vec2 texelCentre(uint level, ivec2 texel) { return (vec2(texel) + 0.5) * float(1u << level); }
 
