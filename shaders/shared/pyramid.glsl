@@ -6,16 +6,10 @@ layout(std140, binding = SUBSCAN_UBO_PYRAMID) uniform PyramidBlock {
 };
 
 uint levelCount() { return pyramid.info.x; }
-ivec2 levelSize(uint level) { return ivec2(pyramid.levels[level].yz); }
-bool insideLevel(uint level, ivec2 texel) {
-    return all(greaterThanEqual(texel, ivec2(0))) && all(lessThan(texel, levelSize(level)));
-}
-uint texelIndex(uint level, ivec2 texel) {
-    return pyramid.levels[level].x + uint(texel.y) * pyramid.levels[level].y + uint(texel.x);
-}
-/// One level's place in the buffer, for loops over levels: where the level is not a uniform,
-/// every read of the layout block is a gather (on llvmpipe, a load per invocation), so a walk up
-/// the pyramid derives each level's place from the one below instead (nextLevel).
+
+/// One level's place in the buffer. Loops over levels derive each level's place from the one
+/// below (nextLevel): where the level is not a uniform, every read of the layout block is a
+/// gather (on llvmpipe, a load per invocation).
 struct LevelLayout {
     uint first;
     ivec2 size;
@@ -34,6 +28,10 @@ bool insideLevel(LevelLayout place, ivec2 texel) {
 uint texelIndex(LevelLayout place, ivec2 texel) {
     return place.first + uint(texel.y) * uint(place.size.x) + uint(texel.x);
 }
+
+ivec2 levelSize(uint level) { return levelLayout(level).size; }
+bool insideLevel(uint level, ivec2 texel) { return insideLevel(levelLayout(level), texel); }
+uint texelIndex(uint level, ivec2 texel) { return texelIndex(levelLayout(level), texel); }
 
 /// Centre of a level texel in full-resolution window coordinates.
 vec2 texelCentre(uint level, ivec2 texel) { return (vec2(texel) + 0.5) * float(1u << level); }
