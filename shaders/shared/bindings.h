@@ -24,8 +24,9 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UBO_SURFACE 3
 
 // ---- plain uniforms ----
-#define SUBSCAN_UNIFORM_LEVEL 0   // uint: the pyramid level a per-level dispatch works on
-#define SUBSCAN_UNIFORM_ORIGIN 1  // ivec2: the texel of invocation (0, 0) (shared/region.glsl)
+#define SUBSCAN_UNIFORM_LEVEL 0    // uint: the pyramid level a per-level dispatch works on
+#define SUBSCAN_UNIFORM_ORIGIN 1   // ivec2: the texel of invocation (0, 0) (shared/region.glsl)
+#define SUBSCAN_UNIFORM_DIVISOR 2  // int: output pixels per pipeline pixel and side (Present)
 
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_POSITIONS 0      // float x, y, z per point (cloud-relative)

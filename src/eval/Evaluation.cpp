@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
@@ -16,6 +17,7 @@
 #include "io/Image.h"
 #include "render/FrameUniforms.h"
 #include "render/PresentPass.h"
+#include "render/ReducedResolution.h"
 #include "render/Renderer.h"
 #include "render/ShadePass.h"
 
@@ -75,6 +77,28 @@ std::vector<glm::vec3> rgbOf(const std::vector<float>& rgba) {
         rgb[i] = {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]};
     }
     return rgb;
+}
+
+/// A pipeline image of `channels` floats per texel at the output camera's pixels: each takes
+/// the texel its centre falls in (ReducedResolution.h), as the metrics compare pixel by pixel.
+std::vector<float> atOutputPixels(const std::vector<float>& values, int channels,
+                                  const Camera& output, const Camera& pipeline, int divisor) {
+    if (divisor == 1) {
+        return values;
+    }
+    std::vector<float> resampled;
+    resampled.reserve(static_cast<std::size_t>(output.width * output.height * channels));
+    for (int y = 0; y < output.height; ++y) {
+        for (int x = 0; x < output.width; ++x) {
+            const glm::ivec2 texel =
+                glm::clamp(glm::ivec2(glm::floor(reducedPosition(output, pipeline, divisor,
+                                                                 glm::dvec2(x + 0.5, y + 0.5)))),
+                           glm::ivec2(0), glm::ivec2(pipeline.width - 1, pipeline.height - 1));
+            const auto first = values.begin() + (texel.y * pipeline.width + texel.x) * channels;
+            resampled.insert(resampled.end(), first, first + channels);
+        }
+    }
+    return resampled;
 }
 
 /// Normals that face the eye, for flat shading of methods without normals.
@@ -140,6 +164,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
     ImageShader shader(context, renderer.gpuCloud());
     const double h = renderer.spacing();
 
+    EvaluationReport report;
     std::vector<QualityMetrics> pointViews, surfaceViews;
     std::vector<std::vector<QualityMetrics>> splatViews(
         static_cast<std::size_t>(settings.largestSplat - settings.smallestSplat + 1));
@@ -147,6 +172,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         OrbitView orbit;
         orbit.yawDegrees = 20.0 + 360.0 * view / settings.views;
         orbit.pitchDegrees = view % 2 == 0 ? 25.0 : -15.0;
+        orbit.distance = settings.distance;
         const Camera camera = orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
                                           settings.fovyDegrees);
         const GroundTruthImages groundTruth = renderGroundTruth(truth, camera);
@@ -178,9 +204,13 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         RenderSettings surfaceSettings = render;
         surfaceSettings.raster.mode = RenderMode::Surface;
         surfaceSettings.raster.stage = Stage::Final;
-        renderer.render(camera, surfaceSettings);
-        ReconstructionImages images{renderer.resources().texture("surfaceDepth").readFloats(),
-                                    rgbOf(renderer.resources().texture("normals").readFloats())};
+        const int divisor = renderer.render(camera, surfaceSettings).divisor;
+        report.surfaceReducedViews += divisor == 1 ? 0 : 1;
+        auto atPixels = [&](const char* name, int channels) {
+            return atOutputPixels(renderer.resources().texture(name).readFloats(), channels, camera,
+                                  renderer.pipelineCamera(), divisor);
+        };
+        ReconstructionImages images{atPixels("surfaceDepth", 1), rgbOf(atPixels("normals", 4))};
         QualityMetrics metrics = compareToGroundTruth(images, groundTruth, h);
         const std::vector<std::uint8_t> surfaceImage = renderer.readImage();
         metrics.psnrDb = psnr(surfaceImage, truthImage);
@@ -191,7 +221,6 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         }
     }
 
-    EvaluationReport report;
     report.views = settings.views;
     report.width = settings.width;
     report.height = settings.height;
@@ -234,6 +263,7 @@ nlohmann::json toJson(const EvaluationReport& report) {
         {"height", report.height},
         {"points", report.points},
         {"spacing", report.spacing},
+        {"surface_reduced_views", report.surfaceReducedViews},
         {"methods",
          {{"points", method(report.points1px)},
           {"splats", splats},

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -20,6 +21,8 @@ struct EvaluationSettings {
     int width = 1024;
     int height = 1024;
     double fovyDegrees = 45.0;
+    /// Eye distance from the centre, scene units (close-ups); unset, the view frames the scene.
+    std::optional<double> distance;
     int smallestSplat = 2;  // the splats baseline reports the best size in this range
     int largestSplat = 8;
     /// When set, each view's pictures go here: truth.png and surface.png (shaded), coverage.png
@@ -40,6 +43,7 @@ struct EvaluationReport {
     QualityMetrics splats;
     int splatSize = 0;  // the best splat size in pixels (by PSNR)
     QualityMetrics surface;
+    int surfaceReducedViews = 0;  // views the surface reconstructed at reduced resolution
 };
 
 /// Renders `points` with each method and compares with `truth` seen by the same cameras.

@@ -5,6 +5,33 @@
 
 namespace subscan {
 
+namespace {
+
+/// The output pixels whose bilinear taps reach the pipeline's region: the rest read only
+/// texels outside it, which hold no surface and so show the background.
+TexelRegion outputRegion(const FrameContext& frame) {
+    const TexelRegion region = frame.region(0);
+    if (frame.divisor == 1 || region.size.x <= 0 || region.size.y <= 0) {
+        return region;
+    }
+    const int d = frame.divisor;
+    // Output pixel p reads texels floor(q) and floor(q) + 1 of the reduced position q;
+    // reducedPosition() inverted, with a pixel to spare for the rounding.
+    const glm::dvec2 outputCentre = 0.5 * glm::dvec2(frame.outputSize());
+    const glm::dvec2 pipelineCentre(0.5 * frame.width(), 0.5 * frame.height());
+    auto toOutput = [&](glm::dvec2 texel) {
+        return (texel - pipelineCentre) * double(d) + outputCentre;
+    };
+    const glm::ivec2 first = glm::max(
+        glm::ivec2(glm::floor(toOutput(glm::dvec2(region.origin) - 0.5))) - 1, glm::ivec2(0));
+    const glm::ivec2 last =
+        glm::min(glm::ivec2(glm::ceil(toOutput(glm::dvec2(region.origin + region.size) + 0.5))) + 1,
+                 frame.outputSize() - 1);
+    return {first, glm::max(last - first + 1, glm::ivec2(0))};
+}
+
+}  // namespace
+
 PresentPass::PresentPass(const ShaderSources& sources, std::string colorInput,
                          std::string depthInput)
     : colorInput_(std::move(colorInput)),
@@ -19,22 +46,23 @@ std::vector<std::string_view> PresentPass::inputs() const {
 }
 
 void PresentPass::execute(FrameContext& frame) {
-    Texture& image =
-        frame.resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(), frame.height());
+    const glm::ivec2 size = frame.outputSize();
+    Texture& image = frame.resources.ensureTexture("image", TextureFormat::RGBA8, size.x, size.y);
     frame.resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     if (!depthInput_.empty()) {
         frame.resources.texture(depthInput_).bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     }
     image.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    glProgramUniform1i(stages_[0].id(), SUBSCAN_UNIFORM_DIVISOR, frame.divisor);
     if (depthInput_.empty() || !frame.restricted()) {
-        stages_.runOverImage(0, frame.width(), frame.height());
+        stages_.runOverImage(0, size.x, size.y);
     } else {
         // The background exactly as the shader encodes it: linear (the frame uniform) to sRGB.
         const glm::vec3& background = frame.settings.raster.backgroundSrgb;
         image.clear(glm::vec4(linearToSrgb(srgbToLinear(background.r)),
                               linearToSrgb(srgbToLinear(background.g)),
                               linearToSrgb(srgbToLinear(background.b)), 1.0f));
-        stages_.runOverRegion(0, frame.region(0));
+        stages_.runOverRegion(0, outputRegion(frame));
     }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);

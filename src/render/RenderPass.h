@@ -27,10 +27,15 @@ struct FrameContext {
     /// Pixels [x, y, z, w) holding rasterized points, measured by MinDepthPyramidPass when
     /// `surfaceBoundsAllowed(settings)`; unset, the passes after it work on the whole frame.
     std::optional<glm::ivec4> pointBounds;
+    /// At reduced resolution (RasterSettings::resolution) `camera` is reducedCamera(the
+    /// output's camera, divisor) and Present scales up to the output's size.
+    int divisor = 1;
+    std::optional<glm::ivec2> reducedFrom;  // the output's size; unset at full resolution
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }
     bool restricted() const { return pointBounds.has_value(); }
+    glm::ivec2 outputSize() const { return reducedFrom.value_or(glm::ivec2(width(), height())); }
     /// The texels of pyramid `level` (0: the image) a pass must compute: those around the
     /// points, with a margin for the 4x4 pull and the bilinear push and normal reads.
     TexelRegion region(unsigned level) const;

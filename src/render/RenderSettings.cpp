@@ -38,6 +38,11 @@ constexpr std::pair<Stage, std::string_view> kStages[] = {
     {Stage::Fill, "fill"},       {Stage::Normals, "normals"},
     {Stage::Shaded, "shaded"},
 };
+constexpr std::pair<Resolution, std::string_view> kResolutions[] = {
+    {Resolution::Full, "full"},
+    {Resolution::Half, "half"},
+    {Resolution::Auto, "auto"},
+};
 
 }  // namespace
 
@@ -59,6 +64,12 @@ std::string toString(Stage stage) {
 Stage parseStage(std::string_view text) {
     return parseName(kStages, text, "stage");
 }
+std::string toString(Resolution resolution) {
+    return nameOf(kResolutions, resolution);
+}
+Resolution parseResolution(std::string_view text) {
+    return parseName(kResolutions, text, "resolution");
+}
 
 bool reconstructsSurface(RenderMode mode) {
     return mode == RenderMode::Surface || mode == RenderMode::Sss;
@@ -76,6 +87,7 @@ void to_json(nlohmann::json& json, const RasterSettings& settings) {
         {"timing", nameOf(kTimings, settings.timing)},
         {"stage", toString(settings.stage)},
         {"stage_level", settings.stageLevel},
+        {"resolution", toString(settings.resolution)},
     };
 }
 
@@ -87,6 +99,7 @@ void from_json(const nlohmann::json& json, RasterSettings& settings) {
     readEnum(json, "timing", settings.timing, kTimings, "timing mode");
     readEnum(json, "stage", settings.stage, kStages, "stage");
     readSetting(json, "stage_level", settings.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
+    readEnum(json, "resolution", settings.resolution, kResolutions, "resolution");
 }
 
 void to_json(nlohmann::json& json, const RenderSettings& settings) {

@@ -30,6 +30,14 @@ enum class Stage { Final, Depth, Pyramid, Visibility, Pull, Push, Fill, Normals,
 /// 64-bit atomics and the two-pass 32-bit path elsewhere; the others force one (tests, bench).
 enum class RasterPath { Auto, Int64, TwoPass32 };
 
+/// The pixels the surface and sss modes reconstruct, shade and scatter before Present scales
+/// the picture to the output: every one (Full), one per 2x2 block (Half), or Half only while
+/// the points are two or more pixels apart on screen (Auto, a close-up: see
+/// ResolutionChooser). The point modes always draw every pixel. Reduced resolution trades about a
+/// pixel of the silhouette for speed (bench/README.md has the measurements), so it is a choice,
+/// not a default.
+enum class Resolution { Full, Half, Auto };
+
 /// Rasterization and presentation.
 struct RasterSettings {
     RenderMode mode = RenderMode::Points;
@@ -39,6 +47,7 @@ struct RasterSettings {
     TimingMode timing = TimingMode::Auto;
     Stage stage = Stage::Final;
     int stageLevel = 3;  // the pyramid level the pyramid and pull stages show
+    Resolution resolution = Resolution::Full;
 };
 
 /// Every setting of a frame, one struct per concern; the JSON the CLI's --settings and the
@@ -68,6 +77,8 @@ std::string toString(RasterPath path);
 RasterPath parseRasterPath(std::string_view text);
 std::string toString(Stage stage);
 Stage parseStage(std::string_view text);
+std::string toString(Resolution resolution);
+Resolution parseResolution(std::string_view text);
 
 /// Whether `mode` reconstructs a surface (the surface and sss modes).
 bool reconstructsSurface(RenderMode mode);

@@ -52,7 +52,8 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
                    std::size_t maxChunkPoints)
     : context_(context),
       cloud_(cloud, context.capabilities(), maxChunkPoints),
-      spacing_(usableSpacing(cloud, spacing)) {}
+      spacing_(usableSpacing(cloud, spacing)),
+      resolutionChooser_(cloud) {}
 
 Renderer::~Renderer() = default;
 
@@ -109,16 +110,32 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
         runnerTiming_ = settings.raster.timing;
     }
 
+    // The point modes draw every pixel: at reduced resolution they would lose points.
+    const int divisor = reconstructsSurface(settings.raster.mode)
+                            ? resolutionChooser_.divisor(settings.raster.resolution, camera,
+                                                         cloud_.origin(), spacing_)
+                            : 1;
+    pipelineCamera_ = divisor == 1 ? camera : reducedCamera(camera, divisor);
     const gpu::PyramidLayout& layout =
-        uniforms_.update(camera, settings, spacing_, cloud_.origin());
+        uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());
 
     const std::vector<RenderPass*> passes = passesFor(settings.raster);
-    FrameContext context{camera, cloud_, settings, capabilities(), resources_, layout, spacing_};
-    return {runner_->run(passes, context)};
+    lastDivisor_ = divisor;
+    FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
+                         resourcesFor(divisor), layout, spacing_};
+    if (divisor != 1) {
+        context.divisor = divisor;
+        context.reducedFrom = glm::ivec2(camera.width, camera.height);
+    }
+    return {runner_->run(passes, context), divisor};
 }
 
 std::vector<std::uint8_t> Renderer::readImage() const {
-    return resources_.texture("image").readRgba8();
+    return resources().texture("image").readRgba8();
+}
+
+std::size_t Renderer::resourceBytes() const {
+    return fullResources_.bytes() + reducedResources_.bytes();
 }
 
 }  // namespace subscan

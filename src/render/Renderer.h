@@ -16,6 +16,7 @@
 #include "render/FrameUniforms.h"
 #include "render/GpuPointCloud.h"
 #include "render/PassRunner.h"
+#include "render/ReducedResolution.h"
 #include "render/RenderSettings.h"
 #include "shared/bindings.h"
 
@@ -35,6 +36,7 @@ class PresentPass;
 
 struct FrameResult {
     std::vector<PassTiming> passes;
+    int divisor = 1;  // output pixels per pipeline pixel and side (RasterSettings::resolution)
     double totalMilliseconds() const;
 };
 
@@ -55,22 +57,40 @@ class Renderer {
 
     /// The last presented image: RGBA8, sRGB-encoded, row 0 at the top.
     std::vector<std::uint8_t> readImage() const;
-    const FrameResources& resources() const { return resources_; }
+    /// The last frame's images and buffers (see pipelineCamera()).
+    const FrameResources& resources() const { return resourcesFor(lastDivisor_); }
+    /// Bytes of every image and buffer the renderer holds, for the memory report.
+    std::size_t resourceBytes() const;
     const GpuPointCloud& gpuCloud() const { return cloud_; }
     const GlCapabilities& capabilities() const { return context_.capabilities(); }
     double spacing() const { return spacing_; }
+    /// The camera of the last frame's pipeline images (all but "image"): the frame's own
+    /// camera, or reducedCamera(it, divisor) when it reconstructed at reduced resolution.
+    const Camera& pipelineCamera() const { return pipelineCamera_; }
     /// The compute rasterizer, once a frame has used it (null before).
     const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
 
   private:
     std::vector<RenderPass*> passesFor(const RasterSettings& raster);
     PresentPass& present(const std::string& color, const std::string& depth);
+    FrameResources& resourcesFor(int divisor) {
+        return divisor == 1 ? fullResources_ : reducedResources_;
+    }
+    const FrameResources& resourcesFor(int divisor) const {
+        return divisor == 1 ? fullResources_ : reducedResources_;
+    }
 
     GlContext& context_;
     ShaderSources sources_;
     GpuPointCloud cloud_;
     double spacing_;
-    FrameResources resources_;
+    ResolutionChooser resolutionChooser_;
+    Camera pipelineCamera_;
+    int lastDivisor_ = 1;
+    // One set per resolution, so that a camera crossing the Auto threshold does not reallocate
+    // every image (a second on llvmpipe for 1080p) each time it crosses.
+    FrameResources fullResources_;
+    FrameResources reducedResources_;
     FrameUniforms uniforms_;
     std::unique_ptr<RasterizePointsPass> rasterize_;
     std::unique_ptr<DrawPointsPass> drawPoints_;

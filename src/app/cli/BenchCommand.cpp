@@ -32,6 +32,7 @@ struct BenchOptions {
     int height = 1080;
     std::string modes = "points-gl,points,surface,sss";
     std::string settingsFile;
+    std::string resolution;
     std::string up = "auto";
     bool json = false;
     bool software = false;
@@ -74,6 +75,7 @@ nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSetti
     glFinish();
     std::vector<double> frameMs;
     std::map<std::string, std::vector<double>> passMs;
+    int reducedFrames = 0;
     for (int frame = 0; frame < options.frames; ++frame) {
         const auto start = std::chrono::steady_clock::now();
         const FrameResult result = renderer.render(cameraAt(frame), settings);
@@ -84,6 +86,7 @@ nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSetti
         for (const PassTiming& pass : result.passes) {
             passMs[pass.pass].push_back(pass.milliseconds);
         }
+        reducedFrames += result.divisor == 1 ? 0 : 1;
     }
     const double totalMs = std::accumulate(frameMs.begin(), frameMs.end(), 0.0);
     std::vector<double> slowest = frameMs;
@@ -98,7 +101,7 @@ nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSetti
     for (const auto& [pass, values] : passMs) {
         perPass[pass] = median(values);
     }
-    const std::size_t bytes = renderer.gpuCloud().bytes() + renderer.resources().bytes();
+    const std::size_t bytes = renderer.gpuCloud().bytes() + renderer.resourceBytes();
     return {
         {"avg_fps", averageFps},
         {"low1_fps", 1000.0 / lowMs},
@@ -106,6 +109,7 @@ nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSetti
         {"per_pass_ms", perPass},
         {"points_per_second", averageFps * static_cast<double>(scan.cloud.size())},
         {"gpu_memory_mb", static_cast<double>(bytes) / (1024.0 * 1024.0)},
+        {"reduced_resolution_frames", reducedFrames},
     };
 }
 
@@ -114,6 +118,9 @@ int runBench(const BenchOptions& options) {
     RenderSettings settings;
     if (!options.settingsFile.empty()) {
         settings = readSettingsFile(options.settingsFile);
+    }
+    if (!options.resolution.empty()) {
+        settings.raster.resolution = parseResolution(options.resolution);
     }
     const LoadedScan scan = loadScanForCommand(options.source);
     const UpAxis up =
@@ -128,6 +135,7 @@ int runBench(const BenchOptions& options) {
         {"width", options.width},
         {"height", options.height},
         {"frames", options.frames},
+        {"resolution", toString(settings.raster.resolution)},
         {"modes", nlohmann::json::object()},
     };
     for (const RenderMode mode : modes) {
@@ -143,14 +151,14 @@ int runBench(const BenchOptions& options) {
     }
     fmt::print("{} | {} points | {}x{} | {} frames\n", report["renderer"].get<std::string>(),
                scan.cloud.size(), options.width, options.height, options.frames);
-    fmt::print("{:<10} {:>9} {:>9} {:>11} {:>14} {:>8}\n", "mode", "avg fps", "1% low", "median ms",
-               "points/s", "GPU MB");
+    fmt::print("{:<10} {:>9} {:>9} {:>11} {:>14} {:>8} {:>8}\n", "mode", "avg fps", "1% low",
+               "median ms", "points/s", "GPU MB", "reduced");
     for (const RenderMode mode : modes) {
         const nlohmann::json& m = report["modes"][toString(mode)];
-        fmt::print("{:<10} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f}\n", toString(mode),
+        fmt::print("{:<10} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f} {:>8}\n", toString(mode),
                    m["avg_fps"].get<double>(), m["low1_fps"].get<double>(),
                    m["frame_ms_median"].get<double>(), m["points_per_second"].get<double>(),
-                   m["gpu_memory_mb"].get<double>());
+                   m["gpu_memory_mb"].get<double>(), m["reduced_resolution_frames"].get<int>());
     }
     return 0;
 }
@@ -172,6 +180,11 @@ Command addBenchCommand(CLI::App& parent) {
         ->check(CLI::Range(1, 65536));
     bench->add_option("--modes", options->modes,
                       "Comma-separated modes (default points-gl,points,surface,sss)");
+    bench
+        ->add_option("--resolution", options->resolution,
+                     "Pixels the surface is reconstructed at: full (default) | half | auto (half "
+                     "while the points are 4 or more pixels apart)")
+        ->check(CLI::IsMember({"full", "half", "auto"}));
     bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
         ->check(CLI::ExistingFile);
     bench->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")

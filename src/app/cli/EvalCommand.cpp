@@ -76,8 +76,12 @@ int runEval(const EvalOptions& options) {
         fmt::print("{}\n", toJson(report).dump(2));
         return 0;
     }
-    fmt::print("{}: {} points (h = {:.4g}), {} views of {}x{}\n", options.source, report.points,
+    fmt::print("{}: {} points (h = {:.4g}), {} views of {}x{}", options.source, report.points,
                report.spacing, report.views, report.width, report.height);
+    fmt::print("{}\n", report.surfaceReducedViews == 0
+                           ? ""
+                           : fmt::format(" ({} of them reconstructed at reduced resolution)",
+                                         report.surfaceReducedViews));
     fmt::print("{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "method", "coverage",
                "leakage", "depth/h", "occluded", "normal°", "normal95", "PSNR");
     auto row = [](const std::string& name, const QualityMetrics& m) {
@@ -106,6 +110,10 @@ Command addEvalCommand(CLI::App& parent) {
         ->check(CLI::Range(16, 8192));
     eval->add_option("--height", options->evaluation.height, "Image height")
         ->check(CLI::Range(16, 8192));
+    eval->add_option("--distance", options->evaluation.distance,
+                     "Eye distance from the centre (scene units), for close-ups; default frames "
+                     "the scene")
+        ->check(CLI::PositiveNumber);
     eval->add_option("--points", options->points,
                      "Points of a mesh: its vertices, or a virtual scan of it")
         ->check(CLI::IsMember({"vertices", "scan"}));

@@ -39,6 +39,7 @@ struct RenderOptions {
     std::string background;
     std::string exportDirectory;
     std::string raster;
+    std::string resolution;
     std::string stage;
     std::string material;
     std::string unit;
@@ -112,9 +113,11 @@ ImageF channelsOf(const Texture& texture, int channels) {
 
 /// camera.json, depth.pfm and color.png always; in the surface and sss modes also normals.pfm,
 /// mask.png and radiance.pfm (after scattering in sss mode), with depth.pfm holding the
-/// reconstructed depth (+inf outside the mask).
+/// reconstructed depth (+inf outside the mask). The camera and the buffers are the pipeline's:
+/// at reduced resolution, smaller than the picture.
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
-                   const Camera& camera, RenderMode mode) {
+                   RenderMode mode) {
+    const Camera& camera = renderer.pipelineCamera();
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) {
@@ -174,6 +177,9 @@ int runRender(const RenderOptions& options) {
     }
     if (!options.raster.empty()) {
         raster.path = parseRasterPath(options.raster);
+    }
+    if (!options.resolution.empty()) {
+        raster.resolution = parseResolution(options.resolution);
     }
     if (!options.stage.empty()) {
         raster.stage = parseStage(options.stage);
@@ -237,7 +243,7 @@ int runRender(const RenderOptions& options) {
     }
 
     if (!options.exportDirectory.empty()) {
-        exportBuffers(options.exportDirectory, renderer, camera, raster.mode);
+        exportBuffers(options.exportDirectory, renderer, raster.mode);
     }
     writePng(output, {camera.width, camera.height, 4, renderer.readImage()});
     return 0;
@@ -295,6 +301,11 @@ Command addRenderCommand(CLI::App& parent) {
                        "Directory for camera.json, depth.pfm, color.png");
     render->add_option("--raster", options->raster, "Compute rasterizer: auto | int64 | two-pass")
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
+    render
+        ->add_option("--resolution", options->resolution,
+                     "Pixels the surface is reconstructed at: full (default) | half | auto (half "
+                     "while the points are 4 or more pixels apart)")
+        ->check(CLI::IsMember({"full", "half", "auto"}));
     render
         ->add_option("--settings", options->settingsFile,
                      "Settings JSON ({\"raster\", \"surface\", \"shading\", \"scattering\"}); "

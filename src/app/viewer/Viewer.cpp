@@ -19,6 +19,7 @@
 #include "core/Error.h"
 #include "io/CameraJson.h"
 #include "io/Image.h"
+#include "render/ReducedResolution.h"
 #include "render/Renderer.h"
 
 namespace subscan::viewer {
@@ -457,6 +458,7 @@ void Viewer::renderIfNeeded() {
         status_.passes = frame.passes;
         status_.imageWidth = size.x;
         status_.imageHeight = size.y;
+        status_.divisor = frame.divisor;
         renderedImage_ = true;
     } catch (const Error& error) {
         fail(error.what());
@@ -552,7 +554,10 @@ std::optional<glm::dvec3> Viewer::surfacePointAt(const glm::dvec2& windowPositio
         return std::nullopt;
     }
     const Texture& depth = resources.texture(name);
-    const glm::dvec2 pixel = windowPosition * context_.windowToFramebufferScale();
+    // The depth is the pipeline's, at reduced resolution when the frame was.
+    const Camera& pipeline = renderer_->pipelineCamera();
+    const glm::dvec2 pixel = reducedPosition(*renderedCamera_, pipeline, status_.divisor,
+                                             windowPosition * context_.windowToFramebufferScale());
     const int x = static_cast<int>(std::floor(pixel.x));
     const int y = static_cast<int>(std::floor(pixel.y));
     if (x < 0 || y < 0 || x >= depth.width() || y >= depth.height()) {
@@ -591,7 +596,7 @@ std::optional<glm::dvec3> Viewer::surfacePointAt(const glm::dvec2& windowPositio
     if (!best) {
         return std::nullopt;
     }
-    return ViewerCamera::unproject(*renderedCamera_, *best, bestDepth);
+    return ViewerCamera::unproject(pipeline, *best, bestDepth);
 }
 
 void Viewer::zoomAt(const glm::dvec2& windowPosition, double steps) {

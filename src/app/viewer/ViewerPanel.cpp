@@ -21,6 +21,7 @@ constexpr Stage kStages[] = {Stage::Final,      Stage::Depth,   Stage::Pyramid,
                              Stage::Visibility, Stage::Pull,    Stage::Push,
                              Stage::Fill,       Stage::Normals, Stage::Shaded};
 constexpr RasterPath kRasterPaths[] = {RasterPath::Auto, RasterPath::Int64, RasterPath::TwoPass32};
+constexpr Resolution kResolutions[] = {Resolution::Full, Resolution::Half, Resolution::Auto};
 constexpr std::pair<TimingMode, const char*> kTimings[] = {
     {TimingMode::Auto, "auto"},
     {TimingMode::GpuQueries, "GPU queries"},
@@ -184,8 +185,9 @@ void ViewerPanel::drawPerformance(const PanelStatus& status, bool& redrawEveryFr
     }
     ImGui::Text("window %.0f FPS", status.windowFps);
     if (!status.passes.empty()) {
-        ImGui::Text("pipeline %.2f ms (%.0f FPS) at %dx%d", total,
-                    total > 0.0 ? 1000.0 / total : 0.0, status.imageWidth, status.imageHeight);
+        ImGui::Text("pipeline %.2f ms (%.0f FPS) at %dx%d%s", total,
+                    total > 0.0 ? 1000.0 / total : 0.0, status.imageWidth, status.imageHeight,
+                    status.divisor == 2 ? ", surface at half" : "");
     }
     ImGui::Checkbox("redraw every frame", &redrawEveryFrame);
     helpTooltip(
@@ -222,6 +224,14 @@ void ViewerPanel::drawView(RenderSettings& settings, Navigation& navigation,
         "stage", raster.stage, kStages, [](Stage stage) { return toString(stage); }, stageAvailable,
         raster.mode);
     helpTooltip("An intermediate buffer of the pipeline instead of the final image.");
+    if (reconstructsSurface(raster.mode)) {
+        choiceCombo<Resolution>("resolution", raster.resolution, kResolutions,
+                                [](Resolution resolution) { return toString(resolution); });
+        helpTooltip(
+            "Pixels the surface is reconstructed at before scaling to the window. half: "
+            "about half the frame time, a pixel of the silhouette lost; auto: half while the "
+            "points are 4 or more pixels apart (close-ups of sparse scans).");
+    }
     if (raster.stage == Stage::Pyramid || raster.stage == Stage::Pull) {
         ImGui::SliderInt("stage level", &raster.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
     }

@@ -32,6 +32,7 @@ struct PanelStatus {
     std::vector<PassTiming> passes;  // of the last pipeline frame
     int imageWidth = 0;
     int imageHeight = 0;
+    int divisor = 1;      // output pixels per reconstructed pixel and side in the last frame
     std::string message;  // the last notice or error, shown at the bottom
     bool messageIsError = false;
 };

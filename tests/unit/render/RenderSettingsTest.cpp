@@ -17,12 +17,14 @@ TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
     settings.pointSize = 6;
     settings.backgroundSrgb = {0.1f, 0.2f, 0.3f};
     settings.timing = TimingMode::FinishAndClock;
+    settings.resolution = Resolution::Half;
     const RasterSettings back = nlohmann::json(settings).get<RasterSettings>();
     EXPECT_EQ(back.mode, settings.mode);
     EXPECT_EQ(back.path, settings.path);
     EXPECT_EQ(back.pointSize, settings.pointSize);
     EXPECT_EQ(back.backgroundSrgb, settings.backgroundSrgb);
     EXPECT_EQ(back.timing, settings.timing);
+    EXPECT_EQ(back.resolution, settings.resolution);
 
     const RasterSettings partial = nlohmann::json{{"point_size", 3}}.get<RasterSettings>();
     EXPECT_EQ(partial.pointSize, 3);
@@ -56,6 +58,20 @@ TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
     }
     const auto unknown = dir.write("unknown.json", R"({"surfaces": {}})");
     EXPECT_THROW(readSettingsFile(unknown), Error);
+}
+
+TEST(RenderSettingsTest, ResolutionIsFullUnlessAsked) {
+    EXPECT_EQ(RenderSettings{}.raster.resolution, Resolution::Full);
+    const test::TempDir dir;
+    const auto half = dir.write("half.json", R"({"raster": {"resolution": "half"}})");
+    EXPECT_EQ(readSettingsFile(half).raster.resolution, Resolution::Half);
+    const auto bad = dir.write("bad.json", R"({"raster": {"resolution": "quarter"}})");
+    try {
+        readSettingsFile(bad);
+        FAIL() << "accepted";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("quarter"));
+    }
 }
 
 TEST(RenderSettingsTest, ScatteringSettingsRoundTripAndCheckTheMaterial) {
