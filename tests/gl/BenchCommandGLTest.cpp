@@ -41,6 +41,17 @@ TEST(BenchCommandGLTest, ReportsEveryModeAsJson) {
               report["modes"]["points"]["gpu_memory_mb"].get<double>());
 }
 
+TEST(BenchCommandGLTest, CountsTheFramesReconstructedAtHalfResolution) {
+    const auto result = runSubscan({"bench", "synthetic:sphere?points=4000", "--frames", "6",
+                                    "--warmup", "0", "--width", "64", "--height", "48", "--modes",
+                                    "points,surface", "--resolution", "half", "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const nlohmann::json report = nlohmann::json::parse(result.out);
+    EXPECT_EQ(report["resolution"], "half");
+    EXPECT_EQ(report["modes"]["surface"]["reduced_resolution_frames"], 6);
+    EXPECT_EQ(report["modes"]["points"]["reduced_resolution_frames"], 0);  // points: every pixel
+}
+
 TEST(BenchCommandGLTest, UnknownModeIsOneSentence) {
     const auto result =
         runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface,voxels"});
