@@ -67,6 +67,8 @@ class Renderer {
     /// The camera of the last frame's pipeline images (all but "image"): the frame's own
     /// camera, or reducedCamera(it, divisor) when it reconstructed at reduced resolution.
     const Camera& pipelineCamera() const { return pipelineCamera_; }
+    /// Output pixels per pipeline pixel and side in the last frame (FrameResult::divisor).
+    int pipelineDivisor() const { return lastDivisor_; }
     /// The compute rasterizer, once a frame has used it (null before).
     const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
 

@@ -180,11 +180,7 @@ Command addBenchCommand(CLI::App& parent) {
         ->check(CLI::Range(1, 65536));
     bench->add_option("--modes", options->modes,
                       "Comma-separated modes (default points-gl,points,surface,sss)");
-    bench
-        ->add_option("--resolution", options->resolution,
-                     "Pixels the surface is reconstructed at: full (default) | half | auto (half "
-                     "while the points are 4 or more pixels apart)")
-        ->check(CLI::IsMember({"full", "half", "auto"}));
+    addResolutionOption(*bench, options->resolution);
     bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
         ->check(CLI::ExistingFile);
     bench->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")

@@ -21,4 +21,12 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
+void addResolutionOption(CLI::App& command, std::string& resolution) {
+    command
+        .add_option("--resolution", resolution,
+                    "Pixels the surface is reconstructed at: full (default) | half | auto (half "
+                    "while the points are 4 or more pixels apart)")
+        ->check(CLI::IsMember({"full", "half", "auto"}));
+}
+
 }  // namespace subscan::cli

@@ -301,11 +301,7 @@ Command addRenderCommand(CLI::App& parent) {
                        "Directory for camera.json, depth.pfm, color.png");
     render->add_option("--raster", options->raster, "Compute rasterizer: auto | int64 | two-pass")
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
-    render
-        ->add_option("--resolution", options->resolution,
-                     "Pixels the surface is reconstructed at: full (default) | half | auto (half "
-                     "while the points are 4 or more pixels apart)")
-        ->check(CLI::IsMember({"full", "half", "auto"}));
+    addResolutionOption(*render, options->resolution);
     render
         ->add_option("--settings", options->settingsFile,
                      "Settings JSON ({\"raster\", \"surface\", \"shading\", \"scattering\"}); "

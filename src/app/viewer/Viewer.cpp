@@ -556,8 +556,9 @@ std::optional<glm::dvec3> Viewer::surfacePointAt(const glm::dvec2& windowPositio
     const Texture& depth = resources.texture(name);
     // The depth is the pipeline's, at reduced resolution when the frame was.
     const Camera& pipeline = renderer_->pipelineCamera();
-    const glm::dvec2 pixel = reducedPosition(*renderedCamera_, pipeline, status_.divisor,
-                                             windowPosition * context_.windowToFramebufferScale());
+    const glm::dvec2 pixel =
+        reducedPosition(*renderedCamera_, pipeline, renderer_->pipelineDivisor(),
+                        windowPosition * context_.windowToFramebufferScale());
     const int x = static_cast<int>(std::floor(pixel.x));
     const int y = static_cast<int>(std::floor(pixel.y));
     if (x < 0 || y < 0 || x >= depth.width() || y >= depth.height()) {
