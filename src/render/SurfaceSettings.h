@@ -11,7 +11,10 @@ namespace subscan {
 /// spacing h, so the defaults fit any scan at any scale; each pass turns its radius into a
 /// pyramid level per pixel: level = log2(radius * h * focal length / depth).
 struct SurfaceSettings {
-    float visibilityRadius = 4.0f;     // HPR looks this far for occluders (x h)
+    // HPR looks this far for occluders (x h); its coarsest level has texels of 1/2 to 1 radius.
+    // With 4 h, close-ups let the back show through the gaps between points (bench/README.md,
+    // "Hidden points at close-ups").
+    float visibilityRadius = 6.0f;
     float visibilityThreshold = 0.3f;  // tau: mean of the 8 smallest omegas for "visible"
     bool edgeRule = true;              // the paper's silhouette rule
     float pullDepthSlope = 8.0f;       // pull keeps children within this many texel widths
