@@ -32,7 +32,7 @@ enum class RasterPath { Auto, Int64, TwoPass32 };
 
 /// The pixels the surface and sss modes reconstruct, shade and scatter before Present scales
 /// the picture to the output: every one (Full), one per 2x2 block (Half), or Half only while
-/// the points are two or more pixels apart on screen (Auto, a close-up: see
+/// the points are four or more pixels apart on screen (Auto, a close-up: see
 /// ResolutionChooser). The point modes always draw every pixel. Reduced resolution trades about a
 /// pixel of the silhouette for speed (bench/README.md has the measurements), so it is a choice,
 /// not a default.
