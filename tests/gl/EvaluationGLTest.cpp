@@ -48,6 +48,27 @@ TEST(EvaluationGLTest, EvalCommandJsonHasTheDocumentedShape) {
     EXPECT_TRUE(json["methods"]["surface"]["normal_error_mean_deg"].is_number());
 }
 
+TEST(EvaluationGLTest, EvalReconstructsAScanFileAgainstTheMesh) {
+    const test::TempDir dir;
+    const auto mesh = dir.write("mesh.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 4\n"
+                                "property float x\nproperty float y\nproperty float z\n"
+                                "element face 2\nproperty list uchar int vertex_indices\n"
+                                "end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+    std::string scan;
+    for (int i = 0; i < 20; ++i) {
+        for (int j = 0; j < 20; ++j) {
+            scan += std::to_string(0.05 * i) + " " + std::to_string(0.05 * j) + " 0\n";
+        }
+    }
+    const auto scanFile = dir.write("scan.xyz", scan);
+    const auto result =
+        test::runSubscan({"eval", mesh.string(), "--points", scanFile.string(), "--views", "1",
+                          "--width", "32", "--height", "32", "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(nlohmann::json::parse(result.out)["points"], 400);  // the file's, not the mesh's 4
+}
+
 TEST(EvaluationGLTest, EvalRefusesAPointCloudWithoutFaces) {
     const test::TempDir dir;
     const auto cloud = dir.write("cloud.xyz", "0 0 0\n1 0 0\n0 1 0\n");

@@ -54,17 +54,20 @@ int runEval(const EvalOptions& options) {
                 fmt::format("{}: has no faces; eval needs a mesh as ground truth", options.source));
         }
         truth = makeMeshScene(mesh.cloud, AlbedoSource::Grey);
-        if (options.points == "vertices") {
-            points = mesh.cloud;
-            points.triangles.clear();
-            points.normals.clear();
-            points.intensities.clear();
-            points.colors.assign(points.size(), srgb8Color(glm::vec3(kMeshAlbedo)));
-        } else {
+        if (options.points == "scan") {
             ScannerSettings scanner;
             scanner.noise = 0.1;
             scanner.noiseInSpacingUnits = true;
             points = scanScene(*truth, scanner);
+        } else {
+            // The mesh's vertices, or a scan file in the mesh's frame (the range scans a mesh
+            // was merged from: real noise and registration offsets, judged by the mesh).
+            points = options.points == "vertices" ? mesh.cloud
+                                                  : loadScanForCommand(options.points).cloud;
+            points.triangles.clear();
+            points.normals.clear();
+            points.intensities.clear();
+            points.colors.assign(points.size(), srgb8Color(glm::vec3(kMeshAlbedo)));
         }
     }
 
@@ -115,8 +118,9 @@ Command addEvalCommand(CLI::App& parent) {
                      "the scene")
         ->check(CLI::PositiveNumber);
     eval->add_option("--points", options->points,
-                     "Points of a mesh: its vertices, or a virtual scan of it")
-        ->check(CLI::IsMember({"vertices", "scan"}));
+                     "Points of a mesh: vertices (its own), scan (a virtual scan of it), or a "
+                     "scan file in the mesh's frame")
+        ->check(CLI::IsMember({"vertices", "scan"}) | CLI::ExistingFile);
     eval->add_option("--settings", options->settingsFile, "Settings JSON for the surface")
         ->check(CLI::ExistingFile);
     eval->add_option("--export-views", options->evaluation.exportDirectory,
