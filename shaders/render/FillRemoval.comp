@@ -38,8 +38,10 @@ const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec
                                      ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
 const uint kNoReach = 15u;
 
+/// Beyond the image counts as weighted: a surface that reaches the image's border goes on past
+/// it, and would otherwise lose its outermost pixels (a frame of background around close-ups).
 bool weighted(uint onLevel, ivec2 texel) {
-    return insideLevel(onLevel, texel) && pullWeight[texelIndex(onLevel, texel)] > 0.0;
+    return !insideLevel(onLevel, texel) || pullWeight[texelIndex(onLevel, texel)] > 0.0;
 }
 
 /// Per direction, `onLevel` where the neighbour of `texel` on that level has weight, else the

@@ -6,6 +6,11 @@
 // i.e. the neighbour y that rises most towards the camera. x is visible when the mean of the 8
 // smallest omegas reaches tau, or (the paper's edge rule) when 3 consecutive directions occlude
 // while at least 3 others are open: x then lies just beyond an occluder's silhouette.
+// Near the image's border a direction's walk is cut short where its texel reaches past the image
+// (odd sizes: where the image fills it only in part). Its omega then weighs in the mean by the
+// share of levels it saw, and it takes no part in the edge rule. Counted in full as open, such
+// directions let points behind the surface near the border pass as visible; left out
+// entirely, the few directions left hid the surface itself in the image's corners.
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
 
@@ -36,33 +41,44 @@ bool visibleAt(ivec2 pixel, float depth) {
     float tau = surface.visibility.y;
 
     float omega[8];
-    float sum = 0.0;
+    bool complete[8];
+    ivec2 imageSize = levelSize(0u);
+    float weightedSum = 0.0;
+    float weightSum = 0.0;
     for (int k = 0; k < 8; ++k) {
         // Branch-free: lanes in lock-step all take every step anyway. A missing neighbour
         // gives +inf, and a direction without any counts as open sideways (omega = 1).
         float smallest = kInfinity;
+        uint seen = 0u;
         LevelLayout place = levelLayout(0u);
         for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
             ivec2 texel = (pixel >> level) + kDirections[k];
-            bool inside = insideLevel(place, texel);
+            bool withinImage = all(greaterThanEqual(texel, ivec2(0))) &&
+                               all(lessThanEqual((texel + 1) << level, imageSize));
+            seen += withinImage ? 1u : 0u;
             float neighbourDepth =
                 minDepth[texelIndex(place, clamp(texel, ivec2(0), place.size - 1))];
             vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
             float value = 1.0 - dot(normalize(y - x), toCamera);
-            smallest = inside && !isinf(neighbourDepth) ? min(smallest, value) : smallest;
+            smallest = withinImage && !isinf(neighbourDepth) ? min(smallest, value) : smallest;
         }
         smallest = isinf(smallest) ? 1.0 : smallest;
         omega[k] = smallest;
-        sum += smallest;
+        complete[k] = seen == levels + 1u;
+        float weight = float(seen) / float(levels + 1u);
+        weightedSum += weight * smallest;
+        weightSum += weight;
     }
-    bool visible = sum / 8.0 >= tau;
+    bool visible = weightedSum >= tau * weightSum;
     if (!visible && surface.visibility.z > 0.5) {
         int open = 0;
+        bool occludes[8];
         for (int k = 0; k < 8; ++k) {
-            open += omega[k] >= tau ? 1 : 0;
+            open += complete[k] && omega[k] >= tau ? 1 : 0;
+            occludes[k] = complete[k] && omega[k] < tau;
         }
         for (int k = 0; k < 8 && !visible; ++k) {
-            bool run = omega[k] < tau && omega[(k + 1) % 8] < tau && omega[(k + 2) % 8] < tau;
+            bool run = occludes[k] && occludes[(k + 1) % 8] && occludes[(k + 2) % 8];
             visible = run && open >= 3;
         }
     }

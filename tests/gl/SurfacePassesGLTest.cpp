@@ -178,17 +178,21 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     const int directions[8][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
                                   {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
     std::array<double, 8> omega{};
-    double sum = 0.0;
+    std::array<bool, 8> complete{};
+    double weightedSum = 0.0, weightSum = 0.0;
     bool tie = false;
     for (int k = 0; k < 8; ++k) {
         double smallest = 1.0;
         bool found = false;
+        int seen = 0;
         for (int l = 0; l <= maxLevel; ++l) {
             const Level& level = all[l];
             const int qx = (px >> l) + directions[k][0], qy = (py >> l) + directions[k][1];
-            if (qx < 0 || qy < 0 || qx >= level.width || qy >= level.height) {
+            // The walk sees only texels wholly inside the image (odd sizes: not the last one).
+            if (qx < 0 || qy < 0 || (qx + 1) << l > kWidth || (qy + 1) << l > kHeight) {
                 continue;
             }
+            ++seen;
             const double d = pyramid[level.offset + qy * level.width + qx];
             if (std::isinf(d)) {
                 continue;
@@ -199,22 +203,27 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
             smallest = found ? std::min(smallest, value) : value;
             found = true;
         }
+        // A walk cut short by the image's border weighs by the share of levels it saw.
         omega[k] = smallest;
-        sum += smallest;
+        complete[k] = seen == maxLevel + 1;
+        const double weight = static_cast<double>(seen) / (maxLevel + 1);
+        weightedSum += weight * smallest;
+        weightSum += weight;
         tie = tie || std::abs(smallest - tau) < kTie;
     }
-    if (std::abs(sum / 8.0 - tau) < kTie || (tie && surface.edgeRule)) {
+    const double mean = weightSum > 0.0 ? weightedSum / weightSum : 1.0;
+    if (std::abs(mean - tau) < kTie || (tie && surface.edgeRule)) {
         return std::nullopt;
     }
-    bool visible = sum / 8.0 >= tau;
+    bool visible = mean >= tau;
     if (!visible && surface.edgeRule) {
         int open = 0;
-        for (double value : omega) {
-            open += value >= tau;
+        for (int k = 0; k < 8; ++k) {
+            open += complete[k] && omega[k] >= tau;
         }
+        auto occludes = [&](int k) { return complete[k % 8] && omega[k % 8] < tau; };
         for (int k = 0; k < 8 && !visible; ++k) {
-            visible =
-                omega[k] < tau && omega[(k + 1) % 8] < tau && omega[(k + 2) % 8] < tau && open >= 3;
+            visible = occludes(k) && occludes(k + 1) && occludes(k + 2) && open >= 3;
         }
     }
     return visible;
@@ -434,7 +443,8 @@ TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
                     for (int l = 0; l <= maxLevel && !found; ++l) {
                         const Level& lv = all[l];
                         const int qx = (x >> l) + direction[0], qy = (y >> l) + direction[1];
-                        found = qx >= 0 && qy >= 0 && qx < lv.width && qy < lv.height &&
+                        // Beyond the image counts as found: the surface goes on past it.
+                        found = qx < 0 || qy < 0 || qx >= lv.width || qy >= lv.height ||
                                 weights[lv.offset + qy * lv.width + qx] > 0.0f;
                     }
                     enclosed += found;
@@ -449,7 +459,7 @@ TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
         }
     }
     EXPECT_LT(ties, 3);
-    EXPECT_GT(kept, 100);  // all three outcomes occur in this frame
+    EXPECT_GT(kept, 80);  // all three outcomes occur in this frame
     EXPECT_GT(filledGaps, 20);
     EXPECT_GT(removed, 0);
 }
