@@ -42,7 +42,6 @@ bool visibleAt(ivec2 pixel, float depth) {
 
     float omega[8];
     bool complete[8];
-    ivec2 imageSize = levelSize(0u);
     float weightedSum = 0.0;
     float weightSum = 0.0;
     for (int k = 0; k < 8; ++k) {
@@ -54,7 +53,7 @@ bool visibleAt(ivec2 pixel, float depth) {
         for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
             ivec2 texel = (pixel >> level) + kDirections[k];
             bool withinImage = all(greaterThanEqual(texel, ivec2(0))) &&
-                               all(lessThanEqual((texel + 1) << level, imageSize));
+                               all(lessThanEqual((texel + 1) << level, imageSizeOfFrame()));
             seen += withinImage ? 1u : 0u;
             float neighbourDepth =
                 minDepth[texelIndex(place, clamp(texel, ivec2(0), place.size - 1))];
