@@ -1,11 +1,15 @@
 #version 450
 // Compute rasterization of 1-pixel points (Schuetz et al. 2021): per pixel keep the nearest
 // point, ties broken by the smaller point index, so every path gives the same winner.
-//   STAGE_DEPTH    one thread per point: 32-bit atomicMin of the depth bits
+//   STAGE_DEPTH    one thread per point: 32-bit atomicMin of the depth bits, straight into the
+//                  "depth" image (viewed as r32ui; cleared to +inf, whose bits are the largest)
 //   STAGE_INDEX    one thread per point: among points at the winning depth, atomicMin of index
 //   STAGE_INT64    one thread per point: one 64-bit atomicMin of depthBits << 32 | index
-//   STAGE_RESOLVE  one thread per pixel: the winner's depth and linear colour into images
-// Positive IEEE floats order like their bit patterns, so depth bits compare as uints.
+//   STAGE_RESOLVE  one thread per pixel: the winner's linear colour (and with USE_INT64 its
+//                  depth) into images
+// Positive IEEE floats order like their bit patterns, so depth bits compare as uints. The
+// 32-bit path keeps its per-pixel words in images rather than storage buffers: on llvmpipe an
+// image load is a vector gather, a storage buffer load one guarded scalar load per lane.
 #if STAGE_INT64 || (STAGE_RESOLVE && USE_INT64)
 #extension GL_ARB_gpu_shader_int64 : require
 #extension GL_NV_shader_atomic_int64 : require
@@ -21,12 +25,14 @@ layout(std430, binding = SUBSCAN_SSBO_POSITIONS) readonly buffer Positions {
 layout(std430, binding = SUBSCAN_SSBO_COLORS) readonly buffer Colors {
     uint colors[];
 };
-layout(std430, binding = SUBSCAN_SSBO_DEPTH_BITS) buffer DepthBits {
-    uint depthBits[];
-};
-layout(std430, binding = SUBSCAN_SSBO_POINT_INDEX) buffer PointIndex {
-    uint pointIndex[];
-};
+#if STAGE_DEPTH
+layout(binding = SUBSCAN_IMAGE_OUT0, r32ui) uniform uimage2D depthBits;
+#elif STAGE_INDEX
+layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D depthBits;
+layout(binding = SUBSCAN_IMAGE_OUT2, r32ui) uniform uimage2D pointIndex;
+#elif STAGE_RESOLVE && !USE_INT64
+layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D pointIndex;
+#endif
 #if STAGE_INT64 || (STAGE_RESOLVE && USE_INT64)
 layout(std430, binding = SUBSCAN_SSBO_DEPTH_INDEX) buffer DepthIndex {
     uint64_t depthIndex[];
@@ -35,7 +41,9 @@ layout(std430, binding = SUBSCAN_SSBO_DEPTH_INDEX) buffer DepthIndex {
 
 #if STAGE_RESOLVE
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+#if USE_INT64
 layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
+#endif
 layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor;
 
 void main() {
@@ -43,19 +51,18 @@ void main() {
     if (any(greaterThanEqual(pixel, imageSizeOfFrame()))) {
         return;
     }
-    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
 #if USE_INT64
-    uint64_t key = depthIndex[linear];
+    uint64_t key = depthIndex[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)];
     uint winner = uint(key & 0xFFFFFFFFul);
-    float depth = uintBitsToFloat(uint(key >> 32));
 #else
-    uint winner = pointIndex[linear];
-    float depth = uintBitsToFloat(depthBits[linear]);
+    uint winner = imageLoad(pointIndex, pixel).r;
 #endif
     if (winner == 0xFFFFFFFFu) {
         // Empty pixel: written once, by the dispatch of the first chunk.
         if (raster.firstPoint == 0u) {
+#if USE_INT64
             imageStore(outDepth, pixel, vec4(kInfinity));
+#endif
             imageStore(outColor, pixel, vec4(0.0));
         }
         return;
@@ -63,7 +70,9 @@ void main() {
     if (winner < raster.firstPoint || winner - raster.firstPoint >= raster.pointCount) {
         return;  // another chunk's point
     }
-    imageStore(outDepth, pixel, vec4(depth));
+#if USE_INT64
+    imageStore(outDepth, pixel, vec4(uintBitsToFloat(uint(key >> 32))));
+#endif
     imageStore(outColor, pixel, vec4(unpackColor(colors[winner - raster.firstPoint]), 1.0));
 }
 
@@ -83,16 +92,16 @@ void main() {
     if (!projectToPixel(viewPosition, pixel, depth)) {
         return;
     }
-    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
     uint bits = floatBitsToUint(depth);
     uint index = raster.firstPoint + local;
 #if STAGE_DEPTH
-    atomicMin(depthBits[linear], bits);
+    imageAtomicMin(depthBits, pixel, bits);
 #elif STAGE_INDEX
-    if (depthBits[linear] == bits) {
-        atomicMin(pointIndex[linear], index);
+    if (imageLoad(depthBits, pixel).r == bits) {
+        imageAtomicMin(pointIndex, pixel, index);
     }
 #elif STAGE_INT64
+    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
     atomicMin(depthIndex[linear], (uint64_t(bits) << 32) | uint64_t(index));
 #endif
 }

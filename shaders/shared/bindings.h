@@ -31,8 +31,6 @@ using mat4 = glm::mat4;
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_POSITIONS 0      // float x, y, z per point (cloud-relative)
 #define SUBSCAN_SSBO_COLORS 1         // uint RGBA8, sRGB-encoded, per point
-#define SUBSCAN_SSBO_DEPTH_BITS 2     // uint per pixel: floatBitsToUint(linear depth)
-#define SUBSCAN_SSBO_POINT_INDEX 3    // uint per pixel: the winning point
 #define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
 #define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
 #define SUBSCAN_SSBO_PULL_VALUES 6    // vec4 per texel, all levels: w * (depth, r, g, b)

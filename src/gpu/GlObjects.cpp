@@ -167,12 +167,26 @@ void Texture::bindImage(GLuint unit, GLenum access) const {
     glBindImageTexture(unit, id(), 0, GL_FALSE, 0, access, info(format_).internalFormat);
 }
 
+void Texture::bindImageBits(GLuint unit, GLenum access) const {
+    if (format_ != TextureFormat::R32F && format_ != TextureFormat::R32UI) {
+        throw Error("only 32-bit single-channel textures can be bound as their bits");
+    }
+    glBindImageTexture(unit, id(), 0, GL_FALSE, 0, access, GL_R32UI);
+}
+
 void Texture::bindSampler(GLuint unit) const {
     glBindTextureUnit(unit, id());
 }
 
 void Texture::clear(const glm::vec4& value) {
     glClearTexImage(id(), 0, info(format_).pixelFormat, GL_FLOAT, &value.x);
+}
+
+void Texture::clearUint(std::uint32_t value) {
+    if (format_ != TextureFormat::R32UI) {
+        throw Error("clearUint needs an R32UI texture");
+    }
+    glClearTexImage(id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &value);
 }
 
 namespace {

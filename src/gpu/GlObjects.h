@@ -131,9 +131,14 @@ class Texture {
     int channels() const;
 
     void bindImage(GLuint unit, GLenum access) const;
+    /// Binds an R32F or R32UI texture as an r32ui image: the raw bits of each texel, for
+    /// atomics on float bits (positive floats order like their bit patterns).
+    void bindImageBits(GLuint unit, GLenum access) const;
     void bindSampler(GLuint unit) const;
     /// Sets every texel to `value` (as many components as the format has).
     void clear(const glm::vec4& value = glm::vec4(0.0f));
+    /// Sets every texel of an R32UI texture to `value`.
+    void clearUint(std::uint32_t value);
 
     /// Texel values, row 0 first, `channels()` per texel (RGBA8 and R8 come back normalised to
     /// 0..1 by readFloats).

@@ -1,5 +1,7 @@
 #include "render/RasterizePointsPass.h"
 
+#include <limits>
+
 #include <fmt/format.h>
 
 #include "core/Error.h"
@@ -16,7 +18,6 @@ std::string stageDefines(bool depth, bool index, bool int64, bool resolve, bool 
 }
 
 constexpr std::uint32_t kEmptyIndex = 0xFFFFFFFFu;
-constexpr std::uint32_t kInfinityBits = 0x7F800000u;
 
 }  // namespace
 
@@ -50,16 +51,17 @@ RasterPath RasterizePointsPass::resolvePath(RasterPath requested,
     return requested;
 }
 
-void RasterizePointsPass::ensurePixelBuffers(std::size_t pixels, bool int64) {
+void RasterizePointsPass::ensurePixelStorage(int width, int height, bool int64) {
     if (int64) {
-        if (depthIndex_.size() != pixels * sizeof(std::uint64_t)) {
-            depthIndex_ = Buffer(pixels * sizeof(std::uint64_t), nullptr, "RasterizePoints.key");
+        const std::size_t bytes = static_cast<std::size_t>(width) *
+                                  static_cast<std::size_t>(height) * sizeof(std::uint64_t);
+        if (depthIndex_.size() != bytes) {
+            depthIndex_ = Buffer(bytes, nullptr, "RasterizePoints.key");
         }
         return;
     }
-    if (depthBits_.size() != pixels * sizeof(std::uint32_t)) {
-        depthBits_ = Buffer(pixels * sizeof(std::uint32_t), nullptr, "RasterizePoints.depth");
-        pointIndex_ = Buffer(pixels * sizeof(std::uint32_t), nullptr, "RasterizePoints.index");
+    if (pointIndex_.width() != width || pointIndex_.height() != height) {
+        pointIndex_ = Texture(TextureFormat::R32UI, width, height, "RasterizePoints.index");
     }
 }
 
@@ -83,7 +85,7 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
 
 std::vector<std::uint32_t> RasterizePointsPass::readWinners() const {
     if (!lastFrameInt64_) {
-        return pointIndex_.read<std::uint32_t>();
+        return pointIndex_.readUints();
     }
     const std::vector<std::uint64_t> keys = depthIndex_.read<std::uint64_t>();
     std::vector<std::uint32_t> winners(keys.size());
@@ -96,11 +98,10 @@ std::vector<std::uint32_t> RasterizePointsPass::readWinners() const {
 void RasterizePointsPass::execute(FrameContext& frame) {
     const int width = frame.camera.width;
     const int height = frame.camera.height;
-    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
     const bool int64 =
         resolvePath(frame.settings.raster.path, frame.capabilities) == RasterPath::Int64;
     lastFrameInt64_ = int64;
-    ensurePixelBuffers(pixels, int64);
+    ensurePixelStorage(width, height, int64);
     Texture& depth = frame.resources.ensureTexture("depth", TextureFormat::R32F, width, height);
     Texture& color = frame.resources.ensureTexture("color", TextureFormat::RGBA16F, width, height);
 
@@ -108,17 +109,20 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         depthIndex_.fill(kEmptyIndex);  // both halves all ones: no depth, no point
         depthIndex_.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
         runPerChunk(int64Stage_, frame, false);
-    } else {
-        depthBits_.fill(kInfinityBits);
-        pointIndex_.fill(kEmptyIndex);
-        depthBits_.bindStorage(SUBSCAN_SSBO_DEPTH_BITS);
-        pointIndex_.bindStorage(SUBSCAN_SSBO_POINT_INDEX);
-        runPerChunk(depthStage_, frame, false);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        depth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    } else {
+        depth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
+        pointIndex_.clearUint(kEmptyIndex);
+        depth.bindImageBits(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
+        runPerChunk(depthStage_, frame, false);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        depth.bindImageBits(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+        pointIndex_.bindImage(SUBSCAN_IMAGE_OUT2, GL_READ_WRITE);
         runPerChunk(indexStage_, frame, false);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        pointIndex_.bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    depth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     color.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     runPerChunk(int64 ? resolve64_ : resolve32_, frame, true);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

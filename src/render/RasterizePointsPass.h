@@ -29,7 +29,7 @@ class RasterizePointsPass final : public RenderPass {
     std::vector<std::uint32_t> readWinners() const;
 
   private:
-    void ensurePixelBuffers(std::size_t pixels, bool int64);
+    void ensurePixelStorage(int width, int height, bool int64);
     void runPerChunk(const Program& program, FrameContext& frame, bool perPixel);
 
     Program depthStage_;
@@ -38,9 +38,8 @@ class RasterizePointsPass final : public RenderPass {
     Program int64Stage_;  // only where 64-bit atomics exist
     Program resolve64_;
     UniformBlock<gpu::RasterParams> params_{"RasterizePoints.params"};
-    Buffer depthBits_;
-    Buffer pointIndex_;
-    Buffer depthIndex_;
+    Texture pointIndex_;  // R32UI, the two-pass path's winners
+    Buffer depthIndex_;   // the 64-bit path's keys
     bool lastFrameInt64_ = false;
 };
 
