@@ -22,12 +22,14 @@ layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
 layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
     SurfaceParams surface;
 };
-layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) readonly buffer PullWeights {
-    float pullWeight[];
-};
-layout(std430, binding = SUBSCAN_SSBO_FILL_REACH) buffer FillReach {
+layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
+// Written as a storage buffer, read as a buffer texture (see Buffer::bindTexels).
+layout(std430, binding = SUBSCAN_SSBO_FILL_REACH) writeonly buffer FillReach {
     uint fillReach[];
 };
+layout(binding = SUBSCAN_TEXELS_FILL_REACH) uniform usamplerBuffer fillReachTexels;
+
+float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
 #if STAGE_MASK
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inFilledDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outMask;
@@ -41,14 +43,14 @@ const uint kNoReach = 15u;
 /// Beyond the image counts as weighted: a surface that reaches the image's border goes on past
 /// it, and would otherwise lose its outermost pixels (a frame of background around close-ups).
 bool weighted(uint onLevel, ivec2 texel) {
-    return !insideLevel(onLevel, texel) || pullWeight[texelIndex(onLevel, texel)] > 0.0;
+    return !insideLevel(onLevel, texel) || pullWeightAt(texelIndex(onLevel, texel)) > 0.0;
 }
 
 /// Per direction, `onLevel` where the neighbour of `texel` on that level has weight, else the
 /// parent's answer (levels above `onLevel`).
 uint reachOf(uint onLevel, ivec2 texel) {
     uint parent = onLevel + 1u < levelCount()
-                      ? fillReach[texelIndex(onLevel + 1u, texel >> 1)]
+                      ? texelFetch(fillReachTexels, int(texelIndex(onLevel + 1u, texel >> 1))).r
                       : kNoReach * 0x11111111u;
     uint reach = 0u;
     for (int k = 0; k < 8; ++k) {
@@ -73,7 +75,7 @@ void main() {
     float depth = imageLoad(inFilledDepth, pixel).r;
     bool surfacePixel = false;
     if (depth > 0.0 && !isinf(depth) && !isnan(depth)) {
-        if (pullWeight[texelIndex(0u, pixel)] > 0.0) {
+        if (pullWeightAt(texelIndex(0u, pixel)) > 0.0) {
             surfacePixel = true;
         } else {
             // Level 1 at least: its texels bridge one-pixel gaps between dense points.

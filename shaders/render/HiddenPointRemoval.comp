@@ -18,9 +18,7 @@ layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GRO
 layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
     SurfaceParams surface;
 };
-layout(std430, binding = SUBSCAN_SSBO_PYRAMID) readonly buffer Pyramid {
-    float minDepth[];
-};
+layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility;
 
 const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
@@ -55,8 +53,8 @@ bool visibleAt(ivec2 pixel, float depth) {
             bool withinImage = all(greaterThanEqual(texel, ivec2(0))) &&
                                all(lessThanEqual((texel + 1) << level, imageSizeOfFrame()));
             seen += withinImage ? 1u : 0u;
-            float neighbourDepth =
-                minDepth[texelIndex(place, clamp(texel, ivec2(0), place.size - 1))];
+            float neighbourDepth = texelFetch(
+                minDepthTexels, int(texelIndex(place, clamp(texel, ivec2(0), place.size - 1)))).r;
             vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
             float value = 1.0 - dot(normalize(y - x), toCamera);
             smallest = withinImage && !isinf(neighbourDepth) ? min(smallest, value) : smallest;
@@ -91,7 +89,7 @@ void main() {
     barrier();
     ivec2 pixel = dispatchTexel();
     if (insideLevel(0u, pixel)) {
-        if (isinf(minDepth[texelIndex(0u, pixel)])) {
+        if (isinf(texelFetch(minDepthTexels, int(texelIndex(0u, pixel))).r)) {
             imageStore(outVisibility, pixel, vec4(0.0));
         } else {
             occupied[atomicAdd(occupiedCount, 1u)] = gl_LocalInvocationIndex;
@@ -102,7 +100,8 @@ void main() {
         uint local = occupied[gl_LocalInvocationIndex];
         ivec2 target = pixel - ivec2(gl_LocalInvocationID.xy) +
                        ivec2(local % gl_WorkGroupSize.x, local / gl_WorkGroupSize.x);
-        bool visible = visibleAt(target, minDepth[texelIndex(0u, target)]);
+        bool visible =
+            visibleAt(target, texelFetch(minDepthTexels, int(texelIndex(0u, target))).r);
         imageStore(outVisibility, target, vec4(visible ? 1.0 : 0.0));
     }
 }

@@ -10,9 +10,10 @@
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
-layout(std430, binding = SUBSCAN_SSBO_PYRAMID) buffer Pyramid {
+layout(std430, binding = SUBSCAN_SSBO_PYRAMID) writeonly buffer Pyramid {
     float minDepth[];
 };
+layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 #if STAGE_FIRST
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 #endif
@@ -35,7 +36,7 @@ void main() {
     }
 #endif
 #if STAGE_BOUNDS
-    if (!isinf(minDepth[texelIndex(level, texel)])) {
+    if (!isinf(texelFetch(minDepthTexels, int(texelIndex(level, texel))).r)) {
         atomicMin(pointBounds.x, texel.x);
         atomicMin(pointBounds.y, texel.y);
         atomicMax(pointBounds.z, texel.x);
@@ -52,7 +53,8 @@ void main() {
                 minDepth[texelIndex(0u, child)] = depth;
                 nearest = min(nearest, depth);
 #else
-                nearest = min(nearest, minDepth[texelIndex(level - 1u, child)]);
+                nearest =
+                    min(nearest, texelFetch(minDepthTexels, int(texelIndex(level - 1u, child))).r);
 #endif
             }
         }

@@ -13,12 +13,12 @@ layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
 layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
     SurfaceParams surface;
 };
-layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) readonly buffer PushValues {
-    vec4 pushValue[];
-};
-layout(std430, binding = SUBSCAN_SSBO_NORMALS) buffer Normals {
+layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
+// Written as a storage buffer, read as a buffer texture (see Buffer::bindTexels).
+layout(std430, binding = SUBSCAN_SSBO_NORMALS) writeonly buffer Normals {
     vec4 normalPyramid[];
 };
+layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
 #if STAGE_BLEND
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outNormals;
@@ -26,7 +26,8 @@ layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outNorma
 
 #if STAGE_LEVEL
 vec3 positionOf(ivec2 texel) {
-    return viewPositionAt(texelCentre(level, texel), pushValue[texelIndex(level, texel)].x);
+    return viewPositionAt(texelCentre(level, texel),
+                          texelFetch(pushValueTexels, int(texelIndex(level, texel))).x);
 }
 
 /// The tangent along `axis`: towards whichever existing neighbour has the smaller depth jump.
@@ -52,7 +53,7 @@ vec3 normalOnLevel(uint normalLevel, vec2 window) {
     bilinearTexels(normalLevel, window, texels, weights);
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; ++i) {
-        sum += weights[i] * normalPyramid[texelIndex(normalLevel, texels[i])].xyz;
+        sum += weights[i] * texelFetch(normalTexels, int(texelIndex(normalLevel, texels[i]))).xyz;
     }
     return sum;
 }

@@ -18,15 +18,23 @@ layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
 layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
     SurfaceParams surface;
 };
-layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) buffer PullValues {
+// Written as storage buffers, read as buffer textures (see Buffer::bindTexels).
+layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) writeonly buffer PullValues {
     vec4 pullValue[];
 };
-layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) buffer PullWeights {
+layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) writeonly buffer PullWeights {
     float pullWeight[];
 };
-layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) buffer PushValues {
+layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) writeonly buffer PushValues {
     vec4 pushValue[];
 };
+layout(binding = SUBSCAN_TEXELS_PULL_VALUES) uniform samplerBuffer pullValueTexels;
+layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
+layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
+
+vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
+float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
+vec4 pushValueAt(uint index) { return texelFetch(pushValueTexels, int(index)); }
 #if STAGE_PULL_INIT
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inColor;
@@ -66,8 +74,8 @@ void main() {
         ivec2 child = 2 * texel + ivec2(c % 4 - 1, c / 4 - 1);
         uint childIndex =
             texelIndex(level - 1u, clamp(child, ivec2(0), levelSize(level - 1u) - 1));
-        float weight = insideLevel(level - 1u, child) ? pullWeight[childIndex] : 0.0;
-        vec4 value = pullValue[childIndex];
+        float weight = insideLevel(level - 1u, child) ? pullWeightAt(childIndex) : 0.0;
+        vec4 value = pullValueAt(childIndex);
         weights[c] = weight;
         values[c] = weight > 0.0 ? value : vec4(0.0);
         depths[c] = weight > 0.0 ? value.x / weight : kInfinity;
@@ -87,21 +95,22 @@ void main() {
     pullWeight[index] = clamped;
     pullValue[index] = weightSum > 0.0 ? valueSum * (clamped / weightSum) : vec4(0.0);
 #elif STAGE_PUSH_TOP
-    float weight = pullWeight[index];
-    pushValue[index] = weight > 0.0 ? pullValue[index] / weight : vec4(kInfinity, 0.0, 0.0, 0.0);
+    float weight = pullWeightAt(index);
+    pushValue[index] = weight > 0.0 ? pullValueAt(index) / weight : vec4(kInfinity, 0.0, 0.0, 0.0);
 #else
     // Coarse neighbours of this texel and their weights {3/4, 1/4} per axis.
     ivec2 coarseSize = levelSize(level + 1u);
     ivec2 near = texel >> 1;
     ivec2 far = clamp(near + ((texel & 1) * 2 - 1), ivec2(0), coarseSize - 1);
-    vec4 m = 0.5625 * pushValue[texelIndex(level + 1u, near)] +
-             0.1875 * pushValue[texelIndex(level + 1u, ivec2(far.x, near.y))] +
-             0.1875 * pushValue[texelIndex(level + 1u, ivec2(near.x, far.y))] +
-             0.0625 * pushValue[texelIndex(level + 1u, far)];
+    vec4 m = 0.5625 * pushValueAt(texelIndex(level + 1u, near)) +
+             0.1875 * pushValueAt(texelIndex(level + 1u, ivec2(far.x, near.y))) +
+             0.1875 * pushValueAt(texelIndex(level + 1u, ivec2(near.x, far.y))) +
+             0.0625 * pushValueAt(texelIndex(level + 1u, far));
     // A fully weighted texel needs nothing from above (and an empty image above would give
     // 0 * inf = NaN).
-    float weight = pullWeight[index];
-    vec4 complete = weight >= 1.0 ? pullValue[index] : pullValue[index] + (1.0 - weight) * m;
+    float weight = pullWeightAt(index);
+    vec4 own = pullValueAt(index);
+    vec4 complete = weight >= 1.0 ? own : own + (1.0 - weight) * m;
     // Level 0 lives only in the images: nothing reads it from the buffer.
     if (level == 0u) {
         imageStore(outDepth, texel, vec4(complete.x));

@@ -40,6 +40,14 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 #define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
 
+// ---- buffer textures: the pyramids above, read with texelFetch (Buffer::bindTexels) ----
+#define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
+#define SUBSCAN_TEXELS_PULL_VALUES 1   // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
+#define SUBSCAN_TEXELS_PULL_WEIGHTS 2  // r32f view of SUBSCAN_SSBO_PULL_WEIGHTS
+#define SUBSCAN_TEXELS_PUSH_VALUES 3   // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
+#define SUBSCAN_TEXELS_NORMALS 4       // rgba32f view of SUBSCAN_SSBO_NORMALS
+#define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
+
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0
 #define SUBSCAN_IMAGE_OUT1 1

@@ -111,7 +111,8 @@ GLuint linkProgram(std::span<const GLuint> shaders, std::string_view name) {
 
 // ---- Buffer -------------------------------------------------------------------------------
 
-Buffer::Buffer(std::size_t bytes, const void* data, std::string_view labelText) : size_(bytes) {
+Buffer::Buffer(std::size_t bytes, const void* data, std::string_view labelText)
+    : size_(bytes), label_(labelText) {
     GLuint id = 0;
     glCreateBuffers(1, &id);
     name_ = GlName<BufferTraits>(id);
@@ -140,6 +141,34 @@ void Buffer::bindStorage(GLuint binding) const {
 
 void Buffer::bindUniform(GLuint binding) const {
     glBindBufferBase(GL_UNIFORM_BUFFER, binding, id());
+}
+
+void Buffer::bindTexels(GLuint unit, TextureFormat format) {
+    if (!texelView_ || texelFormat_ != format) {
+        if (format != TextureFormat::R32F && format != TextureFormat::RGBA32F &&
+            format != TextureFormat::R32UI) {
+            throw Error(
+                fmt::format("the buffer '{}' cannot be read as texels of that format: "
+                            "only 32-bit channels are supported",
+                            label_));
+        }
+        const FormatInfo texel = info(format);
+        const std::size_t texelBytes = static_cast<std::size_t>(texel.channels) * 4;
+        GLint maxTexels = 0;
+        glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
+        if (size_ / texelBytes > static_cast<std::size_t>(maxTexels)) {
+            throw Error(
+                fmt::format("the buffer '{}' holds {} texels, more than the {} the GPU "
+                            "reads through one buffer texture (use a smaller image)",
+                            label_, size_ / texelBytes, maxTexels));
+        }
+        GLuint view = 0;
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &view);
+        texelView_ = GlName<TextureTraits>(view);
+        glTextureBuffer(view, texel.internalFormat, id());
+        texelFormat_ = format;
+    }
+    glBindTextureUnit(unit, texelView_.id());
 }
 
 // ---- Texture ------------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -67,6 +68,8 @@ struct QueryTraits {
     static void destroy(GLuint id) { glDeleteQueries(1, &id); }
 };
 
+enum class TextureFormat { R32F, RG32F, RGBA16F, RGBA32F, RGBA8, R32UI, R8, Depth32F };
+
 /// Immutable-storage buffer (glNamedBufferStorage) that can be updated and read back.
 class Buffer {
   public:
@@ -90,6 +93,12 @@ class Buffer {
 
     void bindStorage(GLuint binding) const;
     void bindUniform(GLuint binding) const;
+    /// Binds the buffer to texture unit `unit` as a buffer texture of `format` texels (a
+    /// samplerBuffer or usamplerBuffer read with texelFetch). On llvmpipe a texel fetch is a
+    /// vector gather, while a storage buffer load is one guarded scalar load per lane, so
+    /// passes read pyramids this way and write them as storage buffers. Throws subscan::Error
+    /// when the buffer holds more texels than the driver's buffer textures may.
+    void bindTexels(GLuint unit, TextureFormat format);
 
     template <class T>
     std::vector<T> read() const {
@@ -101,6 +110,9 @@ class Buffer {
   private:
     GlName<BufferTraits> name_;
     std::size_t size_ = 0;
+    std::string label_;
+    GlName<TextureTraits> texelView_;  // created by the first bindTexels
+    TextureFormat texelFormat_ = TextureFormat::R32F;
 };
 
 /// A uniform buffer holding exactly one T (a struct from shaders/shared/bindings.h).
@@ -114,8 +126,6 @@ class UniformBlock {
   private:
     Buffer buffer_;
 };
-
-enum class TextureFormat { R32F, RG32F, RGBA16F, RGBA32F, RGBA8, R32UI, R8, Depth32F };
 
 /// 2-D texture with immutable storage and a single level. (Image pyramids live in storage
 /// buffers instead: GL mip levels are floor(W / 2^R) wide, the pipeline's levels ceil(W / 2^R).)

@@ -16,9 +16,11 @@ void FillRemovalPass::execute(FrameContext& frame) {
         resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
-    resources.buffer("pullWeights").bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
-    resources.ensureBuffer("fillReach", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t))
-        .bindStorage(SUBSCAN_SSBO_FILL_REACH);
+    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
+    Buffer& fillReach =
+        resources.ensureBuffer("fillReach", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t));
+    fillReach.bindStorage(SUBSCAN_SSBO_FILL_REACH);
+    fillReach.bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
     resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
@@ -29,7 +31,7 @@ void FillRemovalPass::execute(FrameContext& frame) {
     // Coarsest first: every level reads its parent's answer. Level 0 is part of the mask stage.
     for (unsigned level = frame.pyramid.info.x; level-- > 1;) {
         stages_.runOverRegion(Reach, frame.region(level), level);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     }
     stages_.runOverRegion(Mask, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

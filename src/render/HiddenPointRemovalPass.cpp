@@ -8,7 +8,7 @@ HiddenPointRemovalPass::HiddenPointRemovalPass(const ShaderSources& sources)
 void HiddenPointRemovalPass::execute(FrameContext& frame) {
     Texture& visibility = frame.resources.ensureTexture("visibility", TextureFormat::R8,
                                                         frame.width(), frame.height());
-    frame.resources.buffer("pyramid").bindStorage(SUBSCAN_SSBO_PYRAMID);
+    frame.resources.buffer("pyramid").bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
     visibility.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -15,14 +15,15 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
     Buffer& pyramid =
         frame.resources.ensureBuffer("pyramid", pyramidTexels(frame.pyramid) * sizeof(float));
     pyramid.bindStorage(SUBSCAN_SSBO_PYRAMID);
+    pyramid.bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
     frame.resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     stages_.runOverImage(First, (frame.width() + 1) / 2, (frame.height() + 1) / 2, 1);
     for (unsigned level = 2; level < frame.pyramid.info.x; ++level) {
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         const auto& size = frame.pyramid.levels[level];
         stages_.runOverImage(Reduce, static_cast<int>(size.y), static_cast<int>(size.z), level);
     }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     frame.pointBounds.reset();
     if (surfaceBoundsAllowed(frame.settings)) {
         frame.pointBounds = measureBounds(frame);

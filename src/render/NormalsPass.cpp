@@ -9,9 +9,11 @@ NormalsPass::NormalsPass(const ShaderSources& sources)
 
 void NormalsPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
-    resources.ensureBuffer("normalPyramid", pyramidTexels(frame.pyramid) * 4 * sizeof(float))
-        .bindStorage(SUBSCAN_SSBO_NORMALS);
-    resources.buffer("pushValues").bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
+    Buffer& normalPyramid =
+        resources.ensureBuffer("normalPyramid", pyramidTexels(frame.pyramid) * 4 * sizeof(float));
+    normalPyramid.bindStorage(SUBSCAN_SSBO_NORMALS);
+    normalPyramid.bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
+    resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     Texture& normals =
         resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
     // From level 1: the blend never reads level 0 (its smoothing level is at least 1), and the
@@ -19,7 +21,7 @@ void NormalsPass::execute(FrameContext& frame) {
     for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
         stages_.runOverRegion(Level, frame.region(level), level);
     }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {

@@ -10,16 +10,19 @@ PullPushPass::PullPushPass(const ShaderSources& sources)
 void PullPushPass::execute(FrameContext& frame) {
     const std::size_t texels = pyramidTexels(frame.pyramid);
     FrameResources& resources = frame.resources;
-    resources.ensureBuffer("pullValues", texels * 4 * sizeof(float))
-        .bindStorage(SUBSCAN_SSBO_PULL_VALUES);
+    Buffer& pullValues = resources.ensureBuffer("pullValues", texels * 4 * sizeof(float));
+    pullValues.bindStorage(SUBSCAN_SSBO_PULL_VALUES);
+    pullValues.bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
     Buffer& pullWeights = resources.ensureBuffer("pullWeights", texels * sizeof(float));
     pullWeights.bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
+    pullWeights.bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
     if (frame.restricted()) {
         // Pull and fill removal read weights around their region: there they must be zero.
         pullWeights.fill(0);
     }
-    resources.ensureBuffer("pushValues", texels * 4 * sizeof(float))
-        .bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
+    Buffer& pushValues = resources.ensureBuffer("pushValues", texels * 4 * sizeof(float));
+    pushValues.bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
+    pushValues.bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     Texture& filledDepth =
         resources.ensureTexture("filledDepth", TextureFormat::R32F, frame.width(), frame.height());
     Texture& filledColor = resources.ensureTexture("filledColor", TextureFormat::RGBA16F,
@@ -33,7 +36,7 @@ void PullPushPass::execute(FrameContext& frame) {
     const unsigned levels = frame.pyramid.info.x;
     auto run = [&](Stage stage, unsigned level) {
         stages_.runOverRegion(stage, frame.region(level), level);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     };
     run(PullInit, 0);
     for (unsigned level = 1; level < levels; ++level) {

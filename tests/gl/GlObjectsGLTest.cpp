@@ -1,0 +1,56 @@
+// The GL object wrappers' less common views: buffers read as buffer textures, float textures
+// bound as their bits, integer textures cleared. (What the passes read through these views is
+// checked against CPU twins in SurfacePassesGLTest and RasterizePointsGLTest.)
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/Error.h"
+#include "gpu/GlObjects.h"
+#include "support/GlTestSupport.h"
+
+namespace subscan {
+namespace {
+
+std::string errorOf(auto&& call) {
+    try {
+        call();
+    } catch (const Error& error) {
+        return error.what();
+    }
+    return "";
+}
+
+TEST(GlObjectsGLTest, BufferTexelsNeedThirtyTwoBitChannelsAndNameTheBuffer) {
+    test::glTestContext();
+    Buffer buffer(64, nullptr, "test.pyramid");
+    EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::R32F));
+    EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::RGBA32F));  // a new view of the same
+    EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::R32UI));
+    const std::string message = errorOf([&] { buffer.bindTexels(0, TextureFormat::RGBA16F); });
+    EXPECT_NE(message.find("'test.pyramid'"), std::string::npos) << message;
+}
+
+TEST(GlObjectsGLTest, ClearUintFillsAnR32uiTextureAndRefusesOthers) {
+    test::glTestContext();
+    Texture winners(TextureFormat::R32UI, 5, 3, "test.winners");
+    winners.clearUint(0xFFFFFFFFu);
+    EXPECT_EQ(winners.readUints(), std::vector<std::uint32_t>(15, 0xFFFFFFFFu));
+    winners.clearUint(7u);
+    EXPECT_EQ(winners.readUints(), std::vector<std::uint32_t>(15, 7u));
+    Texture depth(TextureFormat::R32F, 5, 3, "test.depth");
+    EXPECT_FALSE(errorOf([&] { depth.clearUint(1u); }).empty());
+}
+
+TEST(GlObjectsGLTest, OnlySingleChannelThirtyTwoBitTexturesBindAsBits) {
+    test::glTestContext();
+    Texture depth(TextureFormat::R32F, 4, 4, "test.depth");
+    EXPECT_NO_THROW(depth.bindImageBits(0, GL_READ_WRITE));
+    Texture color(TextureFormat::RGBA16F, 4, 4, "test.color");
+    EXPECT_FALSE(errorOf([&] { color.bindImageBits(0, GL_READ_WRITE); }).empty());
+}
+
+}  // namespace
+}  // namespace subscan
