@@ -7,6 +7,7 @@
 //   STAGE_BOUNDS  the bounds of the texels of level `level` that hold a depth (min x, min y,
 //                 max x, max y): a coarse level keeps the atomics few
 #include "shared/pyramid.glsl"
+#include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
@@ -24,7 +25,7 @@ layout(std430, binding = SUBSCAN_SSBO_POINT_BOUNDS) buffer PointBounds {
 #endif
 
 void main() {
-    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 texel = dispatchTexel();
 #if STAGE_FIRST
     // A one-pixel image has no level 1 but still needs its level 0.
     if (any(greaterThanEqual(2 * texel, levelSize(0u)))) {

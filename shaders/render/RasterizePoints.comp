@@ -5,8 +5,8 @@
 //                  "depth" image (viewed as r32ui; cleared to +inf, whose bits are the largest)
 //   STAGE_INDEX    one thread per point: among points at the winning depth, atomicMin of index
 //   STAGE_INT64    one thread per point: one 64-bit atomicMin of depthBits << 32 | index
-//   STAGE_RESOLVE  one thread per pixel: the winner's linear colour (and with USE_INT64 its
-//                  depth) into images
+//   STAGE_RESOLVE  one thread per pixel of the cloud's projected bounding box: the winner's
+//                  linear colour (and with USE_INT64 its depth) into images cleared before
 // Positive IEEE floats order like their bit patterns, so depth bits compare as uints. The
 // 32-bit path keeps its per-pixel words in images rather than storage buffers: on llvmpipe an
 // image load is a vector gather, a storage buffer load one guarded scalar load per lane.
@@ -15,6 +15,7 @@
 #extension GL_NV_shader_atomic_int64 : require
 #endif
 #include "shared/common.glsl"
+#include "shared/region.glsl"
 
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform RasterBlock {
     RasterParams raster;
@@ -47,7 +48,7 @@ layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
 layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor;
 
 void main() {
-    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 pixel = dispatchTexel();
     if (any(greaterThanEqual(pixel, imageSizeOfFrame()))) {
         return;
     }
@@ -57,18 +58,9 @@ void main() {
 #else
     uint winner = imageLoad(pointIndex, pixel).r;
 #endif
-    if (winner == 0xFFFFFFFFu) {
-        // Empty pixel: written once, by the dispatch of the first chunk.
-        if (raster.firstPoint == 0u) {
-#if USE_INT64
-            imageStore(outDepth, pixel, vec4(kInfinity));
-#endif
-            imageStore(outColor, pixel, vec4(0.0));
-        }
-        return;
-    }
-    if (winner < raster.firstPoint || winner - raster.firstPoint >= raster.pointCount) {
-        return;  // another chunk's point
+    if (winner == 0xFFFFFFFFu || winner < raster.firstPoint ||
+        winner - raster.firstPoint >= raster.pointCount) {
+        return;  // an empty pixel (cleared before) or another chunk's point
     }
 #if USE_INT64
     imageStore(outDepth, pixel, vec4(uintBitsToFloat(uint(key >> 32))));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
@@ -26,6 +27,37 @@ glm::dvec3 Camera::eye() const {
 
 glm::dmat4 Camera::translation(const glm::dvec3& offset) {
     return glm::translate(glm::dmat4(1.0), offset);
+}
+
+glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds) {
+    const glm::ivec4 whole(0, 0, camera.width, camera.height);
+    if (bounds.empty()) {
+        return glm::ivec4(0);
+    }
+    const glm::dmat4 projection = camera.projection();
+    glm::dvec2 low(std::numeric_limits<double>::infinity());
+    glm::dvec2 high(-std::numeric_limits<double>::infinity());
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p((corner & 1) ? bounds.max.x : bounds.min.x,
+                           (corner & 2) ? bounds.max.y : bounds.min.y,
+                           (corner & 4) ? bounds.max.z : bounds.min.z);
+        const glm::dvec4 viewPosition = camera.view * glm::dvec4(p, 1.0);
+        if (!(-viewPosition.z > camera.nearPlane)) {
+            return whole;
+        }
+        const glm::dvec4 clip = projection * viewPosition;
+        const glm::dvec2 window((clip.x / clip.w + 1.0) * 0.5 * camera.width,
+                                (1.0 - clip.y / clip.w) * 0.5 * camera.height);
+        low = glm::min(low, window);
+        high = glm::max(high, window);
+    }
+    // A box in front of the camera projects inside the hull of its corners' projections.
+    constexpr double kMargin = 2.0;
+    const glm::dvec2 size(camera.width, camera.height);
+    const glm::dvec2 first = glm::clamp(glm::floor(low) - kMargin, glm::dvec2(0.0), size);
+    const glm::dvec2 last = glm::clamp(glm::floor(high) + 1.0 + kMargin, glm::dvec2(0.0), size);
+    return {static_cast<int>(first.x), static_cast<int>(first.y), static_cast<int>(last.x),
+            static_cast<int>(last.y)};
 }
 
 Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int height,

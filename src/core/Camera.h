@@ -4,6 +4,7 @@
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "core/PointCloud.h"
 
@@ -32,6 +33,12 @@ struct Camera {
 
     static glm::dmat4 translation(const glm::dvec3& offset);
 };
+
+/// Pixels [x0, y0, x1, y1) (row 0 at the top) that hold every point of `bounds` a rasterizer
+/// can draw with `camera`: the projected box plus a margin of 2 pixels for float rounding on the
+/// GPU; the whole image when a corner lies on or behind the near plane (the box's projection is
+/// then unbounded); empty (x1 <= x0) when `bounds` is empty or falls outside the image.
+glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds);
 
 enum class UpAxis { Y, Z };
 

@@ -1,11 +1,18 @@
 #include "render/MinDepthPyramidPass.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 
 #include "render/Pyramid.h"
 
 namespace subscan {
+
+namespace {
+
+constexpr std::uint32_t kInfinityBits = 0x7F800000u;
+
+}  // namespace
 
 MinDepthPyramidPass::MinDepthPyramidPass(const ShaderSources& sources)
     : stages_(sources, "render/MinDepthPyramid.comp", {"FIRST", "REDUCE", "BOUNDS"}),
@@ -17,7 +24,14 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
     pyramid.bindStorage(SUBSCAN_SSBO_PYRAMID);
     pyramid.bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
     frame.resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    stages_.runOverImage(First, (frame.width() + 1) / 2, (frame.height() + 1) / 2, 1);
+    // Levels 0 and 1 are copied only where the cloud's bounding box projects: elsewhere the
+    // depth is +inf, as the fill leaves it.
+    pyramid.fill(kInfinityBits);
+    // One invocation per level-1 texel (also for a one-pixel image, which has no level 1).
+    const TexelRegion pixels = frame.cloudRegion(0);
+    const glm::ivec2 first = pixels.origin / 2;
+    const glm::ivec2 end = (pixels.origin + pixels.size + 1) / 2;
+    stages_.runOverRegion(First, {first, end - first}, 1);
     for (unsigned level = 2; level < frame.pyramid.info.x; ++level) {
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
         const auto& size = frame.pyramid.levels[level];

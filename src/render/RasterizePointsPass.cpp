@@ -67,6 +67,10 @@ void RasterizePointsPass::ensurePixelStorage(int width, int height, bool int64) 
 
 void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& frame, bool perPixel) {
     program.use();
+    const TexelRegion region = frame.cloudRegion(0);
+    if (perPixel) {
+        glProgramUniform2i(program.id(), SUBSCAN_UNIFORM_ORIGIN, region.origin.x, region.origin.y);
+    }
     const std::size_t pixels = static_cast<std::size_t>(frame.camera.width) *
                                static_cast<std::size_t>(frame.camera.height);
     for (const GpuPointCloud::Chunk& chunk : frame.cloud.chunks()) {
@@ -75,7 +79,7 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
         chunk.positions.bindStorage(SUBSCAN_SSBO_POSITIONS);
         chunk.colors.bindStorage(SUBSCAN_SSBO_COLORS);
         if (perPixel) {
-            Program::dispatch2D(frame.camera.width, frame.camera.height, SUBSCAN_IMAGE_GROUP_SIZE,
+            Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
                                 SUBSCAN_IMAGE_GROUP_SIZE);
         } else {
             Program::dispatch1D(chunk.pointCount, SUBSCAN_POINTS_GROUP_SIZE);
@@ -105,6 +109,10 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     Texture& depth = frame.resources.ensureTexture("depth", TextureFormat::R32F, width, height);
     Texture& color = frame.resources.ensureTexture("color", TextureFormat::RGBA16F, width, height);
 
+    // Empty pixels: +inf and no colour. The resolve then visits only the pixels the cloud's
+    // bounding box projects to, and writes those that hold a point.
+    depth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
+    color.clear();
     if (int64) {
         depthIndex_.fill(kEmptyIndex);  // both halves all ones: no depth, no point
         depthIndex_.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
@@ -112,7 +120,6 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         depth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     } else {
-        depth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
         pointIndex_.clearUint(kEmptyIndex);
         depth.bindImageBits(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
         runPerChunk(depthStage_, frame, false);

@@ -30,6 +30,19 @@ TexelRegion FrameContext::region(unsigned level) const {
     return {first, last - first + 1};
 }
 
+TexelRegion FrameContext::cloudRegion(unsigned level) const {
+    const glm::ivec2 size(static_cast<int>(pyramid.levels[level].y),
+                          static_cast<int>(pyramid.levels[level].z));
+    if (!cloudPixels) {
+        return {glm::ivec2(0), size};
+    }
+    const glm::ivec4& pixels = *cloudPixels;
+    const int scale = 1 << level;
+    const glm::ivec2 first = glm::ivec2(pixels.x, pixels.y) / scale;
+    const glm::ivec2 end = glm::min((glm::ivec2(pixels.z, pixels.w) + scale - 1) / scale, size);
+    return {first, glm::max(end - first, glm::ivec2(0))};
+}
+
 bool surfaceBoundsAllowed(const RenderSettings& settings) {
     return settings.surface.restrictToPoints && settings.surface.fillDirections >= 6 &&
            isFinalImage(settings.raster.stage);

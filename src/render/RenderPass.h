@@ -31,10 +31,15 @@ struct FrameContext {
     /// output's camera, divisor) and Present scales up to the output's size.
     int divisor = 1;
     std::optional<glm::ivec2> reducedFrom;  // the output's size; unset at full resolution
+    /// Pixels [x, y, z, w) the cloud's bounding box projects to (projectedPixelBounds): no
+    /// point lands outside them. Unset: anywhere in the image.
+    std::optional<glm::ivec4> cloudPixels;
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }
     bool restricted() const { return pointBounds.has_value(); }
+    /// cloudPixels as a region of pyramid `level` (0: the image), rounded outwards.
+    TexelRegion cloudRegion(unsigned level) const;
     glm::ivec2 outputSize() const { return reducedFrom.value_or(glm::ivec2(width(), height())); }
     /// The texels of pyramid `level` (0: the image) a pass must compute: those around the
     /// points, with a margin for the 4x4 pull and the bilinear push and normal reads.

@@ -53,7 +53,8 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
     : context_(context),
       cloud_(cloud, context.capabilities(), maxChunkPoints),
       spacing_(usableSpacing(cloud, spacing)),
-      resolutionChooser_(cloud) {}
+      resolutionChooser_(cloud),
+      cloudBounds_(cloud.bounds) {}
 
 Renderer::~Renderer() = default;
 
@@ -123,6 +124,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     lastDivisor_ = divisor;
     FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
                          resourcesFor(divisor), layout, spacing_};
+    context.cloudPixels = projectedPixelBounds(pipelineCamera_, cloudBounds_);
     if (divisor != 1) {
         context.divisor = divisor;
         context.reducedFrom = glm::ivec2(camera.width, camera.height);

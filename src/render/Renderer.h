@@ -87,6 +87,7 @@ class Renderer {
     GpuPointCloud cloud_;
     double spacing_;
     ResolutionChooser resolutionChooser_;
+    Bounds cloudBounds_;  // file coordinates
     Camera pipelineCamera_;
     int lastDivisor_ = 1;
     // One set per resolution, so that a camera crossing the Auto threshold does not reallocate

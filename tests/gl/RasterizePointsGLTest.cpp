@@ -167,6 +167,42 @@ TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
     }
 }
 
+TEST(RasterizePointsGLTest, AFarFrameAfterACloseOneKeepsNothingOfIt) {
+    // The resolve visits only the pixels the cloud's bounding box projects to: the rest must
+    // still be empty, not what the frame before left there.
+    GlContext& context = test::glTestContext();
+    const Camera close = smallCamera();
+    const PointCloud cloud = testCloud(close, 2);
+    Camera far = close;
+    far.farPlane = 60.0;
+    far.view = glm::lookAt(glm::dvec3(0.3, -0.2, 30.0), glm::dvec3(0.0), glm::dvec3(0, 1, 0));
+    const glm::ivec4 box = projectedPixelBounds(far, cloud.bounds);
+    ASSERT_LT((box.z - box.x) * (box.w - box.y), far.width * far.height / 2);
+
+    Renderer renderer(context, cloud);
+    RenderSettings settings;
+    settings.raster.path = RasterPath::TwoPass32;
+    renderer.render(close, settings);
+    renderer.render(far, settings);
+    const Reference reference = rasterizeOnCpu(cloud, far);
+    const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners();
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
+    std::size_t covered = 0;
+    for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
+        ASSERT_EQ(winners[pixel], reference.winner[pixel]) << "pixel " << pixel;
+        if (reference.winner[pixel] != kEmpty) {
+            ++covered;
+            continue;
+        }
+        EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+        for (int c = 0; c < 4; ++c) {
+            EXPECT_EQ(color[4 * pixel + c], 0.0f) << "pixel " << pixel;
+        }
+    }
+    EXPECT_GT(covered, 10u);  // the far view still shows the cloud
+}
+
 TEST(RasterizePointsGLTest, ForcingInt64WithoutSupportIsAClearError) {
     GlContext& context = test::glTestContext();
     if (context.capabilities().int64Atomics) {

@@ -1,4 +1,5 @@
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -63,6 +64,72 @@ TEST(CameraTest, FocalLengthMatchesTheProjection) {
     const glm::dvec4 clip =
         camera.projection() * glm::dvec4(0, 1, -camera.focalLengthPixels() / 50, 1);
     EXPECT_NEAR(clip.y / clip.w * 50.0, 50.0, 1e-9);
+}
+
+/// The pixel a rasterizer puts `p` in (floor of its window position), or nothing when it does
+/// not project into the image in front of the near plane.
+std::optional<glm::ivec2> pixelOf(const Camera& camera, const glm::dvec3& p) {
+    const glm::dvec4 view = camera.view * glm::dvec4(p, 1.0);
+    if (-view.z <= camera.nearPlane) {
+        return std::nullopt;
+    }
+    const glm::dvec4 clip = camera.projection() * view;
+    const glm::ivec2 pixel(
+        static_cast<int>(std::floor((clip.x / clip.w + 1.0) * 0.5 * camera.width)),
+        static_cast<int>(std::floor((1.0 - clip.y / clip.w) * 0.5 * camera.height)));
+    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= camera.width || pixel.y >= camera.height) {
+        return std::nullopt;
+    }
+    return pixel;
+}
+
+TEST(CameraTest, ProjectedPixelBoundsHoldEveryPointOfTheBoxAndLittleElse) {
+    const Bounds bounds = box({-1, -0.5, -0.25}, {1, 0.5, 0.25});
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    int views = 0;
+    for (const double distance : {1.2, 3.0, 12.0}) {
+        for (const double yaw : {0.0, 35.0, 130.0}) {
+            const Camera camera =
+                orbitCamera(bounds, {yaw, 20.0, distance, UpAxis::Y}, 161, 97, 45);
+            const glm::ivec4 rect = projectedPixelBounds(camera, bounds);
+            glm::ivec2 low(camera.width, camera.height);
+            glm::ivec2 high(-1);
+            for (int i = 0; i < 4000; ++i) {
+                const glm::dvec3 p =
+                    bounds.min +
+                    bounds.extent() * glm::dvec3(unit(random), unit(random), unit(random));
+                if (const auto pixel = pixelOf(camera, p)) {
+                    EXPECT_TRUE(pixel->x >= rect.x && pixel->y >= rect.y && pixel->x < rect.z &&
+                                pixel->y < rect.w)
+                        << "distance " << distance << " yaw " << yaw;
+                    low = glm::min(low, *pixel);
+                    high = glm::max(high, *pixel);
+                }
+            }
+            if (rect != glm::ivec4(0, 0, camera.width, camera.height)) {
+                ++views;
+                // Tight: the random points reach within a few pixels of the box's outline,
+                // plus the 2-pixel margin on each side.
+                EXPECT_LE(low.x - rect.x, 6);
+                EXPECT_LE(rect.z - 1 - high.x, 6);
+                EXPECT_LE(low.y - rect.y, 6);
+                EXPECT_LE(rect.w - 1 - high.y, 6);
+            }
+        }
+    }
+    EXPECT_GE(views, 3);  // the far views do not cover the image
+}
+
+TEST(CameraTest, ProjectedPixelBoundsAreTheWholeImageWhenTheBoxReachesBehindTheCamera) {
+    const Bounds bounds = box({-1, -1, -1}, {1, 1, 1});
+    Camera inside = orbitCamera(bounds, {0, 0, 0.5, UpAxis::Y}, 64, 48, 45);
+    EXPECT_EQ(projectedPixelBounds(inside, bounds), glm::ivec4(0, 0, 64, 48));
+    EXPECT_EQ(projectedPixelBounds(inside, Bounds{}), glm::ivec4(0));
+    // A box entirely beside the view projects nowhere into the image.
+    const Camera framed = orbitCamera(bounds, {0, 0, 10.0, UpAxis::Y}, 64, 48, 45);
+    const glm::ivec4 aside = projectedPixelBounds(framed, box({30, -1, -1}, {32, 1, 1}));
+    EXPECT_LE(aside.z, aside.x);
 }
 
 }  // namespace
