@@ -13,9 +13,12 @@ constexpr int kRegionMargin = 2;
 
 }  // namespace
 
+glm::ivec2 FrameContext::levelSize(unsigned level) const {
+    return {static_cast<int>(pyramid.levels[level].y), static_cast<int>(pyramid.levels[level].z)};
+}
+
 TexelRegion FrameContext::region(unsigned level) const {
-    const glm::ivec2 size(static_cast<int>(pyramid.levels[level].y),
-                          static_cast<int>(pyramid.levels[level].z));
+    const glm::ivec2 size = levelSize(level);
     if (!pointBounds) {
         return {glm::ivec2(0), size};
     }
@@ -31,8 +34,7 @@ TexelRegion FrameContext::region(unsigned level) const {
 }
 
 TexelRegion FrameContext::cloudRegion(unsigned level) const {
-    const glm::ivec2 size(static_cast<int>(pyramid.levels[level].y),
-                          static_cast<int>(pyramid.levels[level].z));
+    const glm::ivec2 size = levelSize(level);
     if (!cloudPixels) {
         return {glm::ivec2(0), size};
     }

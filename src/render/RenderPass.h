@@ -38,6 +38,8 @@ struct FrameContext {
     int width() const { return camera.width; }
     int height() const { return camera.height; }
     bool restricted() const { return pointBounds.has_value(); }
+    /// Texels of pyramid `level` (0: the image), width and height.
+    glm::ivec2 levelSize(unsigned level) const;
     /// cloudPixels as a region of pyramid `level` (0: the image), rounded outwards.
     TexelRegion cloudRegion(unsigned level) const;
     glm::ivec2 outputSize() const { return reducedFrom.value_or(glm::ivec2(width(), height())); }

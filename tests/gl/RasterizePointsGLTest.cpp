@@ -117,16 +117,25 @@ PointCloud testCloud(const Camera& camera, std::uint32_t seed) {
     return builder.finish(warnings);
 }
 
-void expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
-                            const Reference& reference) {
+/// Checks the last frame against `reference` (empty pixels: +inf and no colour) and returns
+/// how many pixels hold a point.
+std::size_t expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
+                                   const Reference& reference) {
     const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners();
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
     const std::vector<float> color = renderer.resources().texture("color").readFloats();
     std::size_t covered = 0;
     for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
-        ASSERT_EQ(winners[pixel], reference.winner[pixel]) << "pixel " << pixel;
+        if (winners[pixel] != reference.winner[pixel]) {
+            ADD_FAILURE() << "pixel " << pixel << ": point " << winners[pixel] << " instead of "
+                          << reference.winner[pixel];
+            return 0;
+        }
         if (reference.winner[pixel] == kEmpty) {
             EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+            for (int c = 0; c < 4; ++c) {
+                EXPECT_EQ(color[4 * pixel + c], 0.0f) << "pixel " << pixel;
+            }
             continue;
         }
         ++covered;
@@ -139,7 +148,7 @@ void expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
             EXPECT_NEAR(color[4 * pixel + c], srgbToLinear(channels[c] / 255.0f), 2e-3);
         }
     }
-    EXPECT_GT(covered, reference.winner.size() / 2);  // the test cloud covers most pixels
+    return covered;
 }
 
 TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
@@ -162,7 +171,9 @@ TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
             RenderSettings settings;
             settings.raster.path = path;
             renderer.render(camera, settings);
-            expectMatchesReference(renderer, cloud, reference);
+            // The test cloud covers most pixels.
+            EXPECT_GT(expectMatchesReference(renderer, cloud, reference),
+                      reference.winner.size() / 2);
         }
     }
 }
@@ -184,23 +195,8 @@ TEST(RasterizePointsGLTest, AFarFrameAfterACloseOneKeepsNothingOfIt) {
     settings.raster.path = RasterPath::TwoPass32;
     renderer.render(close, settings);
     renderer.render(far, settings);
-    const Reference reference = rasterizeOnCpu(cloud, far);
-    const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners();
-    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
-    const std::vector<float> color = renderer.resources().texture("color").readFloats();
-    std::size_t covered = 0;
-    for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
-        ASSERT_EQ(winners[pixel], reference.winner[pixel]) << "pixel " << pixel;
-        if (reference.winner[pixel] != kEmpty) {
-            ++covered;
-            continue;
-        }
-        EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
-        for (int c = 0; c < 4; ++c) {
-            EXPECT_EQ(color[4 * pixel + c], 0.0f) << "pixel " << pixel;
-        }
-    }
-    EXPECT_GT(covered, 10u);  // the far view still shows the cloud
+    // The far view still shows the cloud.
+    EXPECT_GT(expectMatchesReference(renderer, cloud, rasterizeOnCpu(cloud, far)), 10u);
 }
 
 TEST(RasterizePointsGLTest, ForcingInt64WithoutSupportIsAClearError) {
