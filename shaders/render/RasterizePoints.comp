@@ -7,9 +7,10 @@
 //   STAGE_INT64    one thread per point: one 64-bit atomicMin of depthBits << 32 | index
 //   STAGE_RESOLVE  one thread per pixel of the cloud's projected bounding box: the winner's
 //                  linear colour (and with USE_INT64 its depth) into images cleared before
-// Positive IEEE floats order like their bit patterns, so depth bits compare as uints. The
-// 32-bit path keeps its per-pixel words in images rather than storage buffers: on llvmpipe an
-// image load is a vector gather, a storage buffer load one guarded scalar load per lane.
+// Positive IEEE floats order like their bit patterns, so depth bits compare as uints. Points
+// are read as buffer textures and the 32-bit path keeps its per-pixel words in images rather
+// than storage buffers: on llvmpipe a texel fetch or image load is a vector gather, a storage
+// buffer load one guarded scalar load per lane.
 #if STAGE_INT64 || (STAGE_RESOLVE && USE_INT64)
 #extension GL_ARB_gpu_shader_int64 : require
 #extension GL_NV_shader_atomic_int64 : require
@@ -20,12 +21,8 @@
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform RasterBlock {
     RasterParams raster;
 };
-layout(std430, binding = SUBSCAN_SSBO_POSITIONS) readonly buffer Positions {
-    float positions[];
-};
-layout(std430, binding = SUBSCAN_SSBO_COLORS) readonly buffer Colors {
-    uint colors[];
-};
+layout(binding = SUBSCAN_TEXELS_POSITIONS) uniform samplerBuffer positions;  // x, y, z per point
+layout(binding = SUBSCAN_TEXELS_COLORS) uniform usamplerBuffer colors;
 #if STAGE_DEPTH
 layout(binding = SUBSCAN_IMAGE_OUT0, r32ui) uniform uimage2D depthBits;
 #elif STAGE_INDEX
@@ -65,7 +62,8 @@ void main() {
 #if USE_INT64
     imageStore(outDepth, pixel, vec4(uintBitsToFloat(uint(key >> 32))));
 #endif
-    imageStore(outColor, pixel, vec4(unpackColor(colors[winner - raster.firstPoint]), 1.0));
+    imageStore(outColor, pixel,
+               vec4(unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r), 1.0));
 }
 
 #else
@@ -76,8 +74,9 @@ void main() {
     if (local >= raster.pointCount) {
         return;
     }
-    vec3 position = vec3(positions[3u * local], positions[3u * local + 1u],
-                         positions[3u * local + 2u]);
+    int first = 3 * int(local);
+    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
+                         texelFetch(positions, first + 2).r);
     vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
     ivec2 pixel;
     float depth;

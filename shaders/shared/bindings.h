@@ -29,8 +29,6 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_DIVISOR 2  // int: output pixels per pipeline pixel and side (Present)
 
 // ---- shader storage blocks (std430) ----
-#define SUBSCAN_SSBO_POSITIONS 0      // float x, y, z per point (cloud-relative)
-#define SUBSCAN_SSBO_COLORS 1         // uint RGBA8, sRGB-encoded, per point
 #define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
 #define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
 #define SUBSCAN_SSBO_PULL_VALUES 6    // vec4 per texel, all levels: w * (depth, r, g, b)
@@ -40,13 +38,15 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 #define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
 
-// ---- buffer textures: the pyramids above, read with texelFetch (Buffer::bindTexels) ----
+// ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
 #define SUBSCAN_TEXELS_PULL_VALUES 1   // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
 #define SUBSCAN_TEXELS_PULL_WEIGHTS 2  // r32f view of SUBSCAN_SSBO_PULL_WEIGHTS
 #define SUBSCAN_TEXELS_PUSH_VALUES 3   // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
 #define SUBSCAN_TEXELS_NORMALS 4       // rgba32f view of SUBSCAN_SSBO_NORMALS
 #define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
+#define SUBSCAN_TEXELS_POSITIONS 6     // r32f: x, y, z per point (cloud-relative), one chunk
+#define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0

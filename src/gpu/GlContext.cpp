@@ -1,5 +1,6 @@
 #include "gpu/GlContext.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include <epoxy/gl.h>
@@ -60,6 +61,9 @@ void GlContext::initialize(bool debugOutput) {
     GLint64 blockBytes = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &blockBytes);
     capabilities_.maxStorageBlockBytes = static_cast<std::uint64_t>(blockBytes);
+    GLint texelLimit = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texelLimit);
+    capabilities_.maxTextureBufferTexels = static_cast<std::uint64_t>(std::max(texelLimit, 0));
     glGetIntegeri_v(GL_MAX_COMPUTE_WORK_GROUP_COUNT, 0, &capabilities_.maxComputeWorkGroupsX);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &capabilities_.maxTextureSize);
 

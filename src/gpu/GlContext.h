@@ -16,8 +16,11 @@ struct GlCapabilities {
     bool software = false;
     /// GL_NV_shader_atomic_int64 (+ GL_ARB_gpu_shader_int64): the one-pass 64-bit rasterizer.
     bool int64Atomics = false;
-    /// The largest range one shader storage block may bind (bytes); point data is chunked below it.
+    /// The largest range one shader storage block may bind (bytes).
     std::uint64_t maxStorageBlockBytes = 0;
+    /// Texels one buffer texture may hold (GL_MAX_TEXTURE_BUFFER_SIZE); point data is chunked
+    /// below it.
+    std::uint64_t maxTextureBufferTexels = 0;
     int maxComputeWorkGroupsX = 0;
     int maxTextureSize = 0;
 };

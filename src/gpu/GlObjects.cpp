@@ -143,7 +143,7 @@ void Buffer::bindUniform(GLuint binding) const {
     glBindBufferBase(GL_UNIFORM_BUFFER, binding, id());
 }
 
-void Buffer::bindTexels(GLuint unit, TextureFormat format) {
+void Buffer::bindTexels(GLuint unit, TextureFormat format) const {
     if (!texelView_ || texelFormat_ != format) {
         if (format != TextureFormat::R32F && format != TextureFormat::RGBA32F &&
             format != TextureFormat::R32UI) {

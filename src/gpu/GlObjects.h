@@ -98,7 +98,7 @@ class Buffer {
     /// vector gather, while a storage buffer load is one guarded scalar load per lane, so
     /// passes read pyramids this way and write them as storage buffers. Throws subscan::Error
     /// when the buffer holds more texels than the driver's buffer textures may.
-    void bindTexels(GLuint unit, TextureFormat format);
+    void bindTexels(GLuint unit, TextureFormat format) const;
 
     template <class T>
     std::vector<T> read() const {
@@ -111,8 +111,9 @@ class Buffer {
     GlName<BufferTraits> name_;
     std::size_t size_ = 0;
     std::string label_;
-    GlName<TextureTraits> texelView_;  // created by the first bindTexels
-    TextureFormat texelFormat_ = TextureFormat::R32F;
+    // A cache, not state: made by the first bindTexels (again when the format changes).
+    mutable GlName<TextureTraits> texelView_;
+    mutable TextureFormat texelFormat_ = TextureFormat::R32F;
 };
 
 /// A uniform buffer holding exactly one T (a struct from shaders/shared/bindings.h).

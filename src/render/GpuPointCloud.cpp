@@ -52,16 +52,17 @@ std::vector<std::uint32_t> displayColors(const PointCloud& cloud) {
 GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
                              std::size_t maxChunkPoints)
     : size_(cloud.size()), origin_(cloud.origin) {
-    // A chunk must fit one storage binding (positions are the larger array) and one dispatch.
-    const std::size_t byBinding = capabilities.maxStorageBlockBytes / (3 * sizeof(float));
+    // A chunk must fit one buffer texture (positions are the larger one: 3 texels a point) and
+    // one dispatch.
+    const std::size_t byTexture = capabilities.maxTextureBufferTexels / 3;
     const std::size_t byDispatch =
         static_cast<std::size_t>(capabilities.maxComputeWorkGroupsX) * SUBSCAN_POINTS_GROUP_SIZE;
-    std::size_t chunkPoints = std::min({byBinding, byDispatch, std::size_t{1} << 26});
+    std::size_t chunkPoints = std::min({byTexture, byDispatch, std::size_t{1} << 26});
     if (maxChunkPoints > 0) {
         chunkPoints = std::min(chunkPoints, maxChunkPoints);
     }
     if (chunkPoints == 0) {
-        throw Error("the OpenGL driver reports no room for shader storage buffers");
+        throw Error("the OpenGL driver reports no room for buffer textures");
     }
     const std::vector<std::uint32_t> colors = displayColors(cloud);
     for (std::size_t first = 0; first < size_; first += chunkPoints) {

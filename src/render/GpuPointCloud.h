@@ -12,8 +12,10 @@
 
 namespace subscan {
 
-/// A point cloud on the GPU, split into chunks that each fit one shader storage binding and one
-/// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8.
+/// A point cloud on the GPU, split into chunks that each fit one buffer texture and one
+/// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8. The
+/// rasterizer reads both as buffer textures (Buffer::bindTexels), the GL_POINTS baseline as
+/// vertex attributes.
 class GpuPointCloud {
   public:
     struct Chunk {

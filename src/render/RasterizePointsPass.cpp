@@ -76,8 +76,8 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
     for (const GpuPointCloud::Chunk& chunk : frame.cloud.chunks()) {
         params_.set({chunk.firstPoint, chunk.pointCount, static_cast<std::uint32_t>(pixels), 0});
         params_.bind(SUBSCAN_UBO_PASS);
-        chunk.positions.bindStorage(SUBSCAN_SSBO_POSITIONS);
-        chunk.colors.bindStorage(SUBSCAN_SSBO_COLORS);
+        chunk.positions.bindTexels(SUBSCAN_TEXELS_POSITIONS, TextureFormat::R32F);
+        chunk.colors.bindTexels(SUBSCAN_TEXELS_COLORS, TextureFormat::R32UI);
         if (perPixel) {
             Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
                                 SUBSCAN_IMAGE_GROUP_SIZE);
