@@ -31,7 +31,7 @@ void FillRemovalPass::execute(FrameContext& frame) {
     // Coarsest first: every level reads its parent's answer. Level 0 is part of the mask stage.
     for (unsigned level = frame.pyramid.info.x; level-- > 1;) {
         stages_.runOverRegion(Reach, frame.region(level), level);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        glMemoryBarrier(kPyramidWritesBarrier);
     }
     stages_.runOverRegion(Mask, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -28,16 +28,16 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
     // depth is +inf, as the fill leaves it.
     pyramid.fill(kInfinityBits);
     // One invocation per level-1 texel (also for a one-pixel image, which has no level 1).
-    const TexelRegion pixels = frame.cloudRegion(0);
+    const TexelRegion pixels = frame.cloudRegion();
     const glm::ivec2 first = pixels.origin / 2;
     const glm::ivec2 end = (pixels.origin + pixels.size + 1) / 2;
     stages_.runOverRegion(First, {first, end - first}, 1);
     for (unsigned level = 2; level < frame.pyramid.info.x; ++level) {
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        glMemoryBarrier(kPyramidWritesBarrier);
         const auto& size = frame.pyramid.levels[level];
         stages_.runOverImage(Reduce, static_cast<int>(size.y), static_cast<int>(size.z), level);
     }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    glMemoryBarrier(kPyramidWritesBarrier);
     frame.pointBounds.reset();
     if (surfaceBoundsAllowed(frame.settings)) {
         frame.pointBounds = measureBounds(frame);

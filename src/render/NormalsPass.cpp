@@ -21,7 +21,7 @@ void NormalsPass::execute(FrameContext& frame) {
     for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
         stages_.runOverRegion(Level, frame.region(level), level);
     }
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    glMemoryBarrier(kPyramidWritesBarrier);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {

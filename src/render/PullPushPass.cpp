@@ -36,7 +36,7 @@ void PullPushPass::execute(FrameContext& frame) {
     const unsigned levels = frame.pyramid.info.x;
     auto run = [&](Stage stage, unsigned level) {
         stages_.runOverRegion(stage, frame.region(level), level);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+        glMemoryBarrier(kPyramidWritesBarrier);
     };
     run(PullInit, 0);
     for (unsigned level = 1; level < levels; ++level) {

@@ -67,7 +67,7 @@ void RasterizePointsPass::ensurePixelStorage(int width, int height, bool int64) 
 
 void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& frame, bool perPixel) {
     program.use();
-    const TexelRegion region = frame.cloudRegion(0);
+    const TexelRegion region = frame.cloudRegion();
     if (perPixel) {
         glProgramUniform2i(program.id(), SUBSCAN_UNIFORM_ORIGIN, region.origin.x, region.origin.y);
     }

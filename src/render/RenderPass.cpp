@@ -13,12 +13,9 @@ constexpr int kRegionMargin = 2;
 
 }  // namespace
 
-glm::ivec2 FrameContext::levelSize(unsigned level) const {
-    return {static_cast<int>(pyramid.levels[level].y), static_cast<int>(pyramid.levels[level].z)};
-}
-
 TexelRegion FrameContext::region(unsigned level) const {
-    const glm::ivec2 size = levelSize(level);
+    const glm::ivec2 size(static_cast<int>(pyramid.levels[level].y),
+                          static_cast<int>(pyramid.levels[level].z));
     if (!pointBounds) {
         return {glm::ivec2(0), size};
     }
@@ -33,16 +30,13 @@ TexelRegion FrameContext::region(unsigned level) const {
     return {first, last - first + 1};
 }
 
-TexelRegion FrameContext::cloudRegion(unsigned level) const {
-    const glm::ivec2 size = levelSize(level);
+TexelRegion FrameContext::cloudRegion() const {
     if (!cloudPixels) {
-        return {glm::ivec2(0), size};
+        return {glm::ivec2(0), glm::ivec2(width(), height())};
     }
     const glm::ivec4& pixels = *cloudPixels;
-    const int scale = 1 << level;
-    const glm::ivec2 first = glm::ivec2(pixels.x, pixels.y) / scale;
-    const glm::ivec2 end = glm::min((glm::ivec2(pixels.z, pixels.w) + scale - 1) / scale, size);
-    return {first, glm::max(end - first, glm::ivec2(0))};
+    return {glm::ivec2(pixels.x, pixels.y),
+            glm::max(glm::ivec2(pixels.z - pixels.x, pixels.w - pixels.y), glm::ivec2(0))};
 }
 
 bool surfaceBoundsAllowed(const RenderSettings& settings) {

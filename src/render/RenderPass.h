@@ -38,15 +38,18 @@ struct FrameContext {
     int width() const { return camera.width; }
     int height() const { return camera.height; }
     bool restricted() const { return pointBounds.has_value(); }
-    /// Texels of pyramid `level` (0: the image), width and height.
-    glm::ivec2 levelSize(unsigned level) const;
-    /// cloudPixels as a region of pyramid `level` (0: the image), rounded outwards.
-    TexelRegion cloudRegion(unsigned level) const;
+    /// cloudPixels as a region of the image.
+    TexelRegion cloudRegion() const;
     glm::ivec2 outputSize() const { return reducedFrom.value_or(glm::ivec2(width(), height())); }
     /// The texels of pyramid `level` (0: the image) a pass must compute: those around the
     /// points, with a margin for the 4x4 pull and the bilinear push and normal reads.
     TexelRegion region(unsigned level) const;
 };
+
+/// Between the levels of a pyramid pass: storage-buffer writes become visible to the next
+/// dispatch's storage-buffer and buffer-texture reads (Buffer::bindTexels).
+constexpr GLbitfield kPyramidWritesBarrier =
+    GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT;
 
 /// Whether the passes after rasterization may skip the screen outside the points' bounds: when
 /// no pixel there can become surface (fill removal needs 6 or more of the 8 directions, and a
