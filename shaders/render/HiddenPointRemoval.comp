@@ -13,11 +13,9 @@
 // entirely, the few directions left hid the surface itself in the image's corners.
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
+#include "shared/surface.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
-layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
-    SurfaceParams surface;
-};
 layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility;
 

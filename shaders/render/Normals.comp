@@ -4,21 +4,18 @@
 // (so silhouettes do not bend normals), cross them and face the result to the camera. Each
 // pixel then blends the normals of the two levels around its fractional smoothing level.
 //   STAGE_LEVEL  normals of level `level` into the normal pyramid
-//   STAGE_BLEND  the per-pixel blend into the "normals" image (view space)
-#include "shared/pyramid.glsl"
+//   STAGE_BLEND  the per-pixel blend into the "normals" image (view space), unless
+//                FinishSurface.comp blends level 0 itself
+#include "render/Normals.glsl"
+#include "render/PullPush.glsl"
 #include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
-layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
-    SurfaceParams surface;
-};
-layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
 // Written as a storage buffer, read as a buffer texture (see Buffer::bindTexels).
 layout(std430, binding = SUBSCAN_SSBO_NORMALS) writeonly buffer Normals {
     vec4 normalPyramid[];
 };
-layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
 #if STAGE_BLEND
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outNormals;
@@ -27,7 +24,7 @@ layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outNorma
 #if STAGE_LEVEL
 vec3 positionOf(ivec2 texel) {
     return viewPositionAt(texelCentre(level, texel),
-                          texelFetch(pushValueTexels, int(texelIndex(level, texel))).x);
+                          pushValueAt(texelIndex(level, texel)).x);
 }
 
 /// The tangent along `axis`: towards whichever existing neighbour has the smaller depth jump.
@@ -43,19 +40,6 @@ vec3 tangent(ivec2 texel, vec3 centre, ivec2 axis) {
         return previous;
     }
     return abs(next.z) <= abs(previous.z) ? next : previous;
-}
-#endif
-
-#if STAGE_BLEND
-vec3 normalOnLevel(uint normalLevel, vec2 window) {
-    ivec2 texels[4];
-    float weights[4];
-    bilinearTexels(normalLevel, window, texels, weights);
-    vec3 sum = vec3(0.0);
-    for (int i = 0; i < 4; ++i) {
-        sum += weights[i] * texelFetch(normalTexels, int(texelIndex(normalLevel, texels[i]))).xyz;
-    }
-    return sum;
 }
 #endif
 
@@ -87,17 +71,7 @@ void main() {
         imageStore(outNormals, texel, vec4(0.0));
         return;
     }
-    // Level 1 at least: where points are denser than pixels, neighbouring pixels are closer
-    // than the scanner's noise allows a slope to be measured over.
-    float smoothing = clamp(levelForRadius(surface.normals.x, depth), 1.0,
-                            float(levelCount() - 1u));
-    uint lower = uint(smoothing);
-    uint upper = min(lower + 1u, levelCount() - 1u);
-    vec2 window = vec2(texel) + 0.5;
-    vec3 normal = mix(normalOnLevel(lower, window), normalOnLevel(upper, window),
-                      smoothing - float(lower));
-    float length2 = dot(normal, normal);
-    normal = length2 > 0.0 ? normal * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
+    vec3 normal = blendedNormal(texel, depth);
     imageStore(outNormals, texel, vec4(normal, 1.0));
 #endif
 }

@@ -7,18 +7,14 @@
 //   STAGE_PUSH_TOP   the coarsest level: complete value a / w
 //   STAGE_PUSH       level R from R+1: m = bilinear of the complete coarser level with the
 //                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 goes to
-//                    the "filledDepth" and "filledColor" images instead of the buffer.
-#include "shared/pyramid.glsl"
+//                    the "filledDepth" and "filledColor" images instead of the buffer
+//                    (unless FinishSurface.comp pushes it).
+#include "render/PullPush.glsl"
 #include "shared/region.glsl"
-
-
+#include "shared/surface.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
-layout(std140, binding = SUBSCAN_UBO_SURFACE) uniform SurfaceBlock {
-    SurfaceParams surface;
-};
-// Written as storage buffers, read as buffer textures (see Buffer::bindTexels).
 layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) writeonly buffer PullValues {
     vec4 pullValue[];
 };
@@ -28,13 +24,6 @@ layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) writeonly buffer PullWeights
 layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) writeonly buffer PushValues {
     vec4 pushValue[];
 };
-layout(binding = SUBSCAN_TEXELS_PULL_VALUES) uniform samplerBuffer pullValueTexels;
-layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
-layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
-
-vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
-float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
-vec4 pushValueAt(uint index) { return texelFetch(pushValueTexels, int(index)); }
 #if STAGE_PULL_INIT
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inColor;
@@ -98,19 +87,7 @@ void main() {
     float weight = pullWeightAt(index);
     pushValue[index] = weight > 0.0 ? pullValueAt(index) / weight : vec4(kInfinity, 0.0, 0.0, 0.0);
 #else
-    // Coarse neighbours of this texel and their weights {3/4, 1/4} per axis.
-    ivec2 coarseSize = levelSize(level + 1u);
-    ivec2 near = texel >> 1;
-    ivec2 far = clamp(near + ((texel & 1) * 2 - 1), ivec2(0), coarseSize - 1);
-    vec4 m = 0.5625 * pushValueAt(texelIndex(level + 1u, near)) +
-             0.1875 * pushValueAt(texelIndex(level + 1u, ivec2(far.x, near.y))) +
-             0.1875 * pushValueAt(texelIndex(level + 1u, ivec2(near.x, far.y))) +
-             0.0625 * pushValueAt(texelIndex(level + 1u, far));
-    // A fully weighted texel needs nothing from above (and an empty image above would give
-    // 0 * inf = NaN).
-    float weight = pullWeightAt(index);
-    vec4 own = pullValueAt(index);
-    vec4 complete = weight >= 1.0 ? own : own + (1.0 - weight) * m;
+    vec4 complete = pushedValue(level, texel);
     // Level 0 lives only in the images: nothing reads it from the buffer.
     if (level == 0u) {
         imageStore(outDepth, texel, vec4(complete.x));

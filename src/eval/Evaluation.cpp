@@ -204,7 +204,8 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         RenderSettings surfaceSettings = render;
         surfaceSettings.raster.mode = RenderMode::Surface;
         surfaceSettings.raster.stage = Stage::Final;
-        const int divisor = renderer.render(camera, surfaceSettings).divisor;
+        const int divisor =
+            renderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
         report.surfaceReducedViews += divisor == 1 ? 0 : 1;
         auto atPixels = [&](const char* name, int channels) {
             return atOutputPixels(renderer.resources().texture(name).readFloats(), channels, camera,

@@ -10,28 +10,45 @@ namespace subscan {
 FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
     : stages_(sources, "render/FillRemoval.comp", {"REACH", "MASK"}) {}
 
+std::vector<std::string_view> FillRemovalPass::inputs() const {
+    if (levelZero_ == LevelZero::Fused) {
+        return {"pullWeights"};
+    }
+    return {"filledDepth", "pullWeights"};
+}
+
+std::vector<std::string_view> FillRemovalPass::outputs() const {
+    if (levelZero_ == LevelZero::Fused) {
+        return {"fillReach"};
+    }
+    return {"fillReach", "mask", "surfaceDepth"};
+}
+
 void FillRemovalPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
-    Texture& mask =
-        resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
-    Texture& surfaceDepth =
-        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
     resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
     Buffer& fillReach =
         resources.ensureBuffer("fillReach", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t));
     fillReach.bindStorage(SUBSCAN_SSBO_FILL_REACH);
     fillReach.bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
+    // Coarsest first: every level reads its parent's answer. Level 0 is part of the mask stage.
+    for (unsigned level = frame.pyramid.info.x; level-- > 1;) {
+        stages_.runOverRegion(Reach, frame.region(level), level);
+        glMemoryBarrier(kPyramidWritesBarrier);
+    }
+    if (levelZero_ == LevelZero::Fused) {
+        return;
+    }
+    Texture& mask =
+        resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
+    Texture& surfaceDepth =
+        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
     resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     if (frame.restricted()) {
         mask.clear();
         surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
-    }
-    // Coarsest first: every level reads its parent's answer. Level 0 is part of the mask stage.
-    for (unsigned level = frame.pyramid.info.x; level-- > 1;) {
-        stages_.runOverRegion(Reach, frame.region(level), level);
-        glMemoryBarrier(kPyramidWritesBarrier);
     }
     stages_.runOverRegion(Mask, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -7,6 +7,20 @@ namespace subscan {
 NormalsPass::NormalsPass(const ShaderSources& sources)
     : stages_(sources, "render/Normals.comp", {"LEVEL", "BLEND"}) {}
 
+std::vector<std::string_view> NormalsPass::inputs() const {
+    if (levelZero_ == LevelZero::Fused) {
+        return {"pushValues"};
+    }
+    return {"pushValues", "surfaceDepth"};
+}
+
+std::vector<std::string_view> NormalsPass::outputs() const {
+    if (levelZero_ == LevelZero::Fused) {
+        return {"normalPyramid"};
+    }
+    return {"normalPyramid", "normals"};
+}
+
 void NormalsPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
     Buffer& normalPyramid =
@@ -14,14 +28,17 @@ void NormalsPass::execute(FrameContext& frame) {
     normalPyramid.bindStorage(SUBSCAN_SSBO_NORMALS);
     normalPyramid.bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
-    Texture& normals =
-        resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
     // From level 1: the blend never reads level 0 (its smoothing level is at least 1), and the
     // push leaves level 0 in the filled images only.
     for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
         stages_.runOverRegion(Level, frame.region(level), level);
     }
     glMemoryBarrier(kPyramidWritesBarrier);
+    if (levelZero_ == LevelZero::Fused) {
+        return;
+    }
+    Texture& normals =
+        resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {

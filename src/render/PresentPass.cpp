@@ -32,6 +32,14 @@ TexelRegion outputRegion(const FrameContext& frame) {
 
 }  // namespace
 
+void PresentPass::clearToBackground(Texture& image, const RasterSettings& raster) {
+    // Linear (the frame uniform) to sRGB, as the shader does.
+    const glm::vec3& background = raster.backgroundSrgb;
+    image.clear(glm::vec4(linearToSrgb(srgbToLinear(background.r)),
+                          linearToSrgb(srgbToLinear(background.g)),
+                          linearToSrgb(srgbToLinear(background.b)), 1.0f));
+}
+
 PresentPass::PresentPass(const ShaderSources& sources, std::string colorInput,
                          std::string depthInput)
     : colorInput_(std::move(colorInput)),
@@ -57,11 +65,7 @@ void PresentPass::execute(FrameContext& frame) {
     if (depthInput_.empty() || !frame.restricted()) {
         stages_.runOverImage(0, size.x, size.y);
     } else {
-        // The background exactly as the shader encodes it: linear (the frame uniform) to sRGB.
-        const glm::vec3& background = frame.settings.raster.backgroundSrgb;
-        image.clear(glm::vec4(linearToSrgb(srgbToLinear(background.r)),
-                              linearToSrgb(srgbToLinear(background.g)),
-                              linearToSrgb(srgbToLinear(background.b)), 1.0f));
+        clearToBackground(image, frame.settings.raster);
         stages_.runOverRegion(0, outputRegion(frame));
     }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

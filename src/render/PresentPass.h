@@ -19,6 +19,9 @@ class PresentPass final : public RenderPass {
     std::vector<std::string_view> outputs() const override { return {"image"}; }
     void execute(FrameContext& frame) override;
 
+    /// Fills `image` with the frame's background exactly as the shader encodes it.
+    static void clearToBackground(Texture& image, const RasterSettings& raster);
+
   private:
     std::string colorInput_;
     std::string depthInput_;

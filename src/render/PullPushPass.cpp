@@ -7,6 +7,13 @@ namespace subscan {
 PullPushPass::PullPushPass(const ShaderSources& sources)
     : stages_(sources, "render/PullPush.comp", {"PULL_INIT", "PULL", "PUSH_TOP", "PUSH"}) {}
 
+std::vector<std::string_view> PullPushPass::outputs() const {
+    if (levelZero_ == LevelZero::Fused) {
+        return {"pullValues", "pullWeights", "pushValues"};
+    }
+    return {"pullValues", "pullWeights", "pushValues", "filledDepth", "filledColor"};
+}
+
 void PullPushPass::execute(FrameContext& frame) {
     const std::size_t texels = pyramidTexels(frame.pyramid);
     FrameResources& resources = frame.resources;
@@ -23,15 +30,17 @@ void PullPushPass::execute(FrameContext& frame) {
     Buffer& pushValues = resources.ensureBuffer("pushValues", texels * 4 * sizeof(float));
     pushValues.bindStorage(SUBSCAN_SSBO_PUSH_VALUES);
     pushValues.bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
-    Texture& filledDepth =
-        resources.ensureTexture("filledDepth", TextureFormat::R32F, frame.width(), frame.height());
-    Texture& filledColor = resources.ensureTexture("filledColor", TextureFormat::RGBA16F,
-                                                   frame.width(), frame.height());
     resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     resources.texture("color").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     resources.texture("visibility").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
-    filledDepth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    filledColor.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    const bool perPass = levelZero_ == LevelZero::PerPass;
+    if (perPass) {
+        resources.ensureTexture("filledDepth", TextureFormat::R32F, frame.width(), frame.height())
+            .bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+        resources
+            .ensureTexture("filledColor", TextureFormat::RGBA16F, frame.width(), frame.height())
+            .bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    }
 
     const unsigned levels = frame.pyramid.info.x;
     auto run = [&](Stage stage, unsigned level) {
@@ -43,7 +52,8 @@ void PullPushPass::execute(FrameContext& frame) {
         run(Pull, level);
     }
     run(PushTop, levels - 1);
-    for (unsigned level = levels - 1; level-- > 0;) {
+    const unsigned lastLevel = perPass ? 0 : 1;
+    for (unsigned level = levels - 1; level-- > lastLevel;) {
         run(Push, level);
     }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

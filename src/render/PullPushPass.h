@@ -7,7 +7,7 @@ namespace subscan {
 
 /// Pull-push fill of depth and colour from the visible points (DESIGN.md §5.4). Keeps every
 /// pull level ("pullValues" w*(depth, rgb), "pullWeights" w) and push level from 1 up
-/// ("pushValues"); level 0 of the push is "filledDepth" and "filledColor".
+/// ("pushValues"); level 0 of the push is "filledDepth" and "filledColor" (LevelZero::PerPass).
 class PullPushPass final : public RenderPass {
   public:
     explicit PullPushPass(const ShaderSources& sources);
@@ -16,14 +16,14 @@ class PullPushPass final : public RenderPass {
     std::vector<std::string_view> inputs() const override {
         return {"depth", "color", "visibility"};
     }
-    std::vector<std::string_view> outputs() const override {
-        return {"pullValues", "pullWeights", "pushValues", "filledDepth", "filledColor"};
-    }
+    std::vector<std::string_view> outputs() const override;
     void execute(FrameContext& frame) override;
+    void setLevelZero(LevelZero levelZero) { levelZero_ = levelZero; }
 
   private:
     enum Stage { PullInit, Pull, PushTop, Push };
     ComputeStages stages_;
+    LevelZero levelZero_ = LevelZero::PerPass;
 };
 
 }  // namespace subscan

@@ -51,6 +51,12 @@ struct FrameContext {
 constexpr GLbitfield kPyramidWritesBarrier =
     GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT;
 
+/// Who computes the full-resolution level of the surface pipeline (push, mask, normals, shading,
+/// encoding): each pass its own (PerPass: every intermediate image exists, for stage views,
+/// exports, scattering and evaluation), or FinishSurfacePass in one dispatch (Fused:
+/// PullPushPass, FillRemovalPass and NormalsPass stop above level 0).
+enum class LevelZero { PerPass, Fused };
+
 /// Whether the passes after rasterization may skip the screen outside the points' bounds: when
 /// no pixel there can become surface (fill removal needs 6 or more of the 8 directions, and a
 /// pixel beside the bounds finds points in at most 5) and the frame shows no intermediate

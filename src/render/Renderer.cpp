@@ -9,6 +9,7 @@
 #include "core/Spacing.h"
 #include "render/DrawPointsPass.h"
 #include "render/FillRemovalPass.h"
+#include "render/FinishSurfacePass.h"
 #include "render/HiddenPointRemovalPass.h"
 #include "render/MinDepthPyramidPass.h"
 #include "render/NormalsPass.h"
@@ -62,7 +63,7 @@ PresentPass& Renderer::present(const std::string& color, const std::string& dept
     return cached(presents_[{color, depth}], sources_, color, depth);
 }
 
-std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
+std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster, LevelZero levelZero) {
     std::vector<RenderPass*> passes;
     if (raster.mode == RenderMode::PointsGl || raster.mode == RenderMode::Splats) {
         passes.push_back(&cached(drawPoints_, sources_));
@@ -75,9 +76,17 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
     if (surface) {
         passes.push_back(&cached(minDepthPyramid_, sources_));
         passes.push_back(&cached(hiddenPointRemoval_, sources_));
-        passes.push_back(&cached(pullPush_, sources_));
-        passes.push_back(&cached(fillRemoval_, sources_));
-        passes.push_back(&cached(normals_, sources_));
+        PullPushPass& pullPush = cached(pullPush_, sources_);
+        FillRemovalPass& fillRemoval = cached(fillRemoval_, sources_);
+        NormalsPass& normals = cached(normals_, sources_);
+        pullPush.setLevelZero(levelZero);
+        fillRemoval.setLevelZero(levelZero);
+        normals.setLevelZero(levelZero);
+        passes.insert(passes.end(), {&pullPush, &fillRemoval, &normals});
+        if (levelZero == LevelZero::Fused) {
+            passes.push_back(&cached(finishSurface_, sources_));
+            return passes;
+        }
         passes.push_back(scatters ? &cached(shadeSplit_, sources_, ShadeOutputs::Split)
                                   : &cached(shade_, sources_, ShadeOutputs::Radiance));
     } else if (stageView && raster.stage != Stage::Depth) {
@@ -98,7 +107,8 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster) {
     return passes;
 }
 
-FrameResult Renderer::render(const Camera& camera, const RenderSettings& settings) {
+FrameResult Renderer::render(const Camera& camera, const RenderSettings& settings,
+                             FrameOutputs outputs) {
     const int limit = capabilities().maxTextureSize;
     if (camera.width < 1 || camera.height < 1 || camera.width > limit || camera.height > limit) {
         throw Error(
@@ -120,7 +130,12 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     const gpu::PyramidLayout& layout =
         uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());
 
-    const std::vector<RenderPass*> passes = passesFor(settings.raster);
+    // The one-dispatch finish needs a level above level 0 and the picture at the pipeline's size.
+    const bool fused = outputs == FrameOutputs::Picture &&
+                       settings.raster.mode == RenderMode::Surface &&
+                       settings.raster.stage == Stage::Final && divisor == 1 && layout.info.x >= 2;
+    const std::vector<RenderPass*> passes =
+        passesFor(settings.raster, fused ? LevelZero::Fused : LevelZero::PerPass);
     lastDivisor_ = divisor;
     FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
                          resourcesFor(divisor), layout, spacing_};

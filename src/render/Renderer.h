@@ -28,11 +28,18 @@ class MinDepthPyramidPass;
 class HiddenPointRemovalPass;
 class PullPushPass;
 class FillRemovalPass;
+class FinishSurfacePass;
 class NormalsPass;
 class ShadePass;
 class StageViewPass;
 class SubsurfaceScatteringPass;
 class PresentPass;
+
+/// What a frame must leave in Renderer::resources(): the picture ("image", and in the surface
+/// modes "surfaceDepth", which the viewer picks the orbit centre from), or every image its
+/// passes write (exports, evaluation, tests of the passes). The surface mode's final
+/// full-resolution frames finish in one dispatch for the picture alone (FinishSurfacePass).
+enum class FrameOutputs { Picture, Everything };
 
 struct FrameResult {
     std::vector<PassTiming> passes;
@@ -53,7 +60,8 @@ class Renderer {
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a
     /// forced raster path the driver lacks) and GL errors inside a pass.
-    FrameResult render(const Camera& camera, const RenderSettings& settings);
+    FrameResult render(const Camera& camera, const RenderSettings& settings,
+                       FrameOutputs outputs = FrameOutputs::Picture);
 
     /// The last presented image: RGBA8, sRGB-encoded, row 0 at the top.
     std::vector<std::uint8_t> readImage() const;
@@ -73,7 +81,7 @@ class Renderer {
     const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
 
   private:
-    std::vector<RenderPass*> passesFor(const RasterSettings& raster);
+    std::vector<RenderPass*> passesFor(const RasterSettings& raster, LevelZero levelZero);
     PresentPass& present(const std::string& color, const std::string& depth);
     FrameResources& resourcesFor(int divisor) {
         return divisor == 1 ? fullResources_ : reducedResources_;
@@ -102,6 +110,7 @@ class Renderer {
     std::unique_ptr<PullPushPass> pullPush_;
     std::unique_ptr<FillRemovalPass> fillRemoval_;
     std::unique_ptr<NormalsPass> normals_;
+    std::unique_ptr<FinishSurfacePass> finishSurface_;
     std::unique_ptr<ShadePass> shade_;
     std::unique_ptr<ShadePass> shadeSplit_;
     std::unique_ptr<SubsurfaceScatteringPass> subsurfaceScattering_;

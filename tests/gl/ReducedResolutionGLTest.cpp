@@ -83,7 +83,7 @@ TEST(ReducedResolutionGLTest, HalfResolutionIsTheReducedFrameScaledUp) {
 
     // The same reduced camera at full resolution: the very same pipeline images.
     settings.raster.resolution = Resolution::Full;
-    ASSERT_EQ(renderer.render(reduced, settings).divisor, 1);
+    ASSERT_EQ(renderer.render(reduced, settings, FrameOutputs::Everything).divisor, 1);
     EXPECT_EQ(renderer.resources().texture("radiance").readFloats(), radiance);
     EXPECT_EQ(renderer.resources().texture("surfaceDepth").readFloats(), depth);
 }

@@ -79,11 +79,12 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
 /// Per-pass median over `timed` frames after one warm-up (llvmpipe compiles shaders lazily and
 /// buffers are allocated on the first frame).
 std::vector<PassTiming> medianTimings(Renderer& renderer, const Camera& camera,
-                                      const RenderSettings& settings, int timed) {
-    renderer.render(camera, settings);
+                                      const RenderSettings& settings, FrameOutputs outputs,
+                                      int timed) {
+    renderer.render(camera, settings, outputs);
     std::vector<std::vector<PassTiming>> frames;
     for (int i = 0; i < timed; ++i) {
-        frames.push_back(renderer.render(camera, settings).passes);
+        frames.push_back(renderer.render(camera, settings, outputs).passes);
     }
     std::vector<PassTiming> medians = frames.front();
     for (std::size_t pass = 0; pass < medians.size(); ++pass) {
@@ -230,8 +231,11 @@ int runRender(const RenderOptions& options) {
                    caps.renderer);
     }
     Renderer renderer(*context, scan.cloud);
+    const FrameOutputs outputs =
+        options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
     if (options.timings) {
-        const std::vector<PassTiming> timings = medianTimings(renderer, camera, settings, 3);
+        const std::vector<PassTiming> timings =
+            medianTimings(renderer, camera, settings, outputs, 3);
         double total = 0.0;
         for (const PassTiming& timing : timings) {
             fmt::print("{:<20} {:9.3f} ms\n", timing.pass, timing.milliseconds);
@@ -239,7 +243,7 @@ int runRender(const RenderOptions& options) {
         }
         fmt::print("{:<20} {:9.3f} ms\n", "total", total);
     } else {
-        renderer.render(camera, settings);
+        renderer.render(camera, settings, outputs);
     }
 
     if (!options.exportDirectory.empty()) {

@@ -1,0 +1,35 @@
+#version 450
+// The full-resolution end of the surface pipeline in one dispatch, for frames that keep only
+// the picture: per pixel, level 0 of the push (PullPush), the mask (FillRemoval), the blended
+// normal (Normals), the shading (Shade) and the sRGB encoding over the background (Present),
+// from the pyramids those passes leave above level 0. Pass by pass, the same work writes and
+// reads back six full-screen images; here it writes the picture and "surfaceDepth". Each step
+// is the function its pass runs, so the two differ only where that chain rounds its images to
+// half floats.
+#include "render/FillRemoval.glsl"
+#include "render/Normals.glsl"
+#include "render/Shade.glsl"
+#include "shared/region.glsl"
+
+layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
+layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceDepth;
+
+void main() {
+    ivec2 pixel = dispatchTexel();
+    if (!insideLevel(0u, pixel)) {
+        return;
+    }
+    vec4 filled = pushedValue(0u, pixel);
+    bool surfacePixel = onSurface(pixel, filled.x);
+    vec3 color = frame.background.rgb;
+    if (surfacePixel) {
+        vec3 diffuse;
+        vec3 specular;
+        shadePixel(pixel, filled.x, blendedNormal(pixel, filled.x), clamp(filled.yzw, 0.0, 1.0),
+                   diffuse, specular);
+        color = diffuse + specular;
+    }
+    imageStore(outImage, pixel, vec4(linearToSrgb(color), 1.0));
+    imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? filled.x : kInfinity));
+}

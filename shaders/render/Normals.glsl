@@ -1,0 +1,34 @@
+// The per-pixel blend of the normal pyramid, for Normals.comp and FinishSurface.comp (which
+// blends level 0 itself). The pyramid is written as a storage buffer and read as a buffer
+// texture (see Buffer::bindTexels).
+#include "shared/pyramid.glsl"
+#include "shared/surface.glsl"
+
+layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
+
+vec3 normalOnLevel(uint normalLevel, vec2 window) {
+    ivec2 texels[4];
+    float weights[4];
+    bilinearTexels(normalLevel, window, texels, weights);
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < 4; ++i) {
+        sum += weights[i] * texelFetch(normalTexels, int(texelIndex(normalLevel, texels[i]))).xyz;
+    }
+    return sum;
+}
+
+/// The view-space normal of surface pixel `texel` at `depth`: the normals of the two pyramid
+/// levels around its smoothing level, blended.
+vec3 blendedNormal(ivec2 texel, float depth) {
+    // Level 1 at least: where points are denser than pixels, neighbouring pixels are closer
+    // than the scanner's noise allows a slope to be measured over.
+    float smoothing = clamp(levelForRadius(surface.normals.x, depth), 1.0,
+                            float(levelCount() - 1u));
+    uint lower = uint(smoothing);
+    uint upper = min(lower + 1u, levelCount() - 1u);
+    vec2 window = vec2(texel) + 0.5;
+    vec3 normal = mix(normalOnLevel(lower, window), normalOnLevel(upper, window),
+                      smoothing - float(lower));
+    float length2 = dot(normal, normal);
+    return length2 > 0.0 ? normal * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
+}

@@ -1,0 +1,32 @@
+// Reads of the pull-push pyramids and the push step, for PullPush.comp and the passes after it
+// (FinishSurface.comp pushes level 0 itself). The pyramids are written as storage buffers and
+// read as buffer textures (see Buffer::bindTexels).
+#include "shared/pyramid.glsl"
+
+layout(binding = SUBSCAN_TEXELS_PULL_VALUES) uniform samplerBuffer pullValueTexels;
+layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
+layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
+
+vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
+float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
+vec4 pushValueAt(uint index) { return texelFetch(pushValueTexels, int(index)); }
+
+/// The complete (depth, r, g, b) of `texel` on `level` from the complete level above: m is the
+/// bilinear of the coarser level with the kernel {1/4, 3/4, 3/4, 1/4}, and the texel's own
+/// pulled value a with weight w keeps its share, a + (1 - w) * m.
+vec4 pushedValue(uint level, ivec2 texel) {
+    // Coarse neighbours of this texel and their weights {3/4, 1/4} per axis.
+    ivec2 coarseSize = levelSize(level + 1u);
+    ivec2 near = texel >> 1;
+    ivec2 far = clamp(near + ((texel & 1) * 2 - 1), ivec2(0), coarseSize - 1);
+    vec4 m = 0.5625 * pushValueAt(texelIndex(level + 1u, near)) +
+             0.1875 * pushValueAt(texelIndex(level + 1u, ivec2(far.x, near.y))) +
+             0.1875 * pushValueAt(texelIndex(level + 1u, ivec2(near.x, far.y))) +
+             0.0625 * pushValueAt(texelIndex(level + 1u, far));
+    // A fully weighted texel needs nothing from above (and an empty image above would give
+    // 0 * inf = NaN).
+    uint index = texelIndex(level, texel);
+    float weight = pullWeightAt(index);
+    vec4 own = pullValueAt(index);
+    return weight >= 1.0 ? own : own + (1.0 - weight) * m;
+}

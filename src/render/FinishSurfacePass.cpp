@@ -1,0 +1,42 @@
+#include "render/FinishSurfacePass.h"
+
+#include <limits>
+
+#include "core/Error.h"
+#include "render/PresentPass.h"
+#include "render/ShadePass.h"
+
+namespace subscan {
+
+FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources)
+    : stages_(sources, "render/FinishSurface.comp", {"ALL"}) {}
+
+void FinishSurfacePass::execute(FrameContext& frame) {
+    if (frame.divisor != 1 || frame.pyramid.info.x < 2) {
+        // Reduced frames scale up in Present; a one-pixel image has no level above level 0.
+        throw Error("FinishSurface needs a full-resolution frame of more than one pixel");
+    }
+    FrameResources& resources = frame.resources;
+    resources.buffer("pullValues").bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
+    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
+    resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
+    resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
+    resources.buffer("normalPyramid").bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
+    params_.set(ShadePass::parameters(frame.settings.shading, frame.camera));
+    params_.bind(SUBSCAN_UBO_PASS);
+    Texture& image =
+        resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(), frame.height());
+    Texture& surfaceDepth =
+        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
+    image.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    if (frame.restricted()) {
+        PresentPass::clearToBackground(image, frame.settings.raster);
+        surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
+    }
+    stages_.runOverRegion(0, frame.region(0));
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+}  // namespace subscan

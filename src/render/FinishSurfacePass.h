@@ -1,0 +1,31 @@
+#pragma once
+
+#include "render/ComputeStages.h"
+#include "render/RenderPass.h"
+#include "shared/bindings.h"
+
+namespace subscan {
+
+/// The full-resolution end of the surface mode in one dispatch (LevelZero::Fused): per pixel the
+/// push's level 0, the fill-removal mask, the blended normal, the shading and the sRGB encoding
+/// over the background, from the pyramids PullPushPass, FillRemovalPass and NormalsPass leave
+/// above level 0. Writes "image" and "surfaceDepth" (+inf off the surface) and nothing between:
+/// on llvmpipe the per-pass chain's six full-screen images cost more than their arithmetic.
+/// Equals the chain up to its half-float rounding of colour, normals and radiance.
+class FinishSurfacePass final : public RenderPass {
+  public:
+    explicit FinishSurfacePass(const ShaderSources& sources);
+
+    std::string_view name() const override { return "FinishSurface"; }
+    std::vector<std::string_view> inputs() const override {
+        return {"pullValues", "pullWeights", "pushValues", "fillReach", "normalPyramid"};
+    }
+    std::vector<std::string_view> outputs() const override { return {"image", "surfaceDepth"}; }
+    void execute(FrameContext& frame) override;
+
+  private:
+    ComputeStages stages_;
+    UniformBlock<gpu::ShadeParams> params_{"FinishSurface.shade"};
+};
+
+}  // namespace subscan
