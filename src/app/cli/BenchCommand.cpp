@@ -57,37 +57,33 @@ double median(std::vector<double> values) {
     return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-/// One mode's numbers over the camera path.
-nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSettings settings,
-                         RenderMode mode, const BenchOptions& options, UpAxis up) {
-    settings.raster.mode = mode;
-    settings.raster.stage = Stage::Final;
-    // A renderer of its own, so the memory it reports is this mode's alone.
-    Renderer renderer(context, scan.cloud);
-    auto cameraAt = [&](int frame) {
-        const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
-        return cameraForPose(scan.cloud.bounds, benchmarkPose(t), up, options.width, options.height,
-                             45.0);
-    };
-    for (int frame = 0; frame < options.warmup; ++frame) {
-        renderer.render(cameraAt(frame * options.frames / std::max(options.warmup, 1)), settings);
+/// One mode along the camera path: a renderer of its own, so that the memory it reports is
+/// this mode's alone, and its frame and pass times.
+struct ModeRun {
+    ModeRun(GlContext& context, const PointCloud& cloud, RenderSettings modeSettings,
+            RenderMode mode)
+        : settings(std::move(modeSettings)), renderer(context, cloud) {
+        settings.raster.mode = mode;
+        settings.raster.stage = Stage::Final;
     }
-    glFinish();
+
+    /// Renders one frame and waits for it: a frame is done when its image is, with no overlap
+    /// with the next one.
+    FrameResult render(const Camera& camera) {
+        FrameResult result = renderer.render(camera, settings);
+        glFinish();
+        return result;
+    }
+
+    RenderSettings settings;
+    Renderer renderer;
     std::vector<double> frameMs;
     std::map<std::string, std::vector<double>> passMs;
     int reducedFrames = 0;
-    for (int frame = 0; frame < options.frames; ++frame) {
-        const auto start = std::chrono::steady_clock::now();
-        const FrameResult result = renderer.render(cameraAt(frame), settings);
-        glFinish();  // a frame is done when its image is: no overlap with the next one
-        frameMs.push_back(
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count());
-        for (const PassTiming& pass : result.passes) {
-            passMs[pass.pass].push_back(pass.milliseconds);
-        }
-        reducedFrames += result.divisor == 1 ? 0 : 1;
-    }
+};
+
+nlohmann::json summary(const ModeRun& run, std::size_t points) {
+    const std::vector<double>& frameMs = run.frameMs;
     const double totalMs = std::accumulate(frameMs.begin(), frameMs.end(), 0.0);
     std::vector<double> slowest = frameMs;
     std::sort(slowest.begin(), slowest.end(), std::greater<>());
@@ -98,19 +94,59 @@ nlohmann::json benchMode(GlContext& context, const LoadedScan& scan, RenderSetti
         static_cast<double>(lowCount);
     const double averageFps = 1000.0 * static_cast<double>(frameMs.size()) / totalMs;
     nlohmann::json perPass = nlohmann::json::object();
-    for (const auto& [pass, values] : passMs) {
+    for (const auto& [pass, values] : run.passMs) {
         perPass[pass] = median(values);
     }
-    const std::size_t bytes = renderer.gpuCloud().bytes() + renderer.resourceBytes();
+    const std::size_t bytes = run.renderer.gpuCloud().bytes() + run.renderer.resourceBytes();
     return {
         {"avg_fps", averageFps},
         {"low1_fps", 1000.0 / lowMs},
         {"frame_ms_median", median(frameMs)},
         {"per_pass_ms", perPass},
-        {"points_per_second", averageFps * static_cast<double>(scan.cloud.size())},
+        {"points_per_second", averageFps * static_cast<double>(points)},
         {"gpu_memory_mb", static_cast<double>(bytes) / (1024.0 * 1024.0)},
-        {"reduced_resolution_frames", reducedFrames},
+        {"reduced_resolution_frames", run.reducedFrames},
     };
+}
+
+/// Every mode along the same camera path, frame by frame in turn (frame 0 of each mode, then
+/// frame 1, ...): a machine whose speed drifts over minutes (a shared virtual machine, a GPU
+/// warming up) then slows every mode alike instead of whichever ran last.
+std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& scan,
+                                       const RenderSettings& settings,
+                                       const std::vector<RenderMode>& modes,
+                                       const BenchOptions& options, UpAxis up) {
+    auto cameraAt = [&](int frame) {
+        const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
+        return cameraForPose(scan.cloud.bounds, benchmarkPose(t), up, options.width, options.height,
+                             45.0);
+    };
+    std::vector<std::unique_ptr<ModeRun>> runs;
+    for (const RenderMode mode : modes) {
+        runs.push_back(std::make_unique<ModeRun>(context, scan.cloud, settings, mode));
+        for (int frame = 0; frame < options.warmup; ++frame) {
+            runs.back()->render(cameraAt(frame * options.frames / std::max(options.warmup, 1)));
+        }
+    }
+    for (int frame = 0; frame < options.frames; ++frame) {
+        const Camera camera = cameraAt(frame);
+        for (const std::unique_ptr<ModeRun>& run : runs) {
+            const auto start = std::chrono::steady_clock::now();
+            const FrameResult result = run->render(camera);
+            run->frameMs.push_back(
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count());
+            for (const PassTiming& pass : result.passes) {
+                run->passMs[pass.pass].push_back(pass.milliseconds);
+            }
+            run->reducedFrames += result.divisor == 1 ? 0 : 1;
+        }
+    }
+    std::vector<nlohmann::json> summaries;
+    for (const std::unique_ptr<ModeRun>& run : runs) {
+        summaries.push_back(summary(*run, scan.cloud.size()));
+    }
+    return summaries;
 }
 
 int runBench(const BenchOptions& options) {
@@ -138,12 +174,14 @@ int runBench(const BenchOptions& options) {
         {"resolution", toString(settings.raster.resolution)},
         {"modes", nlohmann::json::object()},
     };
-    for (const RenderMode mode : modes) {
-        if (!options.json) {
-            fmt::print(stderr, "subscan: benchmarking {} ({} frames)\n", toString(mode),
-                       options.frames);
-        }
-        report["modes"][toString(mode)] = benchMode(*context, scan, settings, mode, options, up);
+    if (!options.json) {
+        fmt::print(stderr, "subscan: benchmarking {} frames of each mode in turn\n",
+                   options.frames);
+    }
+    const std::vector<nlohmann::json> summaries =
+        benchModes(*context, scan, settings, modes, options, up);
+    for (std::size_t i = 0; i < modes.size(); ++i) {
+        report["modes"][toString(modes[i])] = summaries[i];
     }
     if (options.json) {
         fmt::print("{}\n", report.dump(2));
