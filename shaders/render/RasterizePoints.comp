@@ -86,7 +86,12 @@ void main() {
     uint bits = floatBitsToUint(depth);
     uint index = raster.firstPoint + local;
 #if STAGE_DEPTH
-    imageAtomicMin(depthBits, pixel, bits);
+    // The atomic only where a plain read says the point could win: where many points share a
+    // pixel most lose, and on llvmpipe an image atomic costs about twice a read. A stale read
+    // only lets a losing point try; the minimum stays exact.
+    if (imageLoad(depthBits, pixel).r > bits) {
+        imageAtomicMin(depthBits, pixel, bits);
+    }
 #elif STAGE_INDEX
     if (imageLoad(depthBits, pixel).r == bits) {
         imageAtomicMin(pointIndex, pixel, index);
