@@ -6,6 +6,9 @@
 // reads back six full-screen images; here it writes the picture and "surfaceDepth". Each step
 // is the function its pass runs, so the two differ only where that chain rounds its images to
 // half floats.
+//   STAGE_HEAD_LIGHT  the head light alone (no directional lights)
+//   STAGE_LIGHTS      the head light and the directional lights
+#define SHADE_DIRECTIONAL_LIGHTS STAGE_LIGHTS
 #include "render/FillRemoval.glsl"
 #include "render/Normals.glsl"
 #include "render/Shade.glsl"

@@ -1,5 +1,11 @@
 // The shading model of Shade.comp, for it and FinishSurface.comp (which shades level 0 itself).
+// An includer may define SHADE_DIRECTIONAL_LIGHTS 0 for frames with the head light alone: on
+// llvmpipe the loop over the directional lights costs even when it runs zero times.
 #include "shared/common.glsl"
+
+#ifndef SHADE_DIRECTIONAL_LIGHTS
+#define SHADE_DIRECTIONAL_LIGHTS 1
+#endif
 
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform ShadeBlock {
     ShadeParams shade;
@@ -26,9 +32,11 @@ void shadePixel(ivec2 pixel, float depth, vec3 normal, vec3 albedo, out vec3 dif
     vec3 irradiance = shade.ambient.rgb;
     specular = vec3(0.0);
     addLight(toEye, shade.headLight.rgb, normal, toEye, irradiance, specular);
+#if SHADE_DIRECTIONAL_LIGHTS
     for (uint i = 0u; i < shade.lightCount.x; ++i) {
         addLight(shade.lightDirection[i].xyz, shade.lightColor[i].rgb, normal, toEye, irradiance,
                  specular);
     }
+#endif
     diffuse = albedo * irradiance;
 }

@@ -8,8 +8,16 @@
 
 namespace subscan {
 
-FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources)
-    : stages_(sources, "render/FinishSurface.comp", {"ALL"}) {}
+FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources) : sources_(sources) {}
+
+const ComputeStages& FinishSurfacePass::stagesFor(bool directionalLights) {
+    std::optional<ComputeStages>& stages = directionalLights ? withLights_ : headLightOnly_;
+    if (!stages) {
+        stages.emplace(sources_, "render/FinishSurface.comp",
+                       std::vector<std::string>{directionalLights ? "LIGHTS" : "HEAD_LIGHT"});
+    }
+    return *stages;
+}
 
 void FinishSurfacePass::execute(FrameContext& frame) {
     if (frame.divisor != 1 || frame.pyramid.info.x < 2) {
@@ -22,7 +30,8 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
     resources.buffer("normalPyramid").bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
-    params_.set(ShadePass::parameters(frame.settings.shading, frame.camera));
+    const gpu::ShadeParams shade = ShadePass::parameters(frame.settings.shading, frame.camera);
+    params_.set(shade);
     params_.bind(SUBSCAN_UBO_PASS);
     Texture& image =
         resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(), frame.height());
@@ -34,7 +43,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
         PresentPass::clearToBackground(image, frame.settings.raster);
         surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
     }
-    stages_.runOverRegion(0, frame.region(0));
+    stagesFor(shade.lightCount.x > 0).runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

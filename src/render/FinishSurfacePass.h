@@ -1,5 +1,7 @@
 #pragma once
 
+#include <optional>
+
 #include "render/ComputeStages.h"
 #include "render/RenderPass.h"
 #include "shared/bindings.h"
@@ -24,7 +26,14 @@ class FinishSurfacePass final : public RenderPass {
     void execute(FrameContext& frame) override;
 
   private:
-    ComputeStages stages_;
+    /// Built on first use, with or without the loop over directional lights: on llvmpipe that
+    /// loop costs a frame lit by the head light alone a sixth of this pass even when it runs
+    /// zero times.
+    const ComputeStages& stagesFor(bool directionalLights);
+
+    const ShaderSources& sources_;
+    std::optional<ComputeStages> headLightOnly_;
+    std::optional<ComputeStages> withLights_;
     UniformBlock<gpu::ShadeParams> params_{"FinishSurface.shade"};
 };
 
