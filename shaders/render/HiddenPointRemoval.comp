@@ -36,32 +36,38 @@ bool visibleAt(ivec2 pixel, float depth) {
     uint levels = uint(maxLevel);
     float tau = surface.visibility.y;
 
+    // Level by level, the 8 directions inside: one loop whose length differs between lanes
+    // instead of eight (on llvmpipe each such loop costs beyond its steps). Branch-free: lanes
+    // in lock-step all take every step anyway. A missing neighbour gives +inf, and a direction
+    // without any counts as open sideways (omega = 1).
     float omega[8];
-    bool complete[8];
-    float weightedSum = 0.0;
-    float weightSum = 0.0;
+    uint seen[8];
     for (int k = 0; k < 8; ++k) {
-        // Branch-free: lanes in lock-step all take every step anyway. A missing neighbour
-        // gives +inf, and a direction without any counts as open sideways (omega = 1).
-        float smallest = kInfinity;
-        uint seen = 0u;
-        LevelLayout place = levelLayout(0u);
-        for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
+        omega[k] = kInfinity;
+        seen[k] = 0u;
+    }
+    LevelLayout place = levelLayout(0u);
+    for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
+        for (int k = 0; k < 8; ++k) {
             ivec2 texel = (pixel >> level) + kDirections[k];
             bool withinImage = all(greaterThanEqual(texel, ivec2(0))) &&
                                all(lessThanEqual((texel + 1) << level, imageSizeOfFrame()));
-            seen += withinImage ? 1u : 0u;
+            seen[k] += withinImage ? 1u : 0u;
             float neighbourDepth = texelFetch(
                 minDepthTexels, int(texelIndex(place, clamp(texel, ivec2(0), place.size - 1)))).r;
             vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
             float value = 1.0 - dot(normalize(y - x), toCamera);
-            smallest = withinImage && !isinf(neighbourDepth) ? min(smallest, value) : smallest;
+            omega[k] = withinImage && !isinf(neighbourDepth) ? min(omega[k], value) : omega[k];
         }
-        smallest = isinf(smallest) ? 1.0 : smallest;
-        omega[k] = smallest;
-        complete[k] = seen == levels + 1u;
-        float weight = float(seen) / float(levels + 1u);
-        weightedSum += weight * smallest;
+    }
+    bool complete[8];
+    float weightedSum = 0.0;
+    float weightSum = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        omega[k] = isinf(omega[k]) ? 1.0 : omega[k];
+        complete[k] = seen[k] == levels + 1u;
+        float weight = float(seen[k]) / float(levels + 1u);
+        weightedSum += weight * omega[k];
         weightSum += weight;
     }
     bool visible = weightedSum >= tau * weightSum;
