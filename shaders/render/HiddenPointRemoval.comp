@@ -78,10 +78,11 @@ bool visibleAt(ivec2 pixel, float depth) {
             open += complete[k] && omega[k] >= tau ? 1 : 0;
             occludes[k] = complete[k] && omega[k] < tau;
         }
-        for (int k = 0; k < 8 && !visible; ++k) {
-            bool run = occludes[k] && occludes[(k + 1) % 8] && occludes[(k + 2) % 8];
-            visible = run && open >= 3;
+        bool run = false;
+        for (int k = 0; k < 8; ++k) {
+            run = run || (occludes[k] && occludes[(k + 1) % 8] && occludes[(k + 2) % 8]);
         }
+        visible = run && open >= 3;
     }
     return visible;
 }
