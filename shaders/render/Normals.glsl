@@ -6,13 +6,13 @@
 
 layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
 
-vec3 normalOnLevel(uint normalLevel, vec2 window) {
+vec3 normalOnLevel(uint normalLevel, LevelLayout place, vec2 window) {
     ivec2 texels[4];
     float weights[4];
-    bilinearTexels(normalLevel, window, texels, weights);
+    bilinearTexels(normalLevel, place, window, texels, weights);
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; ++i) {
-        sum += weights[i] * texelFetch(normalTexels, int(texelIndex(normalLevel, texels[i]))).xyz;
+        sum += weights[i] * texelFetch(normalTexels, int(texelIndex(place, texels[i]))).xyz;
     }
     return sum;
 }
@@ -26,9 +26,13 @@ vec3 blendedNormal(ivec2 texel, float depth) {
                             float(levelCount() - 1u));
     uint lower = uint(smoothing);
     uint upper = min(lower + 1u, levelCount() - 1u);
+    // The levels differ between pixels: their layouts are read once (each read of the layout
+    // block at a varying level is a gather), the upper one derived from the lower.
+    LevelLayout lowerPlace = levelLayout(lower);
+    LevelLayout upperPlace = upper == lower ? lowerPlace : nextLevel(lowerPlace);
     vec2 window = vec2(texel) + 0.5;
-    vec3 normal = mix(normalOnLevel(lower, window), normalOnLevel(upper, window),
-                      smoothing - float(lower));
+    vec3 normal = mix(normalOnLevel(lower, lowerPlace, window),
+                      normalOnLevel(upper, upperPlace, window), smoothing - float(lower));
     float length2 = dot(normal, normal);
     return length2 > 0.0 ? normal * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
 }

@@ -36,13 +36,14 @@ uint texelIndex(uint level, ivec2 texel) { return texelIndex(levelLayout(level),
 /// Centre of a level texel in full-resolution window coordinates.
 vec2 texelCentre(uint level, ivec2 texel) { return (vec2(texel) + 0.5) * float(1u << level); }
 
-/// The four texels of `level` around full-resolution window position `window` and their
-/// bilinear weights (texel centres as sample points, clamped at the borders).
-void bilinearTexels(uint level, vec2 window, out ivec2 texels[4], out float weights[4]) {
+/// The four texels of `level` (laid out as `place`) around full-resolution window position
+/// `window` and their bilinear weights (texel centres as sample points, clamped at the borders).
+void bilinearTexels(uint level, LevelLayout place, vec2 window, out ivec2 texels[4],
+                    out float weights[4]) {
     vec2 position = window / float(1u << level) - 0.5;
     vec2 base = floor(position);
     vec2 t = position - base;
-    ivec2 maxTexel = levelSize(level) - 1;
+    ivec2 maxTexel = place.size - 1;
     ivec2 b = ivec2(base);
     texels[0] = clamp(b, ivec2(0), maxTexel);
     texels[1] = clamp(b + ivec2(1, 0), ivec2(0), maxTexel);
