@@ -32,12 +32,12 @@ layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceD
 void main() {
 #if STAGE_REACH
     ivec2 texel = dispatchTexel();
-    if (insideLevel(level, texel)) {
+    if (insideLevel(level, texel) && insideRegion(texel)) {
         fillReach[texelIndex(level, texel)] = reachOf(level, texel);
     }
 #else
     ivec2 pixel = dispatchTexel();
-    if (!insideLevel(0u, pixel)) {
+    if (!insideLevel(0u, pixel) || !insideRegion(pixel)) {
         return;
     }
     float depth = imageLoad(inFilledDepth, pixel).r;

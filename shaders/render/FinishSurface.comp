@@ -20,7 +20,7 @@ layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceD
 
 void main() {
     ivec2 pixel = dispatchTexel();
-    if (!insideLevel(0u, pixel)) {
+    if (!insideLevel(0u, pixel) || !insideRegion(pixel)) {
         return;
     }
     vec4 filled = pushedValue(0u, pixel);

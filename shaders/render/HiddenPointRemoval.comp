@@ -93,7 +93,7 @@ void main() {
     }
     barrier();
     ivec2 pixel = dispatchTexel();
-    if (insideLevel(0u, pixel)) {
+    if (insideLevel(0u, pixel) && insideRegion(pixel)) {
         if (isinf(texelFetch(minDepthTexels, int(texelIndex(0u, pixel))).r)) {
             imageStore(outVisibility, pixel, vec4(0.0));
         } else {

@@ -28,11 +28,11 @@ void main() {
     ivec2 texel = dispatchTexel();
 #if STAGE_FIRST
     // A one-pixel image has no level 1 but still needs its level 0.
-    if (any(greaterThanEqual(2 * texel, levelSize(0u)))) {
+    if (any(greaterThanEqual(2 * texel, levelSize(0u))) || !insideRegion(texel)) {
         return;
     }
 #else
-    if (!insideLevel(level, texel)) {
+    if (!insideLevel(level, texel) || !insideRegion(texel)) {
         return;
     }
 #endif

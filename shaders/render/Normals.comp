@@ -46,7 +46,7 @@ vec3 tangent(ivec2 texel, vec3 centre, ivec2 axis) {
 void main() {
     ivec2 texel = dispatchTexel();
 #if STAGE_LEVEL
-    if (!insideLevel(level, texel)) {
+    if (!insideLevel(level, texel) || !insideRegion(texel)) {
         return;
     }
     vec3 centre = positionOf(texel);
@@ -63,7 +63,7 @@ void main() {
     }
     normalPyramid[texelIndex(level, texel)] = vec4(normal, 0.0);
 #else
-    if (!insideLevel(0u, texel)) {
+    if (!insideLevel(0u, texel) || !insideRegion(texel)) {
         return;
     }
     float depth = imageLoad(inSurfaceDepth, texel).r;

@@ -27,7 +27,7 @@ vec3 colorAt(ivec2 texel) {
 void main() {
     ivec2 pixel = dispatchTexel();
     ivec2 outputSize = imageSize(outImage);
-    if (any(greaterThanEqual(pixel, outputSize))) {
+    if (any(greaterThanEqual(pixel, outputSize)) || !insideRegion(pixel)) {
         return;
     }
     vec3 color;

@@ -38,7 +38,7 @@ const float kPullKernel[4] = float[](1.0 / 3.0, 1.0, 1.0, 1.0 / 3.0);
 
 void main() {
     ivec2 texel = dispatchTexel();
-    if (!insideLevel(level, texel)) {
+    if (!insideLevel(level, texel) || !insideRegion(texel)) {
         return;
     }
     uint index = texelIndex(level, texel);

@@ -46,7 +46,7 @@ layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor
 
 void main() {
     ivec2 pixel = dispatchTexel();
-    if (any(greaterThanEqual(pixel, imageSizeOfFrame()))) {
+    if (any(greaterThanEqual(pixel, imageSizeOfFrame())) || !insideRegion(pixel)) {
         return;
     }
 #if USE_INT64

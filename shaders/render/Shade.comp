@@ -19,7 +19,7 @@ layout(binding = SUBSCAN_IMAGE_OUT3, rgba16f) writeonly uniform image2D outRadia
 
 void main() {
     ivec2 pixel = dispatchTexel();
-    if (any(greaterThanEqual(pixel, imageSizeOfFrame()))) {
+    if (any(greaterThanEqual(pixel, imageSizeOfFrame())) || !insideRegion(pixel)) {
         return;
     }
     float depth = imageLoad(inSurfaceDepth, pixel).r;

@@ -51,7 +51,7 @@ vec3 albedoFactor(vec3 albedo, uint side) {
 void main() {
     ivec2 pixel = dispatchTexel();
     ivec2 size = imageSizeOfFrame();
-    if (any(greaterThanEqual(pixel, size))) {
+    if (any(greaterThanEqual(pixel, size)) || !insideRegion(pixel)) {
         return;
     }
     float depth = imageLoad(inSurfaceDepth, pixel).r;

@@ -27,6 +27,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_LEVEL 0    // uint: the pyramid level a per-level dispatch works on
 #define SUBSCAN_UNIFORM_ORIGIN 1   // ivec2: the texel of invocation (0, 0) (shared/region.glsl)
 #define SUBSCAN_UNIFORM_DIVISOR 2  // int: output pixels per pipeline pixel and side (Present)
+#define SUBSCAN_UNIFORM_END 3      // ivec2: the texel past the region's last (shared/region.glsl)
 
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "core/Error.h"
+
 #include "shared/bindings.h"
 
 namespace subscan {
@@ -16,10 +18,25 @@ ComputeStages::ComputeStages(const ShaderSources& sources, std::string_view path
         programs_.push_back(Program::compute(sources, path, defines));
         hasLevelUniform_.push_back(glGetProgramResourceLocation(programs_.back().id(), GL_UNIFORM,
                                                                 "level") == SUBSCAN_UNIFORM_LEVEL);
-        hasOriginUniform_.push_back(
+        const bool origin =
             glGetProgramResourceLocation(programs_.back().id(), GL_UNIFORM, "dispatchOrigin") ==
-            SUBSCAN_UNIFORM_ORIGIN);
+            SUBSCAN_UNIFORM_ORIGIN;
+        const bool end = glGetProgramResourceLocation(programs_.back().id(), GL_UNIFORM,
+                                                      "dispatchEnd") == SUBSCAN_UNIFORM_END;
+        if (origin != end) {
+            throw Error(
+                fmt::format("{} (STAGE_{}) takes its texel from dispatchTexel() but does "
+                            "not test insideRegion()",
+                            path, active));
+        }
+        hasRegionUniforms_.push_back(origin);
     }
+}
+
+void ComputeStages::setRegionUniforms(const Program& program, const TexelRegion& region) {
+    const glm::ivec2 end = region.origin + region.size;
+    glProgramUniform2i(program.id(), SUBSCAN_UNIFORM_ORIGIN, region.origin.x, region.origin.y);
+    glProgramUniform2i(program.id(), SUBSCAN_UNIFORM_END, end.x, end.y);
 }
 
 void ComputeStages::runOverImage(std::size_t stage, int width, int height, unsigned level) const {
@@ -33,8 +50,8 @@ void ComputeStages::runOverRegion(std::size_t stage, const TexelRegion& region,
     if (hasLevelUniform_[stage]) {
         glProgramUniform1ui(program.id(), SUBSCAN_UNIFORM_LEVEL, level);
     }
-    if (hasOriginUniform_[stage]) {
-        glProgramUniform2i(program.id(), SUBSCAN_UNIFORM_ORIGIN, region.origin.x, region.origin.y);
+    if (hasRegionUniforms_[stage]) {
+        setRegionUniforms(program, region);
     }
     Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
                         SUBSCAN_IMAGE_GROUP_SIZE);

@@ -28,14 +28,17 @@ class ComputeStages {
     /// Runs `stage` over a width x height grid of image-sized work groups, with the per-level
     /// uniform set to `level` where the stage declares it.
     void runOverImage(std::size_t stage, int width, int height, unsigned level = 0) const;
-    /// The same over `region` only; the stage must take its texel from dispatchTexel()
-    /// (shared/region.glsl).
+    /// The same over `region` only; the stage must take its texel from dispatchTexel() and skip
+    /// those where insideRegion() is false (shared/region.glsl).
     void runOverRegion(std::size_t stage, const TexelRegion& region, unsigned level = 0) const;
+
+    /// The uniforms of shared/region.glsl for a dispatch of `program` over `region`.
+    static void setRegionUniforms(const Program& program, const TexelRegion& region);
 
   private:
     std::vector<Program> programs_;
     std::vector<bool> hasLevelUniform_;
-    std::vector<bool> hasOriginUniform_;
+    std::vector<bool> hasRegionUniforms_;
 };
 
 }  // namespace subscan

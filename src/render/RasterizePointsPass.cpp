@@ -69,7 +69,7 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
     program.use();
     const TexelRegion region = frame.cloudRegion();
     if (perPixel) {
-        glProgramUniform2i(program.id(), SUBSCAN_UNIFORM_ORIGIN, region.origin.x, region.origin.y);
+        ComputeStages::setRegionUniforms(program, region);
     }
     const std::size_t pixels = static_cast<std::size_t>(frame.camera.width) *
                                static_cast<std::size_t>(frame.camera.height);
