@@ -38,7 +38,8 @@ class PresentPass;
 /// What a frame must leave in Renderer::resources(): the picture ("image", and in the surface
 /// modes "surfaceDepth", which the viewer picks the orbit centre from), or every image its
 /// passes write (exports, evaluation, tests of the passes). The surface mode's final
-/// full-resolution frames finish in one dispatch for the picture alone (FinishSurfacePass).
+/// full-resolution frames finish in one dispatch for the picture alone (FinishSurfacePass);
+/// the images that dispatch skips then still hold an earlier frame, if any.
 enum class FrameOutputs { Picture, Everything };
 
 struct FrameResult {
