@@ -5,8 +5,6 @@
 
 layout(binding = SUBSCAN_TEXELS_FILL_REACH) uniform usamplerBuffer fillReachTexels;
 
-const ivec2 kFillDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
-                                         ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
 const uint kNoReach = 15u;
 
 /// Beyond the image counts as weighted: a surface that reaches the image's border goes on past
@@ -23,9 +21,8 @@ uint reachOf(uint onLevel, ivec2 texel) {
                       : kNoReach * 0x11111111u;
     uint reach = 0u;
     for (int k = 0; k < 8; ++k) {
-        uint nearest = weighted(onLevel, texel + kFillDirections[k])
-                           ? onLevel
-                           : (parent >> (4 * k)) & 0xFu;
+        uint nearest = weighted(onLevel, texel + kDirections[k]) ? onLevel
+                                                                 : (parent >> (4 * k)) & 0xFu;
         reach |= nearest << (4 * k);
     }
     return reach;

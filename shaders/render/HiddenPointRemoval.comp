@@ -19,9 +19,6 @@ layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GRO
 layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility;
 
-const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
-                                     ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
-
 // The pixels of this work group that hold a point, gathered so that the first invocations test
 // them together: llvmpipe runs 8 invocations in lock-step, and on close-ups, where points are
 // sparse and L(x) is large, most lanes would otherwise idle through their neighbours' walks.

@@ -7,6 +7,11 @@ layout(std140, binding = SUBSCAN_UBO_PYRAMID) uniform PyramidBlock {
 
 uint levelCount() { return pyramid.info.x; }
 
+/// A texel's 8 neighbours, counter-clockwise from +x: the directions the hidden point test and
+/// fill removal look in.
+const ivec2 kDirections[8] = ivec2[](ivec2(1, 0), ivec2(1, 1), ivec2(0, 1), ivec2(-1, 1),
+                                     ivec2(-1, 0), ivec2(-1, -1), ivec2(0, -1), ivec2(1, -1));
+
 /// One level's place in the buffer. Loops over levels derive each level's place from the one
 /// below (nextLevel): where the level is not a uniform, every read of the layout block is a
 /// gather (on llvmpipe, a load per invocation).
