@@ -20,8 +20,7 @@ const ComputeStages& FinishSurfacePass::stagesFor(bool directionalLights) {
 }
 
 void FinishSurfacePass::execute(FrameContext& frame) {
-    if (frame.divisor != 1 || frame.pyramid.info.x < 2) {
-        // Reduced frames scale up in Present; a one-pixel image has no level above level 0.
+    if (!canFinish(frame.divisor, frame.pyramid)) {
         throw Error("FinishSurface needs a full-resolution frame of more than one pixel");
     }
     FrameResources& resources = frame.resources;

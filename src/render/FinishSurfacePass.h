@@ -25,6 +25,12 @@ class FinishSurfacePass final : public RenderPass {
     std::vector<std::string_view> outputs() const override { return {"image", "surfaceDepth"}; }
     void execute(FrameContext& frame) override;
 
+    /// Whether a frame can finish here: at full resolution (reduced frames scale up in
+    /// Present) with a pyramid level above level 0 (a one-pixel image has none).
+    static bool canFinish(int divisor, const gpu::PyramidLayout& pyramid) {
+        return divisor == 1 && pyramid.info.x >= 2;
+    }
+
   private:
     /// Built on first use, with or without the loop over directional lights: on llvmpipe that
     /// loop costs a frame lit by the head light alone a sixth of this pass even when it runs

@@ -130,10 +130,9 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     const gpu::PyramidLayout& layout =
         uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());
 
-    // The one-dispatch finish needs a level above level 0 and the picture at the pipeline's size.
-    const bool fused = outputs == FrameOutputs::Picture &&
-                       settings.raster.mode == RenderMode::Surface &&
-                       settings.raster.stage == Stage::Final && divisor == 1 && layout.info.x >= 2;
+    const bool fused =
+        outputs == FrameOutputs::Picture && settings.raster.mode == RenderMode::Surface &&
+        settings.raster.stage == Stage::Final && FinishSurfacePass::canFinish(divisor, layout);
     const std::vector<RenderPass*> passes =
         passesFor(settings.raster, fused ? LevelZero::Fused : LevelZero::PerPass);
     lastDivisor_ = divisor;
