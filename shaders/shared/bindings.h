@@ -22,6 +22,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UBO_PASS 1
 #define SUBSCAN_UBO_PYRAMID 2
 #define SUBSCAN_UBO_SURFACE 3
+#define SUBSCAN_UBO_LIGHTS 4  // ShadeParams for a pass other than Shade that needs the lights
 
 // ---- plain uniforms ----
 #define SUBSCAN_UNIFORM_LEVEL 0    // uint: the pyramid level a per-level dispatch works on
@@ -48,6 +49,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
 #define SUBSCAN_TEXELS_POSITIONS 6     // r32f: x, y, z per point (cloud-relative), one chunk
 #define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
+#define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0
@@ -129,8 +131,21 @@ struct ScatterParams {
     uvec4 albedo;  // x: where the albedo enters: 0 before the blur, 1 after it, 2 split (sqrt both)
 };
 
+// SingleScattering (DESIGN.md §6.3, §6.4). Coefficients are in mm⁻¹ and lengths in mm as the
+// settings give them; medium.z converts them to the scene's unit.
+struct SingleScatterParams {
+    vec4 sigmaSPrime;   // rgb: the material's reduced scattering coefficient (material source)
+    vec4 sigmaA;        // rgb: the material's absorption coefficient (material source)
+    vec4 meanFreePath;  // rgb: diffuse mean free path ld (colour source)
+    vec4 medium;        // x: eta, y: Henyey-Greenstein g, z: mm per scene unit / scale,
+                        // w: 1 for coefficients from the colour, 0 for the material's
+    vec4 sampling;      // x: samples along the refracted view ray, y: entries of the albedo
+                        // root table, z: total reflectance of its last entry, w: most march steps
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(ScatterParams) == 48);
+static_assert(sizeof(SingleScatterParams) == 80);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
 static_assert(sizeof(SurfaceParams) == 64);
 static_assert(sizeof(ShadeParams) == 3 * 16 + 2 * SUBSCAN_MAX_LIGHTS * 16 + 16);

@@ -92,6 +92,9 @@ void to_json(nlohmann::json& json, const RasterSettings& settings) {
 }
 
 void from_json(const nlohmann::json& json, RasterSettings& settings) {
+    rejectUnknownKeys(json, "raster",
+                      {"mode", "raster_path", "point_size", "background_srgb", "timing", "stage",
+                       "stage_level", "resolution"});
     readEnum(json, "mode", settings.mode, kModes, "render mode");
     readEnum(json, "raster_path", settings.path, kPaths, "raster path");
     readSetting(json, "point_size", settings.pointSize, 1.0f, 64.0f);

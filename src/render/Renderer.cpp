@@ -17,6 +17,7 @@
 #include "render/PullPushPass.h"
 #include "render/RasterizePointsPass.h"
 #include "render/ShadePass.h"
+#include "render/SingleScatteringPass.h"
 #include "render/StageViewPass.h"
 #include "render/SubsurfaceScatteringPass.h"
 
@@ -63,7 +64,19 @@ PresentPass& Renderer::present(const std::string& color, const std::string& dept
     return cached(presents_[{color, depth}], sources_, color, depth);
 }
 
-std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster, LevelZero levelZero) {
+void Renderer::appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes) {
+    if (method != ScatteringMethod::Single) {
+        passes.push_back(&cached(subsurfaceScattering_, sources_));
+    }
+    if (method == ScatteringMethod::Single) {
+        passes.push_back(&cached(singleScattering_, sources_, SingleScatteringBase::Radiance));
+    } else if (method == ScatteringMethod::Both) {
+        passes.push_back(&cached(singleAfterGaussian_, sources_, SingleScatteringBase::Scattered));
+    }
+}
+
+std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, LevelZero levelZero) {
+    const RasterSettings& raster = settings.raster;
     std::vector<RenderPass*> passes;
     if (raster.mode == RenderMode::PointsGl || raster.mode == RenderMode::Splats) {
         passes.push_back(&cached(drawPoints_, sources_));
@@ -97,7 +110,7 @@ std::vector<RenderPass*> Renderer::passesFor(const RasterSettings& raster, Level
         passes.push_back(&cached(stageViews_[raster.stage], sources_, raster.stage));
         passes.push_back(&present("stage", ""));
     } else if (scatters) {
-        passes.push_back(&cached(subsurfaceScattering_, sources_));
+        appendScattering(settings.scattering.method, passes);
         passes.push_back(&present("scatteredRadiance", "surfaceDepth"));
     } else if (surface) {
         passes.push_back(&present("radiance", "surfaceDepth"));
@@ -134,7 +147,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
         outputs == FrameOutputs::Picture && settings.raster.mode == RenderMode::Surface &&
         settings.raster.stage == Stage::Final && FinishSurfacePass::canFinish(divisor, layout);
     const std::vector<RenderPass*> passes =
-        passesFor(settings.raster, fused ? LevelZero::Fused : LevelZero::PerPass);
+        passesFor(settings, fused ? LevelZero::Fused : LevelZero::PerPass);
     lastDivisor_ = divisor;
     FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
                          resourcesFor(divisor), layout, spacing_};

@@ -33,6 +33,7 @@ class NormalsPass;
 class ShadePass;
 class StageViewPass;
 class SubsurfaceScatteringPass;
+class SingleScatteringPass;
 class PresentPass;
 
 /// What a frame must leave in Renderer::resources(): the picture ("image", and in the surface
@@ -82,7 +83,9 @@ class Renderer {
     const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
 
   private:
-    std::vector<RenderPass*> passesFor(const RasterSettings& raster, LevelZero levelZero);
+    std::vector<RenderPass*> passesFor(const RenderSettings& settings, LevelZero levelZero);
+    /// The scattering passes of the sss mode's final picture, by ScatteringSettings::method.
+    void appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes);
     PresentPass& present(const std::string& color, const std::string& depth);
     FrameResources& resourcesFor(int divisor) {
         return divisor == 1 ? fullResources_ : reducedResources_;
@@ -115,6 +118,8 @@ class Renderer {
     std::unique_ptr<ShadePass> shade_;
     std::unique_ptr<ShadePass> shadeSplit_;
     std::unique_ptr<SubsurfaceScatteringPass> subsurfaceScattering_;
+    std::unique_ptr<SingleScatteringPass> singleScattering_;
+    std::unique_ptr<SingleScatteringPass> singleAfterGaussian_;
     std::map<Stage, std::unique_ptr<StageViewPass>> stageViews_;
     std::map<std::pair<std::string, std::string>, std::unique_ptr<PresentPass>> presents_;
     std::unique_ptr<PassRunner> runner_;

@@ -1,5 +1,7 @@
 #include "render/ScatteringSettings.h"
 
+#include <cmath>
+
 #include "render/SettingsJson.h"
 #include "sss/MaterialLibrary.h"
 
@@ -7,6 +9,15 @@ namespace subscan {
 
 namespace {
 
+constexpr std::pair<ScatteringMethod, std::string_view> kMethods[] = {
+    {ScatteringMethod::Gaussian, "gaussian"},
+    {ScatteringMethod::Single, "single"},
+    {ScatteringMethod::Both, "both"},
+};
+constexpr std::pair<CoefficientSource, std::string_view> kSources[] = {
+    {CoefficientSource::Material, "material"},
+    {CoefficientSource::Color, "color"},
+};
 constexpr std::pair<AlbedoPlacement, std::string_view> kPlacements[] = {
     {AlbedoPlacement::PreScatter, "pre"},
     {AlbedoPlacement::PostScatter, "post"},
@@ -35,6 +46,22 @@ double millimetresPerUnit(SceneUnit unit) {
     return 1.0;
 }
 
+double scatteringEta(const ScatteringSettings& settings) {
+    return settings.eta ? *settings.eta : findMaterial(settings.material).eta;
+}
+
+std::string toString(ScatteringMethod method) {
+    return nameOf(kMethods, method);
+}
+ScatteringMethod parseScatteringMethod(std::string_view text) {
+    return parseName(kMethods, text, "scattering method");
+}
+std::string toString(CoefficientSource source) {
+    return nameOf(kSources, source);
+}
+CoefficientSource parseCoefficientSource(std::string_view text) {
+    return parseName(kSources, text, "coefficient source");
+}
 std::string toString(AlbedoPlacement placement) {
     return nameOf(kPlacements, placement);
 }
@@ -50,13 +77,61 @@ SceneUnit parseSceneUnit(std::string_view text) {
 
 void to_json(nlohmann::json& json, const ScatteringSettings& settings) {
     json = {
-        {"material", settings.material}, {"unit", toString(settings.unit)},
-        {"scale", settings.scale},       {"albedo", toString(settings.albedo)},
+        {"method", toString(settings.method)},
+        {"material", settings.material},
+        {"unit", toString(settings.unit)},
+        {"scale", settings.scale},
+        {"albedo", toString(settings.albedo)},
         {"max_taps", settings.maxTaps},
+        {"coefficients", toString(settings.coefficients)},
+        {"mean_free_path_mm", toJson(settings.meanFreePathMm)},
+        {"eta", settings.eta ? nlohmann::json(*settings.eta) : nlohmann::json(nullptr)},
+        {"phase_g", settings.phaseG},
+        {"single_samples", settings.singleSamples},
     };
 }
 
+void checkScatteringSettings(const ScatteringSettings& settings) {
+    for (int c = 0; c < 3; ++c) {
+        const float path = settings.meanFreePathMm[c];
+        if (!(path > 0.0f) || !std::isfinite(path)) {
+            throw Error(fmt::format(
+                "the setting 'mean_free_path_mm' must be positive millimetres in every channel, "
+                "not {}",
+                path));
+        }
+    }
+    if (settings.eta && !(*settings.eta >= 1.0f && *settings.eta <= 3.0f)) {
+        throw Error(fmt::format(
+            "the setting 'eta' = {} is outside 1..3 (the relative index of refraction of a "
+            "medium denser than air)",
+            *settings.eta));
+    }
+    if (!(std::abs(settings.phaseG) < 1.0f)) {
+        throw Error(fmt::format(
+            "the setting 'phase_g' = {} must lie strictly between -1 and 1 (Henyey-Greenstein)",
+            settings.phaseG));
+    }
+    if (!(settings.singleSamples >= 1 && settings.singleSamples <= 64)) {
+        throw Error(fmt::format("the setting 'single_samples' = {} is outside 1..64",
+                                settings.singleSamples));
+    }
+    if (settings.method != ScatteringMethod::Gaussian &&
+        settings.coefficients == CoefficientSource::Material) {
+        measuredMaterial(settings.material);
+    }
+    if (!(settings.scale > 0.0f && settings.scale <= 1000.0f)) {
+        throw Error(fmt::format("the setting 'scale' = {} is outside 0..1000 (exclusive of 0)",
+                                settings.scale));
+    }
+}
+
 void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
+    rejectUnknownKeys(json, "scattering",
+                      {"method", "material", "unit", "scale", "albedo", "max_taps", "coefficients",
+                       "mean_free_path_mm", "eta", "phase_g", "single_samples"});
+    readEnum(json, "method", settings.method, kMethods, "scattering method");
+    readEnum(json, "coefficients", settings.coefficients, kSources, "coefficient source");
     if (const auto found = json.find("material"); found != json.end()) {
         if (!found->is_string()) {
             throw Error("the setting 'material' must be a string");
@@ -67,6 +142,19 @@ void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
     readSetting(json, "scale", settings.scale, 0.0f, 1000.0f);
     readEnum(json, "albedo", settings.albedo, kPlacements, "albedo placement");
     readSetting(json, "max_taps", settings.maxTaps, 1, 128);
+    readSetting(json, "mean_free_path_mm", settings.meanFreePathMm, -1e30f, 1e30f);
+    if (const auto eta = json.find("eta"); eta != json.end()) {
+        if (eta->is_null()) {
+            settings.eta.reset();
+        } else if (eta->is_number()) {
+            settings.eta = eta->get<float>();
+        } else {
+            throw Error("the setting 'eta' must be a number or null (the material's)");
+        }
+    }
+    readSetting(json, "phase_g", settings.phaseG, -1e30f, 1e30f);
+    readSetting(json, "single_samples", settings.singleSamples, -1000000, 1000000);
+    checkScatteringSettings(settings);
 }
 
 }  // namespace subscan

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -12,6 +14,27 @@
 #include "core/Error.h"
 
 namespace subscan {
+
+/// Throws subscan::Error naming the first key of `json` that is not in `known`: a typo such as
+/// "metod" would otherwise be ignored and leave the default in force without a word.
+inline void rejectUnknownKeys(const nlohmann::json& json, std::string_view section,
+                              std::initializer_list<std::string_view> known) {
+    if (!json.is_object()) {
+        throw Error(fmt::format("the settings section '{}' must be a JSON object", section));
+    }
+    for (const auto& [key, value] : json.items()) {
+        if (std::find(known.begin(), known.end(), key) != known.end()) {
+            continue;
+        }
+        std::string expected;
+        for (const std::string_view name : known) {
+            expected += expected.empty() ? "" : ", ";
+            expected += name;
+        }
+        throw Error(fmt::format("unknown setting '{}' in '{}' (expected one of: {})", key, section,
+                                expected));
+    }
+}
 
 /// Reads `key` into `value` when present (absent keys keep their defaults, so a settings file
 /// holds only what it changes), checking min <= value <= max. Throws subscan::Error naming the

@@ -19,6 +19,9 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
 }
 
 void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
+    rejectUnknownKeys(json, "surface",
+                      {"visibility_radius", "visibility_threshold", "edge_rule", "pull_depth_slope",
+                       "fill_radius", "fill_directions", "normal_radius", "restrict_to_points"});
     readSetting(json, "visibility_radius", settings.visibilityRadius, 0.1f, 1000.0f);
     readSetting(json, "visibility_threshold", settings.visibilityThreshold, 0.0f, 2.0f);
     readSetting(json, "edge_rule", settings.edgeRule);
@@ -45,6 +48,8 @@ void to_json(nlohmann::json& json, const ShadingSettings& settings) {
 }
 
 void from_json(const nlohmann::json& json, ShadingSettings& settings) {
+    rejectUnknownKeys(json, "shading",
+                      {"head_light", "ambient", "specular", "shininess", "lights"});
     readSetting(json, "head_light", settings.headLight, 0.0f, 100.0f);
     readSetting(json, "ambient", settings.ambient, 0.0f, 100.0f);
     readSetting(json, "specular", settings.specular, 0.0f, 1.0f);
@@ -57,6 +62,7 @@ void from_json(const nlohmann::json& json, ShadingSettings& settings) {
         settings.lights.clear();
         for (const nlohmann::json& entry : *lights) {
             DirectionalLight light;
+            rejectUnknownKeys(entry, "lights", {"direction", "radiance"});
             readSetting(entry, "direction", light.direction, -1e6f, 1e6f);
             readSetting(entry, "radiance", light.radiance, 0.0f, 100.0f);
             if (!(glm::dot(light.direction, light.direction) > 0.0f)) {

@@ -113,6 +113,19 @@ double ReducedAlbedoTable::reducedAlbedo(double totalReflectance) const {
     return 1.0 - root * root;
 }
 
+std::vector<float> reducedAlbedoRootTable(const ReducedAlbedoTable& table, std::size_t entries) {
+    if (entries < 2) {
+        throw Error("the reduced albedo table needs at least 2 entries");
+    }
+    std::vector<float> roots(entries);
+    for (std::size_t i = 0; i < entries; ++i) {
+        const double reflectance = ReducedAlbedoTable::kMaxReflectance * static_cast<double>(i) /
+                                   static_cast<double>(entries - 1);
+        roots[i] = static_cast<float>(std::sqrt(1.0 - table.reducedAlbedo(reflectance)));
+    }
+    return roots;
+}
+
 ScatteringCoefficients coefficientsFromReflectance(const ReducedAlbedoTable& table,
                                                    const Rgb& totalReflectance,
                                                    const Rgb& diffuseMeanFreePathMm) {

@@ -76,6 +76,12 @@ class ReducedAlbedoTable {
     std::vector<double> reflectanceByRoot_;  // R_d at u = i/(entries − 1), falling from 1 to 0
 };
 
+/// The table the GPU inverts R_d with (SingleScattering.comp): u = √(1 − α′) at
+/// R_d = i/(entries − 1) · kMaxReflectance, for linear interpolation in R_d. u rather than α′
+/// because σa = σtr u/√3 and σs′ = σtr (1 − u²)/(√3 u): both follow u's interpolation error
+/// relatively, where α′ near 1 would lose σa to rounding.
+std::vector<float> reducedAlbedoRootTable(const ReducedAlbedoTable& table, std::size_t entries);
+
 /// σs′ and σa in mm⁻¹.
 struct ScatteringCoefficients {
     Rgb sigmaSPrime{};

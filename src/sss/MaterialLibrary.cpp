@@ -131,3 +131,24 @@ const Material& findMaterial(std::string_view name) {
 }
 
 }  // namespace subscan
+
+namespace subscan {
+
+const Material& measuredMaterial(std::string_view name) {
+    const Material& material = findMaterial(name);
+    if (material.sigmaSPrime && material.sigmaA) {
+        return material;
+    }
+    std::string measured;
+    for (const Material& candidate : materialLibrary()) {
+        if (candidate.sigmaSPrime && candidate.sigmaA) {
+            measured += (measured.empty() ? "" : ", ") + candidate.name;
+        }
+    }
+    throw Error(fmt::format(
+        "the material '{}' is a Gaussian set without measured σs′ and σa, so single scattering "
+        "cannot take its coefficients; choose one of {} or coefficients 'color'",
+        name, measured));
+}
+
+}  // namespace subscan

@@ -30,4 +30,8 @@ const std::vector<Material>& materialLibrary();
 /// The material called `name`; throws Error naming the known materials when there is none.
 const Material& findMaterial(std::string_view name);
 
+/// The material called `name` when it has measured σs′ and σa (single scattering needs them);
+/// throws Error naming the materials that do when it has none.
+const Material& measuredMaterial(std::string_view name);
+
 }  // namespace subscan

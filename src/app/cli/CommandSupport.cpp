@@ -1,11 +1,14 @@
 #include "app/cli/CommandSupport.h"
 
 #include <filesystem>
+#include <sstream>
 #include <system_error>
 
 #include <fmt/format.h>
 
 #include "app/ProgressBar.h"
+#include "core/Error.h"
+#include "sss/MaterialLibrary.h"
 
 namespace subscan::cli {
 
@@ -27,6 +30,82 @@ void addResolutionOption(CLI::App& command, std::string& resolution) {
                     "Pixels the surface is reconstructed at: full (default) | half | auto (half "
                     "while the points are 4 or more pixels apart)")
         ->check(CLI::IsMember({"full", "half", "auto"}));
+}
+
+void ScatteringOptions::add(CLI::App& command) {
+    command
+        .add_option("--scattering", method,
+                    "Light transport of the sss mode: gaussian (blur of the diffuse light) | "
+                    "single (single scattering) | both")
+        ->check(CLI::IsMember({"gaussian", "single", "both"}));
+    command.add_option("--material", material,
+                       "Translucent material of the sss mode (see `subscan materials`)");
+    command.add_option("--unit", unit, "Length unit of the scan: mm | cm | m | in")
+        ->check(CLI::IsMember({"mm", "cm", "m", "in"}));
+    command
+        .add_option("--sss-scale", scale,
+                    "Multiplies every scattering radius and mean free path (> 0)")
+        ->check(CLI::Range(0.0f, 1000.0f));
+    command
+        .add_option("--albedo", albedo,
+                    "Where the colour enters the Gaussian blur: pre | post | split")
+        ->check(CLI::IsMember({"pre", "post", "split"}));
+    command
+        .add_option("--coefficients", coefficients,
+                    "Single scattering's σs′ and σa: color (from the scan's colour, default) | "
+                    "material (measured, see `subscan materials`)")
+        ->check(CLI::IsMember({"material", "color"}));
+    command.add_option("--mean-free-path", meanFreePath,
+                       "R,G,B diffuse mean free path in mm for --coefficients color (default: "
+                       "measured marble's 8.51,5.57,3.95)");
+    command.add_option("--eta", eta,
+                       "Relative index of refraction (default: the material's); overrides the "
+                       "material's for both coefficient sources");
+    command.add_option("--phase-g", phaseG, "Henyey-Greenstein asymmetry g, -1 < g < 1");
+    command.add_option("--single-samples", singleSamples,
+                       "Samples along the refracted view ray (1..64)");
+}
+
+void ScatteringOptions::apply(ScatteringSettings& settings) const {
+    if (!method.empty()) {
+        settings.method = parseScatteringMethod(method);
+    }
+    if (!material.empty()) {
+        settings.material = findMaterial(material).name;
+    }
+    if (!unit.empty()) {
+        settings.unit = parseSceneUnit(unit);
+    }
+    if (scale) {
+        settings.scale = *scale;
+    }
+    if (!albedo.empty()) {
+        settings.albedo = parseAlbedoPlacement(albedo);
+    }
+    if (!coefficients.empty()) {
+        settings.coefficients = parseCoefficientSource(coefficients);
+    }
+    if (!meanFreePath.empty()) {
+        glm::vec3 path;
+        char comma1 = 0, comma2 = 0;
+        std::istringstream stream(meanFreePath);
+        stream >> path.r >> comma1 >> path.g >> comma2 >> path.b;
+        if (!stream || comma1 != ',' || comma2 != ',' || !stream.eof()) {
+            throw Error(fmt::format("--mean-free-path '{}' is not R,G,B (three millimetre values)",
+                                    meanFreePath));
+        }
+        settings.meanFreePathMm = path;
+    }
+    if (eta) {
+        settings.eta = *eta;
+    }
+    if (phaseG) {
+        settings.phaseG = *phaseG;
+    }
+    if (singleSamples) {
+        settings.singleSamples = *singleSamples;
+    }
+    checkScatteringSettings(settings);
 }
 
 }  // namespace subscan::cli

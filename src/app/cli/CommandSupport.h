@@ -1,11 +1,13 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include <CLI/CLI.hpp>
 
 #include "io/ScanLoader.h"
+#include "render/ScatteringSettings.h"
 
 namespace subscan::cli {
 
@@ -15,5 +17,25 @@ LoadedScan loadScanForCommand(std::string_view source);
 
 /// `--resolution full|half|auto` (RasterSettings::resolution), as render and bench take it.
 void addResolutionOption(CLI::App& command, std::string& resolution);
+
+/// The sss mode's options, as render, view and bench take them: each given one overrides the
+/// settings file's value.
+struct ScatteringOptions {
+    std::string method;
+    std::string material;
+    std::string unit;
+    std::optional<float> scale;
+    std::string albedo;
+    std::string coefficients;
+    std::string meanFreePath;  // "R,G,B" in mm
+    std::optional<float> eta;
+    std::optional<float> phaseG;
+    std::optional<int> singleSamples;
+
+    void add(CLI::App& command);
+    /// Writes the given options over `settings`; throws subscan::Error naming the option or the
+    /// impossible combination (checkScatteringSettings).
+    void apply(ScatteringSettings& settings) const;
+};
 
 }  // namespace subscan::cli

@@ -17,7 +17,6 @@
 #include "io/Image.h"
 #include "render/RenderSettings.h"
 #include "render/Renderer.h"
-#include "sss/MaterialLibrary.h"
 
 namespace subscan::cli {
 
@@ -41,10 +40,7 @@ struct RenderOptions {
     std::string raster;
     std::string resolution;
     std::string stage;
-    std::string material;
-    std::string unit;
-    std::optional<float> sssScale;
-    std::string albedo;
+    ScatteringOptions scattering;
     std::string settingsFile;
     std::string saveSettingsFile;
     bool timings = false;
@@ -114,10 +110,12 @@ ImageF channelsOf(const Texture& texture, int channels) {
 
 /// camera.json, depth.pfm and color.png always; in the surface and sss modes also normals.pfm,
 /// mask.png and radiance.pfm (after scattering in sss mode), with depth.pfm holding the
-/// reconstructed depth (+inf outside the mask). The camera and the buffers are the pipeline's:
-/// at reduced resolution, smaller than the picture.
+/// reconstructed depth (+inf outside the mask); with single scattering also single.pfm (that
+/// term alone, linear RGB like radiance.pfm), sigma_s.pfm and sigma_a.pfm (σs′ and σa in mm⁻¹). The
+/// camera and the buffers are the pipeline's: at reduced resolution, smaller than the picture.
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
-                   RenderMode mode) {
+                   const RenderSettings& settings) {
+    const RenderMode mode = settings.raster.mode;
     const Camera& camera = renderer.pipelineCamera();
     std::error_code error;
     std::filesystem::create_directories(directory, error);
@@ -156,6 +154,11 @@ void exportBuffers(const std::filesystem::path& directory, const Renderer& rende
         mask.pixels[pixel] = std::isinf(depth[pixel]) ? 0 : 255;
     }
     writePng(directory / "mask.png", mask);
+    if (scattered && settings.scattering.method != ScatteringMethod::Gaussian) {
+        writePfm(directory / "single.pfm", channelsOf(resources.texture("singleScattering"), 3));
+        writePfm(directory / "sigma_s.pfm", channelsOf(resources.texture("sigmaSPrime"), 3));
+        writePfm(directory / "sigma_a.pfm", channelsOf(resources.texture("sigmaA"), 3));
+    }
 }
 
 int runRender(const RenderOptions& options) {
@@ -188,19 +191,7 @@ int runRender(const RenderOptions& options) {
     if (!options.background.empty()) {
         raster.backgroundSrgb = parseBackground(options.background);
     }
-    ScatteringSettings& scattering = settings.scattering;
-    if (!options.material.empty()) {
-        scattering.material = findMaterial(options.material).name;
-    }
-    if (!options.unit.empty()) {
-        scattering.unit = parseSceneUnit(options.unit);
-    }
-    if (options.sssScale) {
-        scattering.scale = *options.sssScale;
-    }
-    if (!options.albedo.empty()) {
-        scattering.albedo = parseAlbedoPlacement(options.albedo);
-    }
+    options.scattering.apply(settings.scattering);
     if (!options.saveSettingsFile.empty()) {
         writeSettingsFile(options.saveSettingsFile, settings);
     }
@@ -247,7 +238,7 @@ int runRender(const RenderOptions& options) {
     }
 
     if (!options.exportDirectory.empty()) {
-        exportBuffers(options.exportDirectory, renderer, raster.mode);
+        exportBuffers(options.exportDirectory, renderer, settings);
     }
     writePng(output, {camera.width, camera.height, 4, renderer.readImage()});
     return 0;
@@ -275,16 +266,7 @@ Command addRenderCommand(CLI::App& parent) {
                      "normals | shaded (surface and sss modes; depth in any)")
         ->check(CLI::IsMember({"final", "depth", "pyramid", "visibility", "pull", "push", "fill",
                                "normals", "shaded"}));
-    render->add_option("--material", options->material,
-                       "Translucent material of the sss mode (see `subscan materials`)");
-    render->add_option("--unit", options->unit, "Length unit of the scan: mm | cm | m | in")
-        ->check(CLI::IsMember({"mm", "cm", "m", "in"}));
-    render->add_option("--sss-scale", options->sssScale, "Multiplies every scattering radius")
-        ->check(CLI::Range(0.0f, 1000.0f));
-    render
-        ->add_option("--albedo", options->albedo,
-                     "Where the colour enters the scattering: pre | post | split")
-        ->check(CLI::IsMember({"pre", "post", "split"}));
+    options->scattering.add(*render);
     render->add_option("--point-size", options->pointSize, "Splat size in pixels (splats mode)")
         ->check(CLI::Range(1.0f, 64.0f));
     render->add_option("--yaw", options->yaw, "Orbit angle around the up axis, degrees");

@@ -8,12 +8,12 @@
 
 #include <fmt/format.h>
 
+#include "app/cli/CommandSupport.h"
 #include "app/cli/Commands.h"
 #include "app/viewer/Viewer.h"
 #include "app/viewer/ViewerScript.h"
 #include "core/Error.h"
 #include "render/RenderSettings.h"
-#include "sss/MaterialLibrary.h"
 
 namespace subscan::cli {
 
@@ -24,7 +24,7 @@ struct ViewCommandOptions {
     int width = 1280;
     int height = 800;
     std::string mode;
-    std::string material;
+    ScatteringOptions scattering;
     std::string settingsFile;
     std::string up = "auto";
     std::string scriptFile;
@@ -57,9 +57,7 @@ viewer::ViewerOptions checkedOptions(const ViewCommandOptions& command) {
     if (!command.mode.empty()) {
         options.settings.raster.mode = parseRenderMode(command.mode);
     }
-    if (!command.material.empty()) {
-        options.settings.scattering.material = findMaterial(command.material).name;
-    }
+    command.scattering.apply(options.settings.scattering);
     if (!command.scriptFile.empty()) {
         options.script = viewer::readScriptFile(command.scriptFile);
     }
@@ -101,11 +99,10 @@ Command addViewCommand(CLI::App& parent) {
     view->add_option("--mode", options->mode,
                      "points (default) | points-gl | splats | surface | sss")
         ->check(CLI::IsMember({"points", "points-gl", "splats", "surface", "sss"}));
-    view->add_option("--material", options->material,
-                     "Translucent material of the sss mode (see `subscan materials`)");
+    options->scattering.add(*view);
     view->add_option("--settings", options->settingsFile,
                      "Settings JSON, as `subscan render --settings` reads; --mode and "
-                     "--material override it")
+                     "the scattering options override it")
         ->check(CLI::ExistingFile);
     view->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));

@@ -1,0 +1,294 @@
+#version 450
+// Single scattering in screen space (DESIGN.md §6.3, §6.4; the paper's §5.1.1 and §5.2).
+// Per surface pixel: the view ray refracted into the surface is sampled; from each sample a
+// march towards each light through the reconstructed depth finds where that light entered; the
+// light scattered once towards the eye is summed with Fresnel transmission at both ends, the
+// Henyey-Greenstein phase function, extinction on both legs, the refracted beam's compression
+// and 1/η² on leaving. σs and σa come from the material, or per pixel from the colour (the
+// colour taken as total diffuse reflectance, inverted through a table, and the mean free path).
+// The estimator is the CPU's estimateSingleScattering (sss/SingleScattering.h) with midpoint
+// strata.
+//   STAGE_ADD_TO_RADIANCE   "scatteredRadiance" = "radiance" (diffuse + specular) + single
+//   STAGE_ADD_TO_SCATTERED  "scatteredRadiance" += single (after the Gaussian blur)
+// Both write "singleScattering" alone and σs′, σa (mm⁻¹) per pixel for exports.
+#include "shared/common.glsl"
+#include "shared/region.glsl"
+
+layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+layout(std140, binding = SUBSCAN_UBO_PASS) uniform SingleScatterBlock {
+    SingleScatterParams params;
+};
+layout(std140, binding = SUBSCAN_UBO_LIGHTS) uniform LightBlock {
+    ShadeParams lights;
+};
+layout(binding = SUBSCAN_TEXELS_ALBEDO_ROOTS) uniform samplerBuffer albedoRoots;
+layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
+layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inNormals;
+layout(binding = SUBSCAN_IMAGE_IN2, rgba16f) readonly uniform image2D inAlbedo;
+#if STAGE_ADD_TO_SCATTERED
+layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) uniform image2D scatteredRadiance;  // in place
+#else
+layout(binding = SUBSCAN_IMAGE_IN3, rgba16f) readonly uniform image2D inRadiance;
+layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D scatteredRadiance;
+#endif
+layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outSingle;
+layout(binding = SUBSCAN_IMAGE_OUT2, rgba32f) writeonly uniform image2D outSigmaSPrime;
+layout(binding = SUBSCAN_IMAGE_OUT3, rgba32f) writeonly uniform image2D outSigmaA;
+
+const float kPi = 3.14159265358979;
+// The march looks for the entry up to where the light is down to e^-6 (0.25 %) of itself.
+const float kExtinctionDepths = 6.0;
+const int kRefinements = 8;  // bisections of the step that crossed the surface, at most
+
+const int kInside = 0;
+const int kOutside = 1;
+const int kOffScreen = 2;
+
+float refractedCosine(float cosine, float eta) {
+    float sine2 = max(0.0, 1.0 - cosine * cosine) / (eta * eta);
+    return sqrt(max(0.0, 1.0 - sine2));
+}
+
+/// The direction refracted into the medium, still pointing out of the surface.
+vec3 refractedDirection(vec3 direction, vec3 normal, float eta) {
+    float cosine = dot(direction, normal);
+    return (direction - cosine * normal) / eta + refractedCosine(cosine, eta) * normal;
+}
+
+float fresnelTransmittance(float cosine, float eta) {
+    float cosOutside = clamp(abs(cosine), 0.0, 1.0);
+    float cosInside = refractedCosine(cosOutside, eta);
+    float perpendicular = (cosOutside - eta * cosInside) / (cosOutside + eta * cosInside);
+    float parallel = (eta * cosOutside - cosInside) / (eta * cosOutside + cosInside);
+    return 1.0 - 0.5 * (perpendicular * perpendicular + parallel * parallel);
+}
+
+float henyeyGreenstein(float cosine, float g) {
+    float denominator = 1.0 + g * g - 2.0 * g * cosine;
+    return (1.0 - g * g) / (4.0 * kPi * denominator * sqrt(denominator));
+}
+
+/// √(1 − α′) of the medium whose total diffuse reflectance is `reflectance` (linear
+/// interpolation in the table; reflectances past its last entry take that entry's).
+float albedoRoot(float reflectance) {
+    float last = params.sampling.y - 1.0;
+    float position = clamp(reflectance / params.sampling.z, 0.0, 1.0) * last;
+    int lower = min(int(position), int(last) - 1);
+    float fraction = position - float(lower);
+    return mix(texelFetch(albedoRoots, lower).r, texelFetch(albedoRoots, lower + 1).r, fraction);
+}
+
+/// Whether view-space point `q` lies inside the surface the depth buffer shows at its pixel:
+/// below that pixel's tangent plane (exact for a plane, first order elsewhere) and not more
+/// than `thickness` behind it (further behind, the pixel shows another, nearer object).
+int classify(vec3 q, float thickness, out ivec2 pixel) {
+    float depth;
+    if (!projectToPixel(q, pixel, depth)) {
+        return kOffScreen;
+    }
+    float front = imageLoad(inSurfaceDepth, pixel).r;
+    if (isinf(front) || depth - front > thickness) {
+        return kOutside;
+    }
+    vec3 surfacePoint = viewPositionAt(vec2(pixel) + 0.5, front);
+    vec3 normal = imageLoad(inNormals, pixel).xyz;
+    return dot(normal, q - surfacePoint) < 0.0 ? kInside : kOutside;
+}
+
+vec2 windowPosition(vec3 viewPosition) {
+    vec4 clip = frame.projection * vec4(viewPosition, 1.0);
+    vec2 ndc = clip.xy / clip.w;
+    return vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
+}
+
+/// Marches from `start` (inside, `reach` below the surface along the view ray) towards the
+/// light along `toLight`, about a pixel a step, for at most `length`; refines the crossing by
+/// bisection until both ends share a pixel and then solves that pixel's tangent plane. Returns
+/// kInside when no entry lies within `length` (the light is extinct there), kOutside with the
+/// straight distance `t` and the entry's normal when found, kOffScreen when the march left the
+/// image or the depth range first.
+int findEntry(vec3 start, float reach, vec3 toLight, float length, float cosView, out float t,
+              out vec3 entryNormal) {
+    t = 0.0;
+    entryNormal = vec3(0.0);
+    if (toLight.z > 0.0) {
+        // Stay behind the near plane, where points still project.
+        length = min(length, 0.999 * (-start.z - frame.depthRange.x) / toLight.z);
+    }
+    float screenLength = distance(windowPosition(start), windowPosition(start + length * toLight));
+    int steps = clamp(int(ceil(screenLength)), 1, int(params.sampling.w));
+    float step = length / float(steps);
+    float thicknessScale = 2.0 / max(cosView, 0.2);
+    float inside = 0.0;
+    float outside = -1.0;
+    ivec2 insidePixel;
+    classify(start, kInfinity, insidePixel);
+    for (int i = 1; i <= steps; ++i) {
+        float along = float(i) * step;
+        ivec2 pixel;
+        int state = classify(start + along * toLight, thicknessScale * (reach + along), pixel);
+        if (state == kOffScreen) {
+            return kOffScreen;
+        }
+        if (state == kOutside) {
+            outside = along;
+            break;
+        }
+        inside = along;
+        insidePixel = pixel;
+    }
+    if (outside < 0.0) {
+        return kInside;
+    }
+    for (int i = 0; i < kRefinements; ++i) {
+        ivec2 outsidePixel;
+        float outsideDepth;
+        projectToPixel(start + outside * toLight, outsidePixel, outsideDepth);
+        if (outsidePixel == insidePixel) {
+            break;
+        }
+        float middle = 0.5 * (inside + outside);
+        ivec2 pixel;
+        if (classify(start + middle * toLight, thicknessScale * (reach + middle), pixel) ==
+            kInside) {
+            inside = middle;
+            insidePixel = pixel;
+        } else {
+            outside = middle;
+        }
+    }
+    float front = imageLoad(inSurfaceDepth, insidePixel).r;
+    vec3 surfacePoint = viewPositionAt(vec2(insidePixel) + 0.5, front);
+    entryNormal = imageLoad(inNormals, insidePixel).xyz;
+    float approach = dot(entryNormal, toLight);
+    t = abs(approach) > 1e-6 ? dot(entryNormal, surfacePoint - start) / approach : inside;
+    t = clamp(t, inside, outside);
+    return kOutside;
+}
+
+struct Medium {
+    vec3 sigmaS;  // unreduced, per scene unit
+    vec3 sigmaT;  // per scene unit
+};
+
+/// The light of value `color` arriving from `toLight` that single scattering at `samplePoint` (`s`
+/// along the refracted view ray from the surface point with normal `normal`) sends towards the
+/// eye, per channel, before σs e^(−σt s) and the exit terms: p T_i (cos θi / cos θi′) E
+/// e^(−σt s_i′).
+vec3 lightAtSample(vec3 samplePoint, float s, vec3 toLight, vec3 color, vec3 normal, float cosView,
+                   vec3 eyeInside, Medium medium, float extinctionLength) {
+    float eta = params.medium.x;
+    float t;
+    vec3 entryNormal;
+    int found = findEntry(samplePoint, s, toLight, extinctionLength, cosView, t, entryNormal);
+    float cosIn;
+    float lightPath;
+    if (found == kInside) {
+        return vec3(0.0);
+    }
+    if (found == kOutside) {
+        cosIn = abs(dot(entryNormal, toLight));
+        entryNormal = dot(entryNormal, toLight) >= 0.0 ? entryNormal : -entryNormal;
+        lightPath = t * cosIn / refractedCosine(cosIn, eta);
+    } else {
+        // Fallback off screen: the flat slab of the local tangent plane.
+        cosIn = dot(normal, toLight);
+        if (cosIn <= 0.0) {
+            return vec3(0.0);
+        }
+        entryNormal = normal;
+        lightPath = s * refractedCosine(cosView, eta) / refractedCosine(cosIn, eta);
+    }
+    if (cosIn <= 0.0) {
+        return vec3(0.0);
+    }
+    float cosInInside = refractedCosine(cosIn, eta);
+    vec3 lightInside = refractedDirection(toLight, entryNormal, eta);
+    float phase = henyeyGreenstein(-dot(lightInside, eyeInside), params.medium.y);
+    float weight = phase * fresnelTransmittance(cosIn, eta) * cosIn / cosInInside * kPi;
+    return weight * color * exp(-medium.sigmaT * lightPath);
+}
+
+void main() {
+    ivec2 pixel = dispatchTexel();
+    if (any(greaterThanEqual(pixel, imageSizeOfFrame())) || !insideRegion(pixel)) {
+        return;
+    }
+    float depth = imageLoad(inSurfaceDepth, pixel).r;
+#if STAGE_ADD_TO_SCATTERED
+    vec4 base = imageLoad(scatteredRadiance, pixel);
+#else
+    vec4 base = imageLoad(inRadiance, pixel);
+#endif
+    if (isinf(depth)) {
+        imageStore(outSingle, pixel, vec4(0.0));
+        imageStore(outSigmaSPrime, pixel, vec4(0.0));
+        imageStore(outSigmaA, pixel, vec4(0.0));
+        imageStore(scatteredRadiance, pixel, base);
+        return;
+    }
+    float eta = params.medium.x;
+    float g = params.medium.y;
+    vec3 sigmaSPrime = params.sigmaSPrime.rgb;
+    vec3 sigmaA = params.sigmaA.rgb;
+    if (params.medium.w > 0.5) {
+        // DESIGN.md §6.4 with u = √(1 − α′): σt′ = σtr/(√3 u), σs′ = α′σt′, σa = σt′ − σs′.
+        vec3 albedo = clamp(imageLoad(inAlbedo, pixel).rgb, 0.0, 1.0);
+        vec3 root = vec3(albedoRoot(albedo.r), albedoRoot(albedo.g), albedoRoot(albedo.b));
+        vec3 effectiveExtinction = 1.0 / params.meanFreePath.rgb;
+        vec3 reducedExtinction = effectiveExtinction / (sqrt(3.0) * root);
+        sigmaSPrime = (1.0 - root * root) * reducedExtinction;
+        sigmaA = reducedExtinction - sigmaSPrime;
+    }
+    imageStore(outSigmaSPrime, pixel, vec4(sigmaSPrime, 1.0));
+    imageStore(outSigmaA, pixel, vec4(sigmaA, 1.0));
+
+    Medium medium;
+    medium.sigmaS = sigmaSPrime / (1.0 - g) * params.medium.z;
+    medium.sigmaT = max(medium.sigmaS + sigmaA * params.medium.z, vec3(1e-30));
+
+    vec3 normal = normalize(imageLoad(inNormals, pixel).xyz);
+    vec3 surfacePoint = viewPositionAt(vec2(pixel) + 0.5, depth);
+    vec3 toEye = normalize(-surfacePoint);
+    float cosView = dot(normal, toEye);
+    vec3 single = vec3(0.0);
+    if (cosView > 0.0 && any(greaterThan(medium.sigmaS, vec3(0.0)))) {
+        vec3 eyeInside = refractedDirection(toEye, normal, eta);
+        // How far the march looks: kExtinctionDepths of the least extinct channel, along a
+        // straight path whose refracted length is shortened by cos θi/cos θi′ (at most 1/0.05).
+        float sigmaTMin = min(medium.sigmaT.r, min(medium.sigmaT.g, medium.sigmaT.b));
+        int samples = int(params.sampling.x);
+        ivec3 channelSamples = (ivec3(samples + 2) - ivec3(0, 1, 2)) / 3;
+        for (int k = 0; k < samples; ++k) {
+            int channel = k % 3;
+            float xi = (float(k / 3) + 0.5) / float(channelSamples[channel]);
+            float s = -log(1.0 - xi) / medium.sigmaT[channel];
+            vec3 density = vec3(channelSamples) * medium.sigmaT * exp(-medium.sigmaT * s);
+            vec3 samplePoint = surfacePoint - s * eyeInside;
+            ivec2 samplePixel;
+            if (classify(samplePoint, kInfinity, samplePixel) == kOutside) {
+                continue;  // the refracted ray left the medium: nothing scatters there
+            }
+            vec3 light = vec3(0.0);
+            vec3 toHead = normalize(-samplePoint);
+            float headCos = max(dot(normal, toHead), 0.05);
+            light += lightAtSample(samplePoint, s, toHead, lights.headLight.rgb, normal, cosView,
+                                   eyeInside, medium,
+                                   kExtinctionDepths * refractedCosine(headCos, eta) /
+                                       (sigmaTMin * headCos));
+            for (uint i = 0u; i < lights.lightCount.x; ++i) {
+                vec3 toLight = lights.lightDirection[i].xyz;
+                float lightCos = max(dot(normal, toLight), 0.05);
+                light += lightAtSample(samplePoint, s, toLight, lights.lightColor[i].rgb, normal,
+                                       cosView, eyeInside, medium,
+                                       kExtinctionDepths * refractedCosine(lightCos, eta) /
+                                           (sigmaTMin * lightCos));
+            }
+            single += medium.sigmaS * light * exp(-medium.sigmaT * s) /
+                      (density.r + density.g + density.b);
+        }
+        single *= fresnelTransmittance(cosView, eta) / (eta * eta);
+    }
+    imageStore(outSingle, pixel, vec4(single, 1.0));
+    imageStore(scatteredRadiance, pixel, vec4(base.rgb + single, base.a));
+}

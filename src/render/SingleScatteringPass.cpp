@@ -1,0 +1,103 @@
+#include "render/SingleScatteringPass.h"
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+#include "render/ShadePass.h"
+#include "sss/Dipole.h"
+#include "sss/MaterialLibrary.h"
+
+namespace subscan {
+
+namespace {
+
+constexpr GLbitfield kImageBarriers = GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                                      GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT;
+
+glm::vec4 rgbVector(const Rgb& value) {
+    return {static_cast<float>(value[0]), static_cast<float>(value[1]),
+            static_cast<float>(value[2]), 0.0f};
+}
+
+}  // namespace
+
+SingleScatteringPass::SingleScatteringPass(const ShaderSources& sources, SingleScatteringBase base)
+    : base_(base),
+      stages_(sources, "render/SingleScattering.comp",
+              {base == SingleScatteringBase::Radiance ? "ADD_TO_RADIANCE" : "ADD_TO_SCATTERED"}) {}
+
+std::vector<std::string_view> SingleScatteringPass::inputs() const {
+    return {"surfaceDepth", "normals", "albedo",
+            base_ == SingleScatteringBase::Radiance ? "radiance" : "scatteredRadiance"};
+}
+
+gpu::SingleScatterParams SingleScatteringPass::parameters(const ScatteringSettings& settings) {
+    checkScatteringSettings(settings);
+    gpu::SingleScatterParams params{};
+    if (settings.coefficients == CoefficientSource::Material) {
+        const Material& material = measuredMaterial(settings.material);
+        params.sigmaSPrime = rgbVector(*material.sigmaSPrime);
+        params.sigmaA = rgbVector(*material.sigmaA);
+    }
+    params.meanFreePath = glm::vec4(settings.meanFreePathMm, 0.0f);
+    params.medium = {static_cast<float>(scatteringEta(settings)), settings.phaseG,
+                     static_cast<float>(millimetresPerUnit(settings.unit) / settings.scale),
+                     settings.coefficients == CoefficientSource::Color ? 1.0f : 0.0f};
+    params.sampling = {static_cast<float>(settings.singleSamples),
+                       static_cast<float>(kTableEntries),
+                       static_cast<float>(ReducedAlbedoTable::kMaxReflectance),
+                       static_cast<float>(kMaxMarchSteps)};
+    return params;
+}
+
+void SingleScatteringPass::execute(FrameContext& frame) {
+    const ScatteringSettings& settings = frame.settings.scattering;
+    const gpu::SingleScatterParams params = parameters(settings);
+    const double eta = params.medium.x;
+    if (tableEta_ != eta) {
+        const std::vector<float> roots =
+            reducedAlbedoRootTable(ReducedAlbedoTable(eta), kTableEntries);
+        albedoRoots_ = Buffer::fromSpan(std::span<const float>(roots), "SingleScattering.roots");
+        tableEta_ = eta;
+    }
+    FrameResources& resources = frame.resources;
+    const int width = frame.width();
+    const int height = frame.height();
+    Texture& single =
+        resources.ensureTexture("singleScattering", TextureFormat::RGBA16F, width, height);
+    // Full floats: the material's coefficients come out exactly as given.
+    Texture& sigmaSPrime =
+        resources.ensureTexture("sigmaSPrime", TextureFormat::RGBA32F, width, height);
+    Texture& sigmaA = resources.ensureTexture("sigmaA", TextureFormat::RGBA32F, width, height);
+    params_.set(params);
+    params_.bind(SUBSCAN_UBO_PASS);
+    lights_.set(ShadePass::parameters(frame.settings.shading, frame.camera));
+    lights_.bind(SUBSCAN_UBO_LIGHTS);
+    albedoRoots_.bindTexels(SUBSCAN_TEXELS_ALBEDO_ROOTS, TextureFormat::R32F);
+    resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    resources.texture("normals").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+    resources.texture("albedo").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
+    if (base_ == SingleScatteringBase::Radiance) {
+        resources.texture("radiance").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
+        resources.ensureTexture("scatteredRadiance", TextureFormat::RGBA16F, width, height)
+            .bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    } else {
+        resources.texture("scatteredRadiance").bindImage(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
+    }
+    single.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    sigmaSPrime.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    sigmaA.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
+    if (frame.restricted()) {
+        // Exported whole; the pass writes only the points' region.
+        single.clear();
+        sigmaSPrime.clear();
+        sigmaA.clear();
+        if (base_ == SingleScatteringBase::Radiance) {
+            resources.texture("scatteredRadiance").clear();
+        }
+    }
+    stages_.runOverRegion(0, frame.region(0));
+    glMemoryBarrier(kImageBarriers);
+}
+
+}  // namespace subscan
