@@ -8,11 +8,22 @@
 // colour taken as total diffuse reflectance, inverted through a table, and the mean free path).
 // The estimator is the CPU's estimateSingleScattering (sss/SingleScattering.h) with midpoint
 // strata.
-//   STAGE_ADD_TO_RADIANCE   "scatteredRadiance" = "radiance" (diffuse + specular) + single
-//   STAGE_ADD_TO_SCATTERED  "scatteredRadiance" += single (after the Gaussian blur)
+//   STAGE_RADIANCE_*   "scatteredRadiance" = "radiance" (diffuse + specular) + single
+//   STAGE_SCATTERED_*  "scatteredRadiance" += single (after the Gaussian blur)
 // Both write "singleScattering" alone and σs′, σa (mm⁻¹) per pixel for exports.
 #include "shared/common.glsl"
 #include "shared/region.glsl"
+
+// The stages come in pairs by what they add to (RADIANCE_*, SCATTERED_*): *_HEAD_LIGHT for
+// frames lit by the head light alone, *_LIGHTS with the directional lights' loop, which costs
+// on llvmpipe even when it runs zero times.
+#ifdef STAGE_SCATTERED_LIGHTS
+#define ADD_TO_SCATTERED 1
+#define DIRECTIONAL_LIGHTS STAGE_SCATTERED_LIGHTS
+#else
+#define ADD_TO_SCATTERED 0
+#define DIRECTIONAL_LIGHTS STAGE_RADIANCE_LIGHTS
+#endif
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform SingleScatterBlock {
@@ -25,7 +36,7 @@ layout(binding = SUBSCAN_TEXELS_ALBEDO_ROOTS) uniform samplerBuffer albedoRoots;
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
 layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inNormals;
 layout(binding = SUBSCAN_IMAGE_IN2, rgba16f) readonly uniform image2D inAlbedo;
-#if STAGE_ADD_TO_SCATTERED
+#if ADD_TO_SCATTERED
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) uniform image2D scatteredRadiance;  // in place
 #else
 layout(binding = SUBSCAN_IMAGE_IN3, rgba16f) readonly uniform image2D inRadiance;
@@ -39,10 +50,6 @@ const float kPi = 3.14159265358979;
 // The march looks for the entry up to where the light is down to e^-6 (0.25 %) of itself.
 const float kExtinctionDepths = 6.0;
 const int kRefinements = 8;  // bisections of the step that crossed the surface, at most
-
-const int kInside = 0;
-const int kOutside = 1;
-const int kOffScreen = 2;
 
 float refractedCosine(float cosine, float eta) {
     float sine2 = max(0.0, 1.0 - cosine * cosine) / (eta * eta);
@@ -78,21 +85,49 @@ float albedoRoot(float reflectance) {
     return mix(texelFetch(albedoRoots, lower).r, texelFetch(albedoRoots, lower + 1).r, fraction);
 }
 
-/// Whether view-space point `q` lies inside the surface the depth buffer shows at its pixel:
-/// below that pixel's tangent plane (exact for a plane, first order elsewhere) and not more
-/// than `thickness` behind it (further behind, the pixel shows another, nearer object).
-int classify(vec3 q, float thickness, out ivec2 pixel) {
+/// What the depth buffer says of a point: whether it lies inside the surface shown at its
+/// pixel (below that pixel's tangent plane: exact for a plane, first order elsewhere), outside
+/// it, hidden (more than a thickness behind it: that pixel shows another, nearer object) or off
+/// the image; and that pixel's surface point and normal.
+struct Probe {
+    int state;
+    ivec2 pixel;
+    vec3 surfacePoint;
+    vec3 normal;
+};
+
+const int kInside = 0;
+const int kOutside = 1;
+const int kHidden = 2;
+const int kOffScreen = 3;
+
+Probe probe(vec3 q, float thickness) {
+    Probe result;
+    result.surfacePoint = vec3(0.0);
+    result.normal = vec3(0.0);
     float depth;
-    if (!projectToPixel(q, pixel, depth)) {
-        return kOffScreen;
+    if (!projectToPixel(q, result.pixel, depth)) {
+        result.state = kOffScreen;
+        return result;
     }
-    float front = imageLoad(inSurfaceDepth, pixel).r;
-    if (isinf(front) || depth - front > thickness) {
-        return kOutside;
+    float front = imageLoad(inSurfaceDepth, result.pixel).r;
+    if (isinf(front)) {
+        result.state = kOutside;
+        return result;
     }
-    vec3 surfacePoint = viewPositionAt(vec2(pixel) + 0.5, front);
-    vec3 normal = imageLoad(inNormals, pixel).xyz;
-    return dot(normal, q - surfacePoint) < 0.0 ? kInside : kOutside;
+    result.surfacePoint = viewPositionAt(vec2(result.pixel) + 0.5, front);
+    result.normal = imageLoad(inNormals, result.pixel).xyz;
+    if (depth - front > thickness) {
+        result.state = kHidden;
+    } else {
+        result.state = dot(result.normal, q - result.surfacePoint) < 0.0 ? kInside : kOutside;
+    }
+    return result;
+}
+
+/// How far along `toLight` from `start` the tangent plane of `inside` is crossed.
+float planeCrossing(vec3 start, vec3 toLight, Probe inside) {
+    return dot(inside.normal, inside.surfacePoint - start) / dot(inside.normal, toLight);
 }
 
 vec2 windowPosition(vec3 viewPosition) {
@@ -101,16 +136,24 @@ vec2 windowPosition(vec3 viewPosition) {
     return vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
 }
 
-/// Marches from `start` (inside, `reach` below the surface along the view ray) towards the
-/// light along `toLight`, about a pixel a step, for at most `length`; refines the crossing by
-/// bisection until both ends share a pixel and then solves that pixel's tangent plane. Returns
-/// kInside when no entry lies within `length` (the light is extinct there), kOutside with the
-/// straight distance `t` and the entry's normal when found, kOffScreen when the march left the
-/// image or the depth range first.
-int findEntry(vec3 start, float reach, vec3 toLight, float length, float cosView, out float t,
-              out vec3 entryNormal) {
-    t = 0.0;
-    entryNormal = vec3(0.0);
+/// Where a light entered on its way to a sample: the straight distance, the surface's normal
+/// there, and whether it was found.
+struct Entry {
+    int state;  // kOutside: found; kInside: none within reach (extinct); kOffScreen: unknown
+    float distance;
+    vec3 normal;
+};
+
+/// Marches from `start` (inside, `reach` below the surface along the view ray, seen as
+/// `startProbe`) towards a directional light along `toLight`, about a pixel a step, for at most
+/// `length`; refines the crossing by bisection until both ends share a pixel, then solves that
+/// pixel's tangent plane. A point hidden behind a nearer object counts as outside ours.
+Entry marchToLight(vec3 start, Probe startProbe, float reach, vec3 toLight, float length,
+                   float thicknessScale) {
+    Entry entry;
+    entry.state = kInside;
+    entry.distance = 0.0;
+    entry.normal = vec3(0.0);
     if (toLight.z > 0.0) {
         // Stay behind the near plane, where points still project.
         length = min(length, 0.999 * (-start.z - frame.depthRange.x) / toLight.z);
@@ -118,52 +161,59 @@ int findEntry(vec3 start, float reach, vec3 toLight, float length, float cosView
     float screenLength = distance(windowPosition(start), windowPosition(start + length * toLight));
     int steps = clamp(int(ceil(screenLength)), 1, int(params.sampling.w));
     float step = length / float(steps);
-    float thicknessScale = 2.0 / max(cosView, 0.2);
     float inside = 0.0;
     float outside = -1.0;
-    ivec2 insidePixel;
-    classify(start, kInfinity, insidePixel);
+    Probe insideProbe = startProbe;
     for (int i = 1; i <= steps; ++i) {
         float along = float(i) * step;
-        ivec2 pixel;
-        int state = classify(start + along * toLight, thicknessScale * (reach + along), pixel);
-        if (state == kOffScreen) {
-            return kOffScreen;
+        Probe here = probe(start + along * toLight, thicknessScale * (reach + along));
+        if (here.state == kOffScreen) {
+            entry.state = kOffScreen;
+            return entry;
         }
-        if (state == kOutside) {
+        if (here.state != kInside) {
             outside = along;
             break;
         }
         inside = along;
-        insidePixel = pixel;
+        insideProbe = here;
     }
     if (outside < 0.0) {
-        return kInside;
+        return entry;
     }
     for (int i = 0; i < kRefinements; ++i) {
         ivec2 outsidePixel;
         float outsideDepth;
         projectToPixel(start + outside * toLight, outsidePixel, outsideDepth);
-        if (outsidePixel == insidePixel) {
+        if (outsidePixel == insideProbe.pixel) {
             break;
         }
         float middle = 0.5 * (inside + outside);
-        ivec2 pixel;
-        if (classify(start + middle * toLight, thicknessScale * (reach + middle), pixel) ==
-            kInside) {
+        Probe here = probe(start + middle * toLight, thicknessScale * (reach + middle));
+        if (here.state == kInside) {
             inside = middle;
-            insidePixel = pixel;
+            insideProbe = here;
         } else {
             outside = middle;
         }
     }
-    float front = imageLoad(inSurfaceDepth, insidePixel).r;
-    vec3 surfacePoint = viewPositionAt(vec2(insidePixel) + 0.5, front);
-    entryNormal = imageLoad(inNormals, insidePixel).xyz;
-    float approach = dot(entryNormal, toLight);
-    t = abs(approach) > 1e-6 ? dot(entryNormal, surfacePoint - start) / approach : inside;
-    t = clamp(t, inside, outside);
-    return kOutside;
+    float crossing = planeCrossing(start, toLight, insideProbe);
+    entry.state = kOutside;
+    entry.distance = isnan(crossing) ? inside : clamp(crossing, inside, outside);
+    entry.normal = insideProbe.normal;
+    return entry;
+}
+
+/// The flat slab of the local tangent plane (normal `normal`), where the depth buffer cannot
+/// tell where the light entered: the sample lies s cos θo′ below the plane, which lightThrough
+/// turns into the refracted path s cos θo′ / cos θi′.
+Entry localSlabEntry(float s, vec3 toLight, vec3 normal, float cosView) {
+    Entry entry;
+    entry.normal = normal;
+    float cosIn = dot(normal, toLight);
+    entry.state = cosIn > 0.0 ? kOutside : kInside;
+    entry.distance = cosIn > 0.0 ? s * refractedCosine(cosView, params.medium.x) / cosIn : 0.0;
+    return entry;
 }
 
 struct Medium {
@@ -171,38 +221,22 @@ struct Medium {
     vec3 sigmaT;  // per scene unit
 };
 
-/// The light of value `color` arriving from `toLight` that single scattering at `samplePoint` (`s`
-/// along the refracted view ray from the surface point with normal `normal`) sends towards the
-/// eye, per channel, before σs e^(−σt s) and the exit terms: p T_i (cos θi / cos θi′) E
-/// e^(−σt s_i′).
-vec3 lightAtSample(vec3 samplePoint, float s, vec3 toLight, vec3 color, vec3 normal, float cosView,
-                   vec3 eyeInside, Medium medium, float extinctionLength) {
+/// The light of value `color` from `toLight` that entered at `entry` and reaches the sample,
+/// per channel, before σs e^(−σt s) and the exit terms: p T_i (cos θi / cos θi′) E
+/// e^(−σt s_i′), s_i′ = s_i cos θi / cos θi′ (DESIGN.md §6.3).
+vec3 lightThrough(Entry entry, vec3 toLight, vec3 color, vec3 eyeInside, Medium medium) {
+    if (entry.state != kOutside) {
+        return vec3(0.0);
+    }
     float eta = params.medium.x;
-    float t;
-    vec3 entryNormal;
-    int found = findEntry(samplePoint, s, toLight, extinctionLength, cosView, t, entryNormal);
-    float cosIn;
-    float lightPath;
-    if (found == kInside) {
+    float approach = dot(entry.normal, toLight);
+    float cosIn = abs(approach);
+    if (!(cosIn > 0.0)) {
         return vec3(0.0);
     }
-    if (found == kOutside) {
-        cosIn = abs(dot(entryNormal, toLight));
-        entryNormal = dot(entryNormal, toLight) >= 0.0 ? entryNormal : -entryNormal;
-        lightPath = t * cosIn / refractedCosine(cosIn, eta);
-    } else {
-        // Fallback off screen: the flat slab of the local tangent plane.
-        cosIn = dot(normal, toLight);
-        if (cosIn <= 0.0) {
-            return vec3(0.0);
-        }
-        entryNormal = normal;
-        lightPath = s * refractedCosine(cosView, eta) / refractedCosine(cosIn, eta);
-    }
-    if (cosIn <= 0.0) {
-        return vec3(0.0);
-    }
+    vec3 entryNormal = approach >= 0.0 ? entry.normal : -entry.normal;
     float cosInInside = refractedCosine(cosIn, eta);
+    float lightPath = entry.distance * cosIn / cosInInside;
     vec3 lightInside = refractedDirection(toLight, entryNormal, eta);
     float phase = henyeyGreenstein(-dot(lightInside, eyeInside), params.medium.y);
     float weight = phase * fresnelTransmittance(cosIn, eta) * cosIn / cosInInside * kPi;
@@ -215,7 +249,7 @@ void main() {
         return;
     }
     float depth = imageLoad(inSurfaceDepth, pixel).r;
-#if STAGE_ADD_TO_SCATTERED
+#if ADD_TO_SCATTERED
     vec4 base = imageLoad(scatteredRadiance, pixel);
 #else
     vec4 base = imageLoad(inRadiance, pixel);
@@ -254,36 +288,53 @@ void main() {
     vec3 single = vec3(0.0);
     if (cosView > 0.0 && any(greaterThan(medium.sigmaS, vec3(0.0)))) {
         vec3 eyeInside = refractedDirection(toEye, normal, eta);
-        // How far the march looks: kExtinctionDepths of the least extinct channel, along a
-        // straight path whose refracted length is shortened by cos θi/cos θi′ (at most 1/0.05).
         float sigmaTMin = min(medium.sigmaT.r, min(medium.sigmaT.g, medium.sigmaT.b));
         int samples = int(params.sampling.x);
         ivec3 channelSamples = (ivec3(samples + 2) - ivec3(0, 1, 2)) / 3;
+        float thicknessScale = 2.0 / max(cosView, 0.2);
         for (int k = 0; k < samples; ++k) {
             int channel = k % 3;
             float xi = (float(k / 3) + 0.5) / float(channelSamples[channel]);
             float s = -log(1.0 - xi) / medium.sigmaT[channel];
             vec3 density = vec3(channelSamples) * medium.sigmaT * exp(-medium.sigmaT * s);
             vec3 samplePoint = surfacePoint - s * eyeInside;
-            ivec2 samplePixel;
-            if (classify(samplePoint, kInfinity, samplePixel) == kOutside) {
+            Probe sampleProbe = probe(samplePoint, thicknessScale * s);
+            if (sampleProbe.state == kOutside) {
                 continue;  // the refracted ray left the medium: nothing scatters there
             }
+            bool local = sampleProbe.state != kInside;
             vec3 light = vec3(0.0);
+            // The head light's path to the sample lies on the sample's own line of sight, so
+            // it entered through the surface of the sample's pixel: no march.
             vec3 toHead = normalize(-samplePoint);
-            float headCos = max(dot(normal, toHead), 0.05);
-            light += lightAtSample(samplePoint, s, toHead, lights.headLight.rgb, normal, cosView,
-                                   eyeInside, medium,
-                                   kExtinctionDepths * refractedCosine(headCos, eta) /
-                                       (sigmaTMin * headCos));
+            Entry headEntry;
+            if (local) {
+                headEntry = localSlabEntry(s, toHead, normal, cosView);
+            } else {
+                headEntry.normal = sampleProbe.normal;
+                headEntry.distance = planeCrossing(samplePoint, toHead, sampleProbe);
+                headEntry.state = headEntry.distance >= 0.0 ? kOutside : kInside;
+            }
+            light += lightThrough(headEntry, toHead, lights.headLight.rgb, eyeInside, medium);
+#if DIRECTIONAL_LIGHTS
             for (uint i = 0u; i < lights.lightCount.x; ++i) {
                 vec3 toLight = lights.lightDirection[i].xyz;
-                float lightCos = max(dot(normal, toLight), 0.05);
-                light += lightAtSample(samplePoint, s, toLight, lights.lightColor[i].rgb, normal,
-                                       cosView, eyeInside, medium,
-                                       kExtinctionDepths * refractedCosine(lightCos, eta) /
-                                           (sigmaTMin * lightCos));
+                Entry entry;
+                if (!local) {
+                    // kExtinctionDepths of the least extinct channel along a straight path
+                    // whose refracted length is shortened by cos θi/cos θi′ (at most 1/0.05).
+                    float cosIn = max(dot(normal, toLight), 0.05);
+                    float reach = kExtinctionDepths * refractedCosine(cosIn, eta) /
+                                  (sigmaTMin * cosIn);
+                    entry = marchToLight(samplePoint, sampleProbe, s, toLight, reach,
+                                         thicknessScale);
+                }
+                if (local || entry.state == kOffScreen) {
+                    entry = localSlabEntry(s, toLight, normal, cosView);
+                }
+                light += lightThrough(entry, toLight, lights.lightColor[i].rgb, eyeInside, medium);
             }
+#endif
             single += medium.sigmaS * light * exp(-medium.sigmaT * s) /
                       (density.r + density.g + density.b);
         }

@@ -19,12 +19,18 @@ glm::vec4 rgbVector(const Rgb& value) {
             static_cast<float>(value[2]), 0.0f};
 }
 
+enum Stage { HeadLight, Lights };
+
+std::vector<std::string> stageNames(SingleScatteringBase base) {
+    const std::string prefix = base == SingleScatteringBase::Radiance ? "RADIANCE" : "SCATTERED";
+    return {prefix + "_HEAD_LIGHT", prefix + "_LIGHTS"};
+}
+
 }  // namespace
 
 SingleScatteringPass::SingleScatteringPass(const ShaderSources& sources, SingleScatteringBase base)
     : base_(base),
-      stages_(sources, "render/SingleScattering.comp",
-              {base == SingleScatteringBase::Radiance ? "ADD_TO_RADIANCE" : "ADD_TO_SCATTERED"}) {}
+      stages_(sources, "render/SingleScattering.comp", stageNames(base)) {}
 
 std::vector<std::string_view> SingleScatteringPass::inputs() const {
     return {"surfaceDepth", "normals", "albedo",
@@ -71,7 +77,8 @@ void SingleScatteringPass::execute(FrameContext& frame) {
     Texture& sigmaA = resources.ensureTexture("sigmaA", TextureFormat::RGBA32F, width, height);
     params_.set(params);
     params_.bind(SUBSCAN_UBO_PASS);
-    lights_.set(ShadePass::parameters(frame.settings.shading, frame.camera));
+    const gpu::ShadeParams lights = ShadePass::parameters(frame.settings.shading, frame.camera);
+    lights_.set(lights);
     lights_.bind(SUBSCAN_UBO_LIGHTS);
     albedoRoots_.bindTexels(SUBSCAN_TEXELS_ALBEDO_ROOTS, TextureFormat::R32F);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
@@ -96,7 +103,7 @@ void SingleScatteringPass::execute(FrameContext& frame) {
             resources.texture("scatteredRadiance").clear();
         }
     }
-    stages_.runOverRegion(0, frame.region(0));
+    stages_.runOverRegion(lights.lightCount.x > 0 ? Lights : HeadLight, frame.region(0));
     glMemoryBarrier(kImageBarriers);
 }
 
