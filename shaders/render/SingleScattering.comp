@@ -144,10 +144,20 @@ struct Entry {
     vec3 normal;
 };
 
+/// Whether `q` lies inside, by its probe; where the probe's pixel shows a nearer object, by
+/// the tangent plane of the last pixel that showed ours (`last`): the surface is taken to go on
+/// as it was behind the other object, so that object casts nothing on ours.
+bool insideAlong(vec3 q, Probe here, Probe last) {
+    if (here.state == kHidden) {
+        return dot(last.normal, q - last.surfacePoint) < 0.0;
+    }
+    return here.state == kInside;
+}
+
 /// Marches from `start` (inside, `reach` below the surface along the view ray, seen as
 /// `startProbe`) towards a directional light along `toLight`, about a pixel a step, for at most
-/// `length`; refines the crossing by bisection until both ends share a pixel, then solves that
-/// pixel's tangent plane. A point hidden behind a nearer object counts as outside ours.
+/// `length`; refines the crossing by bisection until both ends share a pixel, then solves the
+/// tangent plane of the last pixel inside.
 Entry marchToLight(vec3 start, Probe startProbe, float reach, vec3 toLight, float length,
                    float thicknessScale) {
     Entry entry;
@@ -166,17 +176,18 @@ Entry marchToLight(vec3 start, Probe startProbe, float reach, vec3 toLight, floa
     Probe insideProbe = startProbe;
     for (int i = 1; i <= steps; ++i) {
         float along = float(i) * step;
-        Probe here = probe(start + along * toLight, thicknessScale * (reach + along));
+        vec3 q = start + along * toLight;
+        Probe here = probe(q, thicknessScale * (reach + along));
         if (here.state == kOffScreen) {
             entry.state = kOffScreen;
             return entry;
         }
-        if (here.state != kInside) {
+        if (!insideAlong(q, here, insideProbe)) {
             outside = along;
             break;
         }
         inside = along;
-        insideProbe = here;
+        insideProbe = here.state == kInside ? here : insideProbe;
     }
     if (outside < 0.0) {
         return entry;
@@ -189,10 +200,11 @@ Entry marchToLight(vec3 start, Probe startProbe, float reach, vec3 toLight, floa
             break;
         }
         float middle = 0.5 * (inside + outside);
-        Probe here = probe(start + middle * toLight, thicknessScale * (reach + middle));
-        if (here.state == kInside) {
+        vec3 q = start + middle * toLight;
+        Probe here = probe(q, thicknessScale * (reach + middle));
+        if (insideAlong(q, here, insideProbe)) {
             inside = middle;
-            insideProbe = here;
+            insideProbe = here.state == kInside ? here : insideProbe;
         } else {
             outside = middle;
         }
@@ -266,13 +278,14 @@ void main() {
     vec3 sigmaSPrime = params.sigmaSPrime.rgb;
     vec3 sigmaA = params.sigmaA.rgb;
     if (params.medium.w > 0.5) {
-        // DESIGN.md §6.4 with u = √(1 − α′): σt′ = σtr/(√3 u), σs′ = α′σt′, σa = σt′ − σs′.
+        // DESIGN.md §6.4 with u = √(1 − α′): σt′ = σtr/(√3 u), σs′ = α′σt′ and
+        // σa = σt′ − σs′ = σtr u/√3, written so that no difference of near-equal terms loses
+        // a bright colour's small σa.
         vec3 albedo = clamp(imageLoad(inAlbedo, pixel).rgb, 0.0, 1.0);
         vec3 root = vec3(albedoRoot(albedo.r), albedoRoot(albedo.g), albedoRoot(albedo.b));
         vec3 effectiveExtinction = 1.0 / params.meanFreePath.rgb;
-        vec3 reducedExtinction = effectiveExtinction / (sqrt(3.0) * root);
-        sigmaSPrime = (1.0 - root * root) * reducedExtinction;
-        sigmaA = reducedExtinction - sigmaSPrime;
+        sigmaSPrime = (1.0 - root * root) * effectiveExtinction / (sqrt(3.0) * root);
+        sigmaA = effectiveExtinction * root / sqrt(3.0);
     }
     imageStore(outSigmaSPrime, pixel, vec4(sigmaSPrime, 1.0));
     imageStore(outSigmaA, pixel, vec4(sigmaA, 1.0));
