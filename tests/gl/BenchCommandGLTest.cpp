@@ -1,4 +1,5 @@
 // `subscan bench` on llvmpipe: a smoke test of its JSON with few frames at a small size.
+#include <algorithm>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -52,6 +53,103 @@ TEST(BenchCommandGLTest, CountsTheFramesReconstructedAtHalfResolution) {
     EXPECT_EQ(report["resolution"], "half");
     EXPECT_EQ(report["modes"]["surface"]["reduced_resolution_frames"], 6);
     EXPECT_EQ(report["modes"]["points"]["reduced_resolution_frames"], 0);  // points: every pixel
+}
+
+// Each scattering method of the sss mode is its own run, beside the others in one bench; the
+// ratio of single scattering to the reconstruction is the one its own per-pass means give.
+TEST(BenchCommandGLTest, RunsEachScatteringMethodAsItsOwnMode) {
+    const auto result = runSubscan({"bench", "synthetic:sphere?points=4000", "--frames", "4",
+                                    "--warmup", "1", "--width", "64", "--height", "48", "--modes",
+                                    "surface,sss:gaussian,sss:single,sss:both", "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const nlohmann::json report = nlohmann::json::parse(result.out);
+    ASSERT_EQ(report["modes"].size(), 4u);
+    const char* reconstruction[] = {"RasterizePoints", "MinDepthPyramid", "HiddenPointRemoval",
+                                    "PullPush",        "FillRemoval",     "Normals"};
+    for (const char* mode : {"surface", "sss:gaussian", "sss:single", "sss:both"}) {
+        SCOPED_TRACE(mode);
+        const nlohmann::json& m = report["modes"][mode];
+        const nlohmann::json& means = m["per_pass_mean_ms"];
+        double sum = 0.0;
+        for (const char* pass : reconstruction) {
+            ASSERT_TRUE(means.contains(pass)) << pass;
+            EXPECT_TRUE(m["per_pass_ms"].contains(pass)) << pass;
+            sum += means[pass].get<double>();
+        }
+        // Every frame runs all six passes: the mean of their sums is the sum of their means.
+        const double reconstructionMs = m["reconstruction_ms"];
+        EXPECT_GT(reconstructionMs, 0.0);
+        EXPECT_NEAR(reconstructionMs, sum, 1e-9 * sum);
+    }
+    EXPECT_EQ(report["modes"]["sss:gaussian"]["scattering_method"], "gaussian");
+    EXPECT_TRUE(report["modes"]["sss:gaussian"]["per_pass_ms"].contains("SubsurfaceScattering"));
+    EXPECT_FALSE(report["modes"]["sss:gaussian"]["per_pass_ms"].contains("SingleScattering"));
+    EXPECT_FALSE(report["modes"]["sss:gaussian"].contains("single_scattering_ratio"));
+    EXPECT_FALSE(report["modes"]["surface"].contains("single_scattering_ratio"));
+    EXPECT_FALSE(report["modes"]["surface"].contains("scattering_method"));
+    // single adds single scattering to the unblurred light, both to the blurred one.
+    EXPECT_FALSE(report["modes"]["sss:single"]["per_pass_ms"].contains("SubsurfaceScattering"));
+    EXPECT_TRUE(report["modes"]["sss:both"]["per_pass_ms"].contains("SubsurfaceScattering"));
+    for (const char* mode : {"sss:single", "sss:both"}) {
+        SCOPED_TRACE(mode);
+        const nlohmann::json& m = report["modes"][mode];
+        EXPECT_EQ(m["scattering_method"], std::string(mode).substr(4));
+        EXPECT_GT(m["per_pass_ms"]["SingleScattering"].get<double>(), 0.0);
+        const double single = m["per_pass_mean_ms"]["SingleScattering"];
+        EXPECT_GT(single, 0.0);
+        const double ratio = m["single_scattering_ratio"];
+        const double expected = single / m["reconstruction_ms"].get<double>();
+        EXPECT_NEAR(ratio, expected, 1e-9 * expected);
+    }
+}
+
+// Plain sss keeps the settings' method, here from --scattering; the scattering options reach
+// every run.
+TEST(BenchCommandGLTest, PlainSssTakesTheScatteringOptions) {
+    const auto result = runSubscan({"bench", "synthetic:sphere?points=4000", "--frames", "2",
+                                    "--warmup", "0", "--width", "32", "--height", "24", "--modes",
+                                    "sss,sss:gaussian", "--scattering", "single", "--coefficients",
+                                    "material", "--material", "marble", "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const nlohmann::json report = nlohmann::json::parse(result.out);
+    EXPECT_EQ(report["modes"]["sss"]["scattering_method"], "single");
+    EXPECT_TRUE(report["modes"]["sss"].contains("single_scattering_ratio"));
+    EXPECT_EQ(report["modes"]["sss:gaussian"]["scattering_method"], "gaussian");
+
+    const auto unknown = runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--material",
+                                     "no-such-material", "--modes", "sss"});
+    EXPECT_EQ(unknown.exitCode, 1);
+    EXPECT_THAT(unknown.err, ::testing::HasSubstr("no-such-material"));
+}
+
+TEST(BenchCommandGLTest, TextTableNamesTheScatteringRuns) {
+    const auto result =
+        runSubscan({"bench", "synthetic:sphere?points=2000", "--frames", "2", "--warmup", "0",
+                    "--width", "32", "--height", "24", "--modes", "points,sss:single"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.out, ::testing::HasSubstr("single/recon"));
+    EXPECT_THAT(result.out, ::testing::HasSubstr("sss:single"));
+}
+
+TEST(BenchCommandGLTest, BadScatteringSuffixIsOneSentence) {
+    const auto unknown =
+        runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface,sss:fast"});
+    EXPECT_EQ(unknown.exitCode, 1);
+    EXPECT_THAT(unknown.err, ::testing::HasSubstr("'sss:fast' names the unknown scattering "
+                                                  "method 'fast' (expected sss:gaussian, "
+                                                  "sss:single or sss:both)"));
+    EXPECT_EQ(std::count(unknown.err.begin(), unknown.err.end(), '\n'), 1) << unknown.err;
+
+    const auto notSss =
+        runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface:single"});
+    EXPECT_EQ(notSss.exitCode, 1);
+    EXPECT_THAT(notSss.err, ::testing::HasSubstr("'surface:single': only the sss mode takes a "
+                                                 "scattering method after ':'"));
+
+    const auto twice = runSubscan(
+        {"bench", "synthetic:sphere", "--frames", "2", "--modes", "sss:single,sss:single"});
+    EXPECT_EQ(twice.exitCode, 1);
+    EXPECT_THAT(twice.err, ::testing::HasSubstr("--modes names 'sss:single' twice"));
 }
 
 TEST(BenchCommandGLTest, UnknownModeIsOneSentence) {

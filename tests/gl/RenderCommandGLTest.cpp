@@ -1,6 +1,7 @@
 // `subscan render` end to end: the exported buffers can be reproduced from the scan and
 // camera.json alone, far-from-origin clouds render without quantisation, and bad requests fail
 // with one sentence and no output file.
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -245,6 +246,32 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
          {},
          1,
          "there is no material 'jade'"},
+        {{"render", scan.string(), "-o", out.string(), "--mode", "sss", "--scattering", "single",
+          "--coefficients", "material", "--material", "marble-jimenez"},
+         {},
+         1,
+         "the material 'marble-jimenez' is a Gaussian set without measured σs′ and σa"},
+        {{"render", scan.string(), "-o", out.string(), "--mean-free-path", "1,2"},
+         {},
+         1,
+         "--mean-free-path '1,2' is not R,G,B"},
+        {{"render", scan.string(), "-o", out.string(), "--mean-free-path", "1,0,2"},
+         {},
+         1,
+         "'mean_free_path_mm' must be positive millimetres in every channel, not 0"},
+        {{"render", scan.string(), "-o", out.string(), "--phase-g", "-1"},
+         {},
+         1,
+         "'phase_g' = -1 must lie strictly between -1 and 1"},
+        {{"render", scan.string(), "-o", out.string(), "--eta", "0.8"},
+         {},
+         1,
+         "'eta' = 0.8 is outside 1..3"},
+        {{"render", scan.string(), "-o", out.string(), "--single-samples", "65"},
+         {},
+         1,
+         "'single_samples' = 65 is outside 1..64"},
+        {{"render", scan.string(), "-o", out.string(), "--scattering", "multiple"}, {}, 2, ""},
         // glvnd finds no EGL vendor: what a machine without any OpenGL driver looks like.
         {{"render", scan.string(), "-o", out.string()},
          {"__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl.json",
@@ -264,6 +291,62 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
     }
     // The refused overwrite left the input intact.
     EXPECT_EQ(fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+}
+
+/// The RGB of pixel i of a 3-channel PFM.
+std::array<float, 3> rgbAt(const ImageF& image, std::size_t i) {
+    return {image.values[3 * i], image.values[3 * i + 1], image.values[3 * i + 2]};
+}
+
+TEST(RenderCommandGLTest, SingleScatteringExportsItsTermAndCoefficients) {
+    const test::TempDir dir;
+    const std::string scan = "synthetic:sphere?points=20000";
+    const std::vector<std::string> view{"--width", "48", "--height", "40", "--unit", "cm"};
+    auto render = [&](const std::string& name, std::vector<std::string> extra) {
+        std::vector<std::string> arguments{"render",
+                                           scan,
+                                           "-o",
+                                           (dir / (name + ".png")).string(),
+                                           "--export-buffers",
+                                           (dir / name).string()};
+        arguments.insert(arguments.end(), view.begin(), view.end());
+        arguments.insert(arguments.end(), extra.begin(), extra.end());
+        const auto result = runSubscan(arguments);
+        EXPECT_EQ(result.exitCode, 0) << result.err;
+    };
+    render("surface", {"--mode", "surface"});
+    render("single", {"--mode", "sss", "--scattering", "single", "--coefficients", "material",
+                      "--material", "skin2"});
+    render("gaussian", {"--mode", "sss"});
+    for (const char* file : {"single.pfm", "sigma_s.pfm", "sigma_a.pfm"}) {
+        EXPECT_TRUE(std::filesystem::exists(dir / "single" / file)) << file;
+        EXPECT_FALSE(std::filesystem::exists(dir / "gaussian" / file)) << file;
+    }
+    const ImageF surface = readPfm(dir / "surface" / "radiance.pfm");
+    const ImageF radiance = readPfm(dir / "single" / "radiance.pfm");
+    const ImageF single = readPfm(dir / "single" / "single.pfm");
+    const ImageF sigmaS = readPfm(dir / "single" / "sigma_s.pfm");
+    const ImageF sigmaA = readPfm(dir / "single" / "sigma_a.pfm");
+    const ImageF depth = readPfm(dir / "single" / "depth.pfm");
+    ASSERT_EQ(single.values.size(), radiance.values.size());
+    // skin2 (Jensen et al. 2001), mm⁻¹.
+    const std::array<float, 3> skinSigmaS{1.09f, 1.59f, 1.79f}, skinSigmaA{0.013f, 0.070f, 0.145f};
+    int covered = 0;
+    for (std::size_t i = 0; i < depth.values.size(); ++i) {
+        const bool surfacePixel = !std::isinf(depth.values[i]);
+        covered += surfacePixel ? 1 : 0;
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(rgbAt(sigmaS, i)[c], surfacePixel ? skinSigmaS[c] : 0.0f) << i;
+            EXPECT_EQ(rgbAt(sigmaA, i)[c], surfacePixel ? skinSigmaA[c] : 0.0f) << i;
+            // radiance.pfm is the surface mode's radiance plus single scattering: the same
+            // reconstruction and shading, so they differ by the half-float roundings of two
+            // images (2^-11 of each).
+            const float expected = rgbAt(surface, i)[c] + rgbAt(single, i)[c];
+            EXPECT_NEAR(rgbAt(radiance, i)[c], expected, 2e-3f * expected + 1e-6f) << i;
+            EXPECT_EQ(rgbAt(single, i)[c] > 0.0f, surfacePixel) << i << " channel " << c;
+        }
+    }
+    EXPECT_GT(covered, 300);  // the sphere fills about half of 48x40
 }
 
 }  // namespace

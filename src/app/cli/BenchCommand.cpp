@@ -5,8 +5,11 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -31,6 +34,7 @@ struct BenchOptions {
     int width = 1920;
     int height = 1080;
     std::string modes = "points-gl,points,surface,sss";
+    ScatteringOptions scattering;
     std::string settingsFile;
     std::string resolution;
     std::string up = "auto";
@@ -38,17 +42,66 @@ struct BenchOptions {
     bool software = false;
 };
 
-std::vector<RenderMode> parseModes(const std::string& list) {
-    std::vector<RenderMode> modes;
+/// One entry of --modes: a render mode, and for `sss:METHOD` the scattering method that
+/// replaces the settings' one. Its name (as given) names the run in the output.
+struct BenchMode {
+    std::string name;
+    RenderMode mode = RenderMode::Points;
+    std::optional<ScatteringMethod> method;
+};
+
+/// The passes that turn the points into a surface (DESIGN.md §5), whose sum is a run's
+/// `reconstruction_ms`: the yardstick that the scattering passes are measured against.
+constexpr std::string_view kReconstructionPasses[] = {"RasterizePoints",    "MinDepthPyramid",
+                                                      "HiddenPointRemoval", "PullPush",
+                                                      "FillRemoval",        "Normals"};
+constexpr std::string_view kSingleScatteringPass = "SingleScattering";
+
+std::vector<BenchMode> parseModes(const std::string& list) {
+    std::vector<BenchMode> modes;
+    std::set<std::string> names;
     std::stringstream stream(list);
     std::string name;
     while (std::getline(stream, name, ',')) {
-        modes.push_back(parseRenderMode(name));
+        BenchMode entry{name};
+        const std::size_t colon = name.find(':');
+        entry.mode = parseRenderMode(name.substr(0, colon));
+        if (colon != std::string::npos) {
+            const std::string suffix = name.substr(colon + 1);
+            if (entry.mode != RenderMode::Sss) {
+                throw Error(fmt::format(
+                    "--modes entry '{}': only the sss mode takes a scattering method after ':' "
+                    "(sss:gaussian, sss:single or sss:both)",
+                    name));
+            }
+            bool known = false;
+            for (const ScatteringMethod method :
+                 {ScatteringMethod::Gaussian, ScatteringMethod::Single, ScatteringMethod::Both}) {
+                if (toString(method) == suffix) {
+                    entry.method = method;
+                    known = true;
+                }
+            }
+            if (!known) {
+                throw Error(fmt::format(
+                    "--modes entry '{}' names the unknown scattering method '{}' (expected "
+                    "sss:gaussian, sss:single or sss:both)",
+                    name, suffix));
+            }
+        }
+        if (!names.insert(name).second) {
+            throw Error(fmt::format("--modes names '{}' twice", name));
+        }
+        modes.push_back(std::move(entry));
     }
     if (modes.empty()) {
         throw Error("--modes names no render mode");
     }
     return modes;
+}
+
+double mean(const std::vector<double>& values) {
+    return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
 }
 
 double median(std::vector<double> values) {
@@ -57,14 +110,17 @@ double median(std::vector<double> values) {
     return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-/// One mode along the camera path: a renderer of its own, so that the memory it reports is
-/// this mode's alone, and its frame and pass times.
+/// One mode along the camera path: a renderer and settings of its own, so that the memory it
+/// reports is this mode's alone, and its frame and pass times.
 struct ModeRun {
     ModeRun(GlContext& context, const PointCloud& cloud, RenderSettings modeSettings,
-            RenderMode mode)
+            const BenchMode& mode)
         : settings(std::move(modeSettings)), renderer(context, cloud) {
-        settings.raster.mode = mode;
+        settings.raster.mode = mode.mode;
         settings.raster.stage = Stage::Final;
+        if (mode.method) {
+            settings.scattering.method = *mode.method;
+        }
     }
 
     /// Renders one frame and waits for it: a frame is done when its image is, with no overlap
@@ -79,6 +135,7 @@ struct ModeRun {
     Renderer renderer;
     std::vector<double> frameMs;
     std::map<std::string, std::vector<double>> passMs;
+    std::vector<double> reconstructionMs;  // per frame, the sum of kReconstructionPasses
     int reducedFrames = 0;
 };
 
@@ -94,19 +151,34 @@ nlohmann::json summary(const ModeRun& run, std::size_t points) {
         static_cast<double>(lowCount);
     const double averageFps = 1000.0 * static_cast<double>(frameMs.size()) / totalMs;
     nlohmann::json perPass = nlohmann::json::object();
+    nlohmann::json perPassMean = nlohmann::json::object();
     for (const auto& [pass, values] : run.passMs) {
         perPass[pass] = median(values);
+        perPassMean[pass] = mean(values);
     }
     const std::size_t bytes = run.renderer.gpuCloud().bytes() + run.renderer.resourceBytes();
-    return {
+    nlohmann::json result = {
         {"avg_fps", averageFps},
         {"low1_fps", 1000.0 / lowMs},
         {"frame_ms_median", median(frameMs)},
         {"per_pass_ms", perPass},
+        {"per_pass_mean_ms", perPassMean},
         {"points_per_second", averageFps * static_cast<double>(points)},
         {"gpu_memory_mb", static_cast<double>(bytes) / (1024.0 * 1024.0)},
         {"reduced_resolution_frames", run.reducedFrames},
     };
+    if (run.settings.raster.mode == RenderMode::Sss) {
+        result["scattering_method"] = toString(run.settings.scattering.method);
+    }
+    if (reconstructsSurface(run.settings.raster.mode)) {
+        const double reconstruction = mean(run.reconstructionMs);
+        result["reconstruction_ms"] = reconstruction;
+        if (const auto single = run.passMs.find(std::string(kSingleScatteringPass));
+            single != run.passMs.end()) {
+            result["single_scattering_ratio"] = mean(single->second) / reconstruction;
+        }
+    }
+    return result;
 }
 
 /// Every mode along the same camera path, frame by frame in turn (frame 0 of each mode, then
@@ -114,7 +186,7 @@ nlohmann::json summary(const ModeRun& run, std::size_t points) {
 /// warming up) then slows every mode alike instead of whichever ran last.
 std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& scan,
                                        const RenderSettings& settings,
-                                       const std::vector<RenderMode>& modes,
+                                       const std::vector<BenchMode>& modes,
                                        const BenchOptions& options, UpAxis up) {
     auto cameraAt = [&](int frame) {
         const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
@@ -122,7 +194,7 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
                              45.0);
     };
     std::vector<std::unique_ptr<ModeRun>> runs;
-    for (const RenderMode mode : modes) {
+    for (const BenchMode& mode : modes) {
         runs.push_back(std::make_unique<ModeRun>(context, scan.cloud, settings, mode));
         for (int frame = 0; frame < options.warmup; ++frame) {
             runs.back()->render(cameraAt(frame * options.frames / std::max(options.warmup, 1)));
@@ -136,9 +208,15 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
             run->frameMs.push_back(
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                     .count());
+            double reconstruction = 0.0;
             for (const PassTiming& pass : result.passes) {
                 run->passMs[pass.pass].push_back(pass.milliseconds);
+                if (std::find(std::begin(kReconstructionPasses), std::end(kReconstructionPasses),
+                              pass.pass) != std::end(kReconstructionPasses)) {
+                    reconstruction += pass.milliseconds;
+                }
             }
+            run->reconstructionMs.push_back(reconstruction);
             run->reducedFrames += result.divisor == 1 ? 0 : 1;
         }
     }
@@ -150,11 +228,12 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
 }
 
 int runBench(const BenchOptions& options) {
-    const std::vector<RenderMode> modes = parseModes(options.modes);
+    const std::vector<BenchMode> modes = parseModes(options.modes);
     RenderSettings settings;
     if (!options.settingsFile.empty()) {
         settings = readSettingsFile(options.settingsFile);
     }
+    options.scattering.apply(settings.scattering);
     if (!options.resolution.empty()) {
         settings.raster.resolution = parseResolution(options.resolution);
     }
@@ -181,7 +260,7 @@ int runBench(const BenchOptions& options) {
     const std::vector<nlohmann::json> summaries =
         benchModes(*context, scan, settings, modes, options, up);
     for (std::size_t i = 0; i < modes.size(); ++i) {
-        report["modes"][toString(modes[i])] = summaries[i];
+        report["modes"][modes[i].name] = summaries[i];
     }
     if (options.json) {
         fmt::print("{}\n", report.dump(2));
@@ -189,14 +268,19 @@ int runBench(const BenchOptions& options) {
     }
     fmt::print("{} | {} points | {}x{} | {} frames\n", report["renderer"].get<std::string>(),
                scan.cloud.size(), options.width, options.height, options.frames);
-    fmt::print("{:<10} {:>9} {:>9} {:>11} {:>14} {:>8} {:>8}\n", "mode", "avg fps", "1% low",
-               "median ms", "points/s", "GPU MB", "reduced");
-    for (const RenderMode mode : modes) {
-        const nlohmann::json& m = report["modes"][toString(mode)];
-        fmt::print("{:<10} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f} {:>8}\n", toString(mode),
-                   m["avg_fps"].get<double>(), m["low1_fps"].get<double>(),
+    fmt::print("{:<12} {:>9} {:>9} {:>11} {:>14} {:>8} {:>8} {:>10} {:>13}\n", "mode", "avg fps",
+               "1% low", "median ms", "points/s", "GPU MB", "reduced", "recon ms", "single/recon");
+    for (const BenchMode& mode : modes) {
+        const nlohmann::json& m = report["modes"][mode.name];
+        const auto optional = [&m](const char* key, int decimals) {
+            return m.contains(key) ? fmt::format("{:.{}f}", m[key].get<double>(), decimals)
+                                   : std::string("-");
+        };
+        fmt::print("{:<12} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f} {:>8} {:>10} {:>13}\n",
+                   mode.name, m["avg_fps"].get<double>(), m["low1_fps"].get<double>(),
                    m["frame_ms_median"].get<double>(), m["points_per_second"].get<double>(),
-                   m["gpu_memory_mb"].get<double>(), m["reduced_resolution_frames"].get<int>());
+                   m["gpu_memory_mb"].get<double>(), m["reduced_resolution_frames"].get<int>(),
+                   optional("reconstruction_ms", 2), optional("single_scattering_ratio", 3));
     }
     return 0;
 }
@@ -217,12 +301,15 @@ Command addBenchCommand(CLI::App& parent) {
     bench->add_option("--height", options->height, "Image height (default 1080)")
         ->check(CLI::Range(1, 65536));
     bench->add_option("--modes", options->modes,
-                      "Comma-separated modes (default points-gl,points,surface,sss)");
+                      "Comma-separated modes (default points-gl,points,surface,sss); "
+                      "sss:gaussian, sss:single and sss:both run the sss mode with that "
+                      "scattering method (plain sss: the settings' method), each its own run");
     addResolutionOption(*bench, options->resolution);
     bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
         ->check(CLI::ExistingFile);
     bench->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));
+    options->scattering.add(*bench);
     bench->add_flag("--json", options->json, "Print the results as JSON");
     bench->add_flag("--software", options->software,
                     "Use Mesa's software rasterizer even when a GPU exists");

@@ -129,3 +129,121 @@ TEST(RenderSettingsTest, DisplayColorsUseColourThenIntensityThenGrey) {
 
 }  // namespace
 }  // namespace subscan
+
+namespace subscan {
+namespace {
+
+/// The message of the subscan::Error that reading `json` as a settings file throws.
+std::string settingsError(const std::string& json) {
+    const test::TempDir dir;
+    const auto file = dir.write("settings.json", json);
+    try {
+        readSettingsFile(file);
+    } catch (const Error& error) {
+        const std::string message = error.what();
+        EXPECT_THAT(message, ::testing::HasSubstr(file.string())) << "the file is named";
+        return message;
+    }
+    ADD_FAILURE() << "accepted " << json;
+    return {};
+}
+
+TEST(RenderSettingsTest, SingleScatteringSettingsRoundTrip) {
+    RenderSettings settings;
+    ScatteringSettings& scattering = settings.scattering;
+    scattering.method = ScatteringMethod::Both;
+    scattering.coefficients = CoefficientSource::Material;
+    scattering.material = "skin1";
+    scattering.meanFreePathMm = {1.0f, 2.0f, 3.0f};
+    scattering.eta = 1.45f;
+    scattering.phaseG = -0.25f;
+    scattering.singleSamples = 12;
+    const ScatteringSettings back = nlohmann::json(settings).get<RenderSettings>().scattering;
+    EXPECT_EQ(back.method, ScatteringMethod::Both);
+    EXPECT_EQ(back.coefficients, CoefficientSource::Material);
+    EXPECT_EQ(back.meanFreePathMm, glm::vec3(1.0f, 2.0f, 3.0f));
+    ASSERT_TRUE(back.eta.has_value());
+    EXPECT_EQ(*back.eta, 1.45f);
+    EXPECT_EQ(back.phaseG, -0.25f);
+    EXPECT_EQ(back.singleSamples, 12);
+    // Unset η is written as null and read back unset: the material's η.
+    scattering.eta.reset();
+    EXPECT_FALSE(nlohmann::json(settings).get<RenderSettings>().scattering.eta.has_value());
+}
+
+TEST(RenderSettingsTest, EtaIsTheMaterialsUnlessSet) {
+    ScatteringSettings settings;
+    settings.material = "marble";
+    EXPECT_DOUBLE_EQ(scatteringEta(settings), 1.5);
+    settings.material = "skin1";
+    EXPECT_DOUBLE_EQ(scatteringEta(settings), 1.3);
+    settings.eta = 1.7f;
+    EXPECT_DOUBLE_EQ(scatteringEta(settings), 1.7f);
+}
+
+TEST(RenderSettingsTest, DefaultsKeepTheGaussianPathAndColourCoefficients) {
+    const ScatteringSettings settings;
+    EXPECT_EQ(settings.method, ScatteringMethod::Gaussian);
+    EXPECT_EQ(settings.coefficients, CoefficientSource::Color);
+    EXPECT_EQ(settings.phaseG, 0.0f);
+    EXPECT_FALSE(settings.eta.has_value());
+}
+
+TEST(RenderSettingsTest, AnUnknownKeyInAnySectionIsNamed) {
+    EXPECT_THAT(settingsError(R"({"scattering": {"metod": "single"}})"),
+                ::testing::HasSubstr("unknown setting 'metod' in 'scattering'"));
+    EXPECT_THAT(settingsError(R"({"raster": {"mdoe": "sss"}})"),
+                ::testing::HasSubstr("unknown setting 'mdoe' in 'raster'"));
+    EXPECT_THAT(settingsError(R"({"surface": {"fill_radiu": 2}})"),
+                ::testing::HasSubstr("unknown setting 'fill_radiu' in 'surface'"));
+    EXPECT_THAT(settingsError(R"({"shading": {"lite": []}})"),
+                ::testing::HasSubstr("unknown setting 'lite' in 'shading'"));
+    EXPECT_THAT(
+        settingsError(R"({"shading": {"lights": [{"direction": [0, 1, 0], "color": [1, 1, 1]}]}})"),
+        ::testing::HasSubstr("unknown setting 'color' in 'lights'"));
+    EXPECT_THAT(settingsError(R"({"scattering": []})"),
+                ::testing::HasSubstr("the settings section 'scattering' must be a JSON object"));
+}
+
+TEST(RenderSettingsTest, ImpossibleScatteringValuesAreNamed) {
+    EXPECT_THAT(settingsError(R"({"scattering": {"method": "double"}})"),
+                ::testing::HasSubstr("'double' is not a scattering method (expected one of: "
+                                     "gaussian, single, both)"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"coefficients": "scan"}})"),
+                ::testing::HasSubstr("'scan' is not a coefficient source (expected one of: "
+                                     "material, color)"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"mean_free_path_mm": [1, 0, 1]}})"),
+                ::testing::HasSubstr("'mean_free_path_mm' must be positive millimetres in "
+                                     "every channel, not 0"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"mean_free_path_mm": [1, -2, 1]}})"),
+                ::testing::HasSubstr("not -2"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"mean_free_path_mm": 3}})"),
+                ::testing::HasSubstr("'mean_free_path_mm' must be 3 numbers"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"eta": 0.9}})"),
+                ::testing::HasSubstr("'eta' = 0.9 is outside 1..3"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"eta": "glass"}})"),
+                ::testing::HasSubstr("'eta' must be a number or null"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"phase_g": 1}})"),
+                ::testing::HasSubstr("'phase_g' = 1 must lie strictly between -1 and 1"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"phase_g": -1.5}})"),
+                ::testing::HasSubstr("'phase_g' = -1.5 must lie strictly between -1 and 1"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"single_samples": 0}})"),
+                ::testing::HasSubstr("'single_samples' = 0 is outside 1..64"));
+    EXPECT_THAT(settingsError(R"({"scattering": {"scale": 0}})"),
+                ::testing::HasSubstr("'scale' = 0 is outside 0..1000 (exclusive of 0)"));
+    // Single scattering from a Gaussian-only material's coefficients: there are none.
+    EXPECT_THAT(settingsError(R"({"scattering": {"method": "single", "coefficients": "material",
+                                                 "material": "skin-deon"}})"),
+                ::testing::HasSubstr("the material 'skin-deon' is a Gaussian set without "
+                                     "measured σs′ and σa"));
+    // ... which is fine while only the Gaussian blur runs.
+    const test::TempDir dir;
+    const auto gaussian =
+        dir.write("gaussian.json",
+                  R"({"scattering": {"coefficients": "material", "material": "skin-deon"}})");
+    EXPECT_NO_THROW(readSettingsFile(gaussian));
+    EXPECT_EQ(readSettingsFile(gaussian).scattering.coefficients, CoefficientSource::Material);
+}
+
+}  // namespace
+}  // namespace subscan
