@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,8 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
 #include "io/Image.h"
@@ -259,6 +262,101 @@ TEST_F(ViewerTest, ResizingTheWindowReallocatesThePipeline) {
     for (const Image8* image : {&small, &larger, &narrow}) {
         EXPECT_GT(foregroundFraction(*image), 0.08);
     }
+}
+
+nlohmann::json readJsonFile(const std::filesystem::path& file) {
+    std::ifstream stream(file);
+    EXPECT_TRUE(stream) << file;
+    return nlohmann::json::parse(stream, nullptr, false);
+}
+
+/// The direction of the first directional light in a screenshot's settings file.
+glm::dvec3 firstLightDirection(const std::filesystem::path& settings) {
+    const nlohmann::json json = readJsonFile(settings);
+    const nlohmann::json& direction = json.at("shading").at("lights").at(0).at("direction");
+    return {direction.at(0).get<double>(), direction.at(1).get<double>(),
+            direction.at(2).get<double>()};
+}
+
+TEST_F(ViewerTest, SingleScatteringRendersAndLDragsTurnTheLightNotTheView) {
+    // The sculpture is 29 cm tall in metres (the default unit): marble's mean free paths of
+    // 4-9 mm show.
+    const auto script = writeScript(nlohmann::json::array({
+        {{"frame", 0}, {"action", "screenshot"}, {"path", path("single.png")}},
+        // Pressing L adds a light from the upper left of the view.
+        {{"frame", 1}, {"action", "light"}},
+        {{"frame", 1}, {"action", "screenshot"}, {"path", path("lit.png")}},
+        // An L drag of a quarter turn to the right.
+        {{"frame", 2}, {"action", "light"}, {"dx", 300}, {"dy", 0}},
+        {{"frame", 2}, {"action", "screenshot"}, {"path", path("turned.png")}},
+        {{"frame", 3},
+         {"action", "settings"},
+         {"settings", {{"scattering", {{"coefficients", "material"}, {"material", "skin1"}}}}}},
+        {{"frame", 3}, {"action", "screenshot"}, {"path", path("skin1.png")}},
+        {{"frame", 4}, {"action", "exit"}},
+    }));
+    const CommandResult result =
+        view({kScan, "--mode", "sss", "--scattering", "single", "--width", "320", "--height", "240",
+              "--hide-panel", "--script", script.string(), "--exit-after-frames", kFrameLimit});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("added light 1"));
+
+    const Image8 single = readPng(path("single.png"));
+    const Image8 lit = readPng(path("lit.png"));
+    const Image8 turned = readPng(path("turned.png"));
+    const Image8 skin1 = readPng(path("skin1.png"));
+    for (const Image8* image : {&single, &lit, &turned, &skin1}) {
+        EXPECT_GT(foregroundFraction(*image), 0.08);
+    }
+    // The added light and its turn change the lit surface; so do other coefficients.
+    EXPECT_GT(differingFraction(single, lit, 8), 0.02);
+    EXPECT_GT(differingFraction(lit, turned, 8), 0.02);
+    EXPECT_GT(differingFraction(turned, skin1, 8), 0.01);
+
+    // The view stayed where it was; the light turned by a quarter.
+    EXPECT_EQ(readJsonFile(path("lit.camera.json")), readJsonFile(path("turned.camera.json")));
+    EXPECT_EQ(readJsonFile(path("single.camera.json")), readJsonFile(path("turned.camera.json")));
+    const glm::dvec3 added = firstLightDirection(path("lit.settings.json"));
+    const glm::dvec3 moved = firstLightDirection(path("turned.settings.json"));
+    EXPECT_NEAR(glm::length(added), 1.0, 1e-6);
+    EXPECT_NEAR(glm::length(moved), 1.0, 1e-6);
+    // From the upper left (-1, 1, 1 in the view's right, up, towards-the-eye) a quarter turn
+    // around the view's up axis goes to the upper right (1, 1, 1): the move is along the view's
+    // right, which is level for this orbit around the y axis.
+    EXPECT_NEAR(glm::dot(added, moved), 1.0 / 3.0, 1e-4);
+    EXPECT_NEAR(moved.y - added.y, 0.0, 1e-4);
+
+    // The screenshot's files give `subscan render` the same picture.
+    const CommandResult render =
+        runSubscan({"render", kScan, "-o", path("rendered.png"), "--camera",
+                    path("turned.camera.json"), "--settings", path("turned.settings.json")});
+    ASSERT_EQ(render.exitCode, 0) << render.err;
+    EXPECT_LT(differingFraction(turned, readPng(path("rendered.png")), 8), 0.005);
+}
+
+TEST_F(ViewerTest, SingleScatteringFromAGaussianOnlyMaterialEndsARunWithTheSentence) {
+    // Interactively the panel shows the sentence and keeps the last good scattering settings
+    // (ViewerPanelTest); a scripted run ends with it, as every error the panel shows.
+    const auto script = writeScript(nlohmann::json::array({
+        {{"frame", 0}, {"action", "screenshot"}, {"path", path("before.png")}},
+        {{"frame", 1},
+         {"action", "settings"},
+         {"settings", {{"scattering", {{"coefficients", "material"}, {"material", "skin-deon"}}}}}},
+        {{"frame", 1}, {"action", "screenshot"}, {"path", path("after.png")}},
+    }));
+    const CommandResult result =
+        view({kScan, "--mode", "sss", "--scattering", "single", "--width", "320", "--height", "240",
+              "--hide-panel", "--script", script.string(), "--exit-after-frames", kFrameLimit});
+    EXPECT_EQ(result.exitCode, 1);
+    // One sentence, once, and last (after the screenshot's notice); no crash, no repetition.
+    const std::string sentence =
+        "subscan: the material 'skin-deon' is a Gaussian set without measured";
+    EXPECT_THAT(result.err, HasSubstr(sentence));
+    EXPECT_EQ(result.err.find(sentence), result.err.rfind(sentence)) << result.err;
+    EXPECT_EQ(result.err.find('\n', result.err.find(sentence)), result.err.size() - 1)
+        << result.err;
+    EXPECT_GT(foregroundFraction(readPng(path("before.png"))), 0.08);
+    EXPECT_FALSE(std::filesystem::exists(path("after.png")));
 }
 
 TEST_F(ViewerTest, MissingScanFailsWithOneSentence) {

@@ -79,6 +79,7 @@ Viewer::Viewer(ViewerOptions options)
       context_(windowOptions(options_)),
       imgui_(context_.window()),
       settings_(options_.settings),
+      scattering_(options_.settings.scattering),
       showPanel_(options_.showPanel) {
     const GlCapabilities& capabilities = context_.capabilities();
     status_.glRenderer = fmt::format("OpenGL {} | {}", capabilities.version, capabilities.renderer);
@@ -187,8 +188,10 @@ void Viewer::onMouseButton(GLFWwindow* window, int button, int action, int mods)
         if (button == GLFW_MOUSE_BUTTON_LEFT) {
             viewer.drag_ = DragButton::Orbit;
             const double now = glfwGetTime();
-            if (now - viewer.lastClickTime_ < kDoubleClickSeconds &&
-                glm::length(cursor - viewer.lastClickPosition_) < kDoubleClickPixels) {
+            if (viewer.lightKeyHeld()) {
+                viewer.lastClickTime_ = -1.0;  // a light drag, not half a double click
+            } else if (now - viewer.lastClickTime_ < kDoubleClickSeconds &&
+                       glm::length(cursor - viewer.lastClickPosition_) < kDoubleClickPixels) {
                 viewer.lastClickTime_ = -1.0;
                 viewer.pickCentreAt(cursor);
             } else {
@@ -207,7 +210,11 @@ void Viewer::onCursorPosition(GLFWwindow* window, double x, double y) {
         const glm::dvec2 delta = cursor - viewer.lastCursor_;
         viewer.lastCursor_ = cursor;
         if (viewer.drag_ == DragButton::Orbit) {
-            if (viewer.navigation_ == Navigation::Fly) {
+            // Decided at every move: pressing or releasing L during a drag switches between
+            // turning the light and the view, and the view never moves while L is held.
+            if (viewer.lightKeyHeld()) {
+                viewer.dragLight(delta.x, delta.y);
+            } else if (viewer.navigation_ == Navigation::Fly) {
                 viewer.camera_.look(delta.x, delta.y);
             } else {
                 viewer.camera_.orbit(delta.x, delta.y);
@@ -281,6 +288,9 @@ void Viewer::handleKey(int key) {
         case GLFW_KEY_TAB:
             showPanel_ = !showPanel_;
             break;
+        case GLFW_KEY_L:
+            firstLight();
+            break;
         case GLFW_KEY_C:
             navigation_ = navigation_ == Navigation::Orbit ? Navigation::Fly : Navigation::Orbit;
             notify(navigation_ == Navigation::Fly ? "fly: WASD to move, Q/E down/up, drag to look"
@@ -289,6 +299,25 @@ void Viewer::handleKey(int key) {
         default:
             break;
     }
+}
+
+bool Viewer::lightKeyHeld() const {
+    return glfwGetKey(context_.window(), GLFW_KEY_L) == GLFW_PRESS &&
+           !ImGui::GetIO().WantCaptureKeyboard;
+}
+
+DirectionalLight& Viewer::firstLight() {
+    std::vector<DirectionalLight>& lights = settings_.shading.lights;
+    if (lights.empty()) {
+        lights.push_back({glm::vec3(camera_.defaultLightDirection()), glm::vec3(1.0f)});
+        notify("added light 1 from the upper left: hold L and drag to turn it");
+    }
+    return lights.front();
+}
+
+void Viewer::dragLight(double dxPixels, double dyPixels) {
+    DirectionalLight& light = firstLight();
+    light.direction = glm::vec3(camera_.dragLight(glm::dvec3(light.direction), dxPixels, dyPixels));
 }
 
 void Viewer::flyWithKeys(double seconds) {
@@ -406,9 +435,24 @@ void Viewer::runScriptCommand(const ScriptCommand& command) {
                        }
                    },
                    [&](const script::ShowPanel& panel) { showPanel_ = panel.show; },
+                   [&](const script::Light& light) { dragLight(light.dx, light.dy); },
+                   [&](const script::Settings& change) { changeSettings(change.patch); },
                    [&](const script::Exit&) { exitRequested_ = true; },
                },
                command);
+}
+
+void Viewer::changeSettings(const std::string& patch) {
+    try {
+        nlohmann::json merged = settings_;
+        merged.merge_patch(nlohmann::json::parse(patch));
+        settings_ = merged.get<RenderSettings>();
+    } catch (const Error& error) {
+        fail(error.what());
+    } catch (const nlohmann::json::exception& error) {
+        fail(fmt::format("the script's settings do not fit the settings file's form: {}",
+                         error.what()));
+    }
 }
 
 void Viewer::resizeWindow(int width, int height) {
@@ -432,6 +476,23 @@ void Viewer::resizeWindow(int width, int height) {
 
 // ---- drawing ---------------------------------------------------------------------------------
 
+RenderSettings Viewer::appliedSettings() const {
+    RenderSettings settings = settings_;
+    settings.scattering = scattering_.settings();
+    return settings;
+}
+
+void Viewer::offerSettings() {
+    const std::string refusedBefore = scattering_.refusal();
+    if (const std::optional<std::string> refusal = scattering_.offer(settings_.scattering)) {
+        fail(*refusal);
+    } else if (!refusedBefore.empty() && scattering_.refusal().empty() && status_.messageIsError &&
+               status_.message == refusedBefore) {
+        status_.message.clear();  // mended: the error no longer holds
+    }
+    status_.scatteringRefusal = scattering_.refusal();
+}
+
 bool Viewer::frameIsStale() const {
     const glm::ivec2 size = viewportSize();
     if (!renderer_ || size.x < 1 || size.y < 1) {
@@ -439,22 +500,24 @@ bool Viewer::frameIsStale() const {
     }
     return redrawEveryFrame_ || !renderedCamera_ ||
            !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
-           nlohmann::json(settings_).dump() != renderedSettings_;
+           nlohmann::json(appliedSettings()).dump() != renderedSettings_;
 }
 
 void Viewer::renderIfNeeded() {
+    offerSettings();  // a script's change since the panel last offered them
     if (!frameIsStale()) {
         return;
     }
     const glm::ivec2 size = viewportSize();
     const Camera camera = camera_.camera(size.x, size.y);
+    const RenderSettings settings = appliedSettings();
     // Recorded before rendering: a frame that fails is not retried until something changes.
     renderedCamera_ = camera;
-    renderedSettings_ = nlohmann::json(settings_).dump();
-    renderedMode_ = settings_.raster.mode;
+    renderedSettings_ = nlohmann::json(settings).dump();
+    renderedMode_ = settings.raster.mode;
     renderedImage_ = false;
     try {
-        const FrameResult frame = renderer_->render(camera, settings_);
+        const FrameResult frame = renderer_->render(camera, settings);
         status_.passes = frame.passes;
         status_.imageWidth = size.x;
         status_.imageHeight = size.y;
@@ -503,6 +566,11 @@ void Viewer::drawPanel() {
     }
     try {
         if (requests.saveSettings) {
+            // A file of refused settings would not load again; the panel's are the ones the
+            // user means, so they are not swapped for the applied ones either.
+            if (!scattering_.refusal().empty()) {
+                throw Error("the settings were not saved: " + scattering_.refusal());
+            }
             writeSettingsFile(*requests.saveSettings, settings_);
             notify("saved the settings to " + *requests.saveSettings);
         }
@@ -513,6 +581,8 @@ void Viewer::drawPanel() {
     } catch (const Error& error) {
         fail(error.what());
     }
+    // The panel's edits of this frame: a refusal shows at once, a change renders at once.
+    offerSettings();
 }
 
 void Viewer::writeScreenshot(const std::filesystem::path& path) {
@@ -521,7 +591,8 @@ void Viewer::writeScreenshot(const std::filesystem::path& path) {
     try {
         writePng(path, context_.readBackBuffer());
         writeCameraFile(sidecarPath(path, ".camera.json"), camera);
-        writeSettingsFile(sidecarPath(path, ".settings.json"), settings_);
+        // What the picture shows.
+        writeSettingsFile(sidecarPath(path, ".settings.json"), appliedSettings());
         notify("wrote " + path.string());
     } catch (const Error& error) {
         fail(error.what());

@@ -75,6 +75,12 @@ class Viewer {
     static void onCursorEnter(GLFWwindow* window, int entered);
     void installCallbacks();
     void handleKey(int key);
+    /// `L` is held (and not typed into the panel): a left drag turns the light.
+    bool lightKeyHeld() const;
+    /// The first directional light, added from the upper left of the view when there is none.
+    DirectionalLight& firstLight();
+    /// A left drag of (dx, dy) window pixels with `L` held (ViewerCamera::dragLight).
+    void dragLight(double dxPixels, double dyPixels);
     /// The mouse at `cursor` belongs to the panel (or one of its popups), not to the camera.
     bool panelTakes(const glm::dvec2& cursor) const;
 
@@ -83,11 +89,19 @@ class Viewer {
     void finishLoading();
     void runScript();
     void runScriptCommand(const ScriptCommand& command);
+    /// Merges `patch` (JSON text in the settings file's form) into the settings, checked as a
+    /// settings file is; an impossible result is an error and changes nothing.
+    void changeSettings(const std::string& patch);
     void resizeWindow(int width, int height);
     void flyWithKeys(double seconds);
 
-    /// The camera, the settings or the window size differ from what the last pipeline frame
-    /// showed (or every frame is to be rendered).
+    /// The panel's settings with the scattering settings in effect (AppliedScattering): what
+    /// the pipeline renders.
+    RenderSettings appliedSettings() const;
+    /// Offers the panel's scattering settings to scattering_; a refusal is an error (once).
+    void offerSettings();
+    /// The camera, the applied settings or the window size differ from what the last pipeline
+    /// frame showed (or every frame is to be rendered).
     bool frameIsStale() const;
     /// Renders the pipeline for the current camera and settings when the frame is stale.
     void renderIfNeeded();
@@ -115,7 +129,8 @@ class Viewer {
     GlfwContext context_;
     ImGuiSession imgui_;
     ViewerPanel panel_;
-    RenderSettings settings_;
+    RenderSettings settings_;  // as the panel shows them
+    AppliedScattering scattering_;
     bool showPanel_;
     bool redrawEveryFrame_ = false;
     Navigation navigation_ = Navigation::Orbit;

@@ -134,6 +134,32 @@ void ViewerCamera::setCentre(const glm::dvec3& point) {
     clampDistance();
 }
 
+glm::dvec3 ViewerCamera::dragLight(const glm::dvec3& towardsLight, double dxPixels,
+                                   double dyPixels) const {
+    // The direction in the view's frame: x right, y up, z towards the eye.
+    const glm::dvec3 x = right();
+    const glm::dvec3 y = up();
+    const glm::dvec3 z = towardsEye();
+    glm::dvec3 view(glm::dot(towardsLight, x), glm::dot(towardsLight, y),
+                    glm::dot(towardsLight, z));
+    const double length = glm::length(view);
+    view = length > 0.0 && std::isfinite(length) ? view / length : glm::dvec3(0.0, 0.0, 1.0);
+    // Azimuth 0 faces the eye and grows to the right; elevation grows upwards (window y grows
+    // downwards).
+    const double azimuth = std::atan2(view.x, view.z) + glm::radians(dxPixels * kDegreesPerPixel);
+    const double maxElevation = glm::radians(kMaxPitchDegrees);
+    const double elevation = std::clamp(
+        std::asin(std::clamp(view.y, -1.0, 1.0)) - glm::radians(dyPixels * kDegreesPerPixel),
+        -maxElevation, maxElevation);
+    const glm::dvec3 turned(std::cos(elevation) * std::sin(azimuth), std::sin(elevation),
+                            std::cos(elevation) * std::cos(azimuth));
+    return glm::normalize(turned.x * x + turned.y * y + turned.z * z);
+}
+
+glm::dvec3 ViewerCamera::defaultLightDirection() const {
+    return glm::normalize(-right() + up() + towardsEye());
+}
+
 Camera ViewerCamera::camera(int width, int height) const {
     Camera camera;
     camera.width = width;

@@ -49,6 +49,18 @@ class ViewerCamera {
     /// Orbits around `point` from now on; the eye stays where it is and turns towards it.
     void setCentre(const glm::dvec3& point);
 
+    /// A directional light's direction (towards the light, scene coordinates) after a drag of
+    /// (dx, dy) pixels with `L` held. The light turns around the scene in the frame of this
+    /// view: its azimuth around the view's up axis (a drag to the right moves a light in front
+    /// of the scene to the right) and its elevation towards that axis (a drag upwards raises
+    /// it), kDegreesPerPixel as for orbit, the elevation stopping kMaxPitchDegrees short of the
+    /// view's up and down where the azimuth would be lost. The camera does not move; the result
+    /// is a unit vector (a zero direction starts from the eye's side).
+    glm::dvec3 dragLight(const glm::dvec3& towardsLight, double dxPixels, double dyPixels) const;
+    /// The light `L` adds when there is none: from the upper left of this view, on the eye's
+    /// side of the scene (45 degrees to the left, 35 up), a unit vector.
+    glm::dvec3 defaultLightDirection() const;
+
     /// The camera for a viewport of width x height pixels; near and far hug the scene.
     Camera camera(int width, int height) const;
 

@@ -1,13 +1,18 @@
 #include "app/viewer/ViewerPanel.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
+#include "core/Error.h"
 #include "shared/bindings.h"
 #include "sss/MaterialLibrary.h"
 
@@ -31,8 +36,20 @@ constexpr AlbedoPlacement kAlbedoPlacements[] = {
     AlbedoPlacement::PreScatter, AlbedoPlacement::PostScatter, AlbedoPlacement::Split};
 constexpr SceneUnit kUnits[] = {SceneUnit::Millimetre, SceneUnit::Centimetre, SceneUnit::Metre,
                                 SceneUnit::Inch};
+constexpr ScatteringMethod kMethods[] = {ScatteringMethod::Gaussian, ScatteringMethod::Single,
+                                         ScatteringMethod::Both};
+constexpr CoefficientSource kSources[] = {CoefficientSource::Material, CoefficientSource::Color};
+// The ranges checkScatteringSettings allows, a little inside where its bounds are open.
+constexpr float kMinMeanFreePathMm = 0.01f;
+constexpr float kMaxMeanFreePathMm = 1000.0f;
+constexpr float kMinEta = 1.0f;
+constexpr float kMaxEta = 3.0f;
+constexpr float kMaxPhaseG = 0.95f;
+constexpr int kMaxSingleSamples = 64;
 
 constexpr ImGuiSliderFlags kLogarithmic = ImGuiSliderFlags_Logarithmic;
+// Ctrl+click typing stays inside the slider's range too.
+constexpr ImGuiSliderFlags kClamp = ImGuiSliderFlags_AlwaysClamp;
 // Colours that are radiances: linear and allowed above 1.
 constexpr ImGuiColorEditFlags kRadiance = ImGuiColorEditFlags_Float | ImGuiColorEditFlags_HDR;
 
@@ -79,7 +96,64 @@ void helpTooltip(const char* text) {
     }
 }
 
+const Material* libraryMaterial(const std::string& name) {
+    for (const Material& material : materialLibrary()) {
+        if (material.name == name) {
+            return &material;
+        }
+    }
+    return nullptr;
+}
+
+bool hasMeasuredCoefficients(const Material& material) {
+    return material.sigmaSPrime.has_value() && material.sigmaA.has_value();
+}
+
+/// `text` with the Greek of the optics (the material library's sentences say σs′, σa, η)
+/// spelt out: ImGui's built-in font has Latin-1 only and would draw them as '?'.
+std::string inPanelFont(std::string text) {
+    constexpr std::pair<std::string_view, std::string_view> kSpellings[] = {
+        {"σ", "sigma_"}, {"′", "'"}, {"η", "eta"}, {"α", "alpha"}};
+    for (const auto& [symbol, spelling] : kSpellings) {
+        for (std::size_t at = text.find(symbol); at != std::string::npos;
+             at = text.find(symbol, at + spelling.size())) {
+            text.replace(at, symbol.size(), spelling);
+        }
+    }
+    return text;
+}
+
+/// Wrapped text, red for an error.
+void messageText(const std::string& text, bool error) {
+    if (error) {
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+    }
+    ImGui::TextWrapped("%s", inPanelFont(text).c_str());
+    if (error) {
+        ImGui::PopStyleColor();
+    }
+}
+
 }  // namespace
+
+AppliedScattering::AppliedScattering(ScatteringSettings initial) : applied_(std::move(initial)) {}
+
+std::optional<std::string> AppliedScattering::offer(const ScatteringSettings& wanted) {
+    std::string offered = nlohmann::json(wanted).dump();
+    if (offered == offered_) {
+        return std::nullopt;
+    }
+    offered_ = std::move(offered);
+    try {
+        checkScatteringSettings(wanted);
+    } catch (const Error& error) {
+        refusal_ = error.what();
+        return refusal_;
+    }
+    applied_ = wanted;
+    refusal_.clear();
+    return std::nullopt;
+}
 
 bool stageAvailable(Stage stage, RenderMode mode) {
     return reconstructsSurface(mode) || stage == Stage::Final || stage == Stage::Depth;
@@ -121,6 +195,8 @@ PanelRequests ViewerPanel::draw(RenderSettings& settings, Navigation& navigation
                 "right/middle   pan\n"
                 "wheel          zoom to the cursor\n"
                 "double click   orbit around that point\n"
+                "L + left drag  turn light 1 around the\n"
+                "               scan (L adds one if none)\n"
                 "R / F          reset view / frame all\n"
                 "C              orbit <-> fly (WASD, Q/E,\n"
                 "               Shift faster)\n"
@@ -130,15 +206,18 @@ PanelRequests ViewerPanel::draw(RenderSettings& settings, Navigation& navigation
                 "drop a file    open it");
         }
         ImGui::PopItemWidth();
-        if (!status.message.empty()) {
+        if (!status.scatteringRefusal.empty()) {
+            // Stays while it lasts, whatever notices come after it.
             ImGui::Separator();
-            if (status.messageIsError) {
-                ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
-            }
-            ImGui::TextWrapped("%s", status.message.c_str());
-            if (status.messageIsError) {
-                ImGui::PopStyleColor();
-            }
+            messageText(
+                "Not applied (the picture keeps the last scattering settings that "
+                "work): " +
+                    status.scatteringRefusal,
+                true);
+        }
+        if (!status.message.empty() && status.message != status.scatteringRefusal) {
+            ImGui::Separator();
+            messageText(status.message, status.messageIsError);
         }
     }
     ImGui::End();
@@ -328,28 +407,115 @@ void ViewerPanel::drawShading(ShadingSettings& shading) {
 
 void ViewerPanel::drawScattering(ScatteringSettings& scattering) {
     ImGui::TextDisabled("used by the sss mode");
-    const std::vector<Material>& materials = materialLibrary();
+    choiceCombo<ScatteringMethod>("method", scattering.method, kMethods,
+                                  [](ScatteringMethod method) { return toString(method); });
+    helpTooltip(
+        "gaussian: the screen-space blur of the diffuse light; single: single scattering added "
+        "to the unblurred diffuse light; both: single scattering added to the blurred light.");
+    const bool blurs = scattering.method != ScatteringMethod::Single;
+    const bool single = scattering.method != ScatteringMethod::Gaussian;
+    // Single scattering from the material's coefficients needs a measured material. The
+    // combo still offers the Gaussian-only ones, marked: picking one shows why it cannot work
+    // (AppliedScattering keeps the picture) instead of an entry that vanishes or greys out
+    // depending on two other combos, and the user may be on the way to coefficients=color.
+    const bool needsMeasured = single && scattering.coefficients == CoefficientSource::Material;
     if (ImGui::BeginCombo("material", scattering.material.c_str())) {
-        for (const Material& material : materials) {
+        for (const Material& material : materialLibrary()) {
             const bool selected = material.name == scattering.material;
-            if (ImGui::Selectable(material.name.c_str(), selected)) {
+            const bool unusable = needsMeasured && !hasMeasuredCoefficients(material);
+            const std::string label =
+                unusable ? material.name + " (Gaussian only)##" + material.name : material.name;
+            if (ImGui::Selectable(label.c_str(), selected)) {
                 scattering.material = material.name;
             }
-            helpTooltip(material.description.c_str());
+            if (unusable) {
+                helpTooltip(
+                    "No measured sigma_s' and sigma_a: single scattering needs coefficients "
+                    "'color' with it.");
+            } else {
+                helpTooltip(material.description.c_str());
+            }
             if (selected) {
                 ImGui::SetItemDefaultFocus();
             }
         }
         ImGui::EndCombo();
     }
+    helpTooltip(
+        "The Gaussian set of the blur; for single scattering its eta, and with coefficients "
+        "'material' its measured sigma_s' and sigma_a.");
     choiceCombo<SceneUnit>("scan unit", scattering.unit, kUnits,
                            [](SceneUnit unit) { return toString(unit); });
     helpTooltip("The length unit of the scan's coordinates; profiles are in millimetres.");
-    ImGui::SliderFloat("radius scale", &scattering.scale, 0.01f, 100.0f, "%.3f", kLogarithmic);
+    ImGui::SliderFloat("radius scale", &scattering.scale, 0.01f, 100.0f, "%.3f",
+                       kLogarithmic | kClamp);
+    helpTooltip("Multiplies every radius of the profile and every mean free path.");
+
+    ImGui::Separator();
+    ImGui::TextDisabled(blurs ? "Gaussian blur" : "Gaussian blur (method gaussian or both)");
+    ImGui::BeginDisabled(!blurs);
     choiceCombo<AlbedoPlacement>("albedo", scattering.albedo, kAlbedoPlacements,
                                  [](AlbedoPlacement placement) { return toString(placement); });
     helpTooltip("Where the colour enters the blur: before it, after it, or sqrt on both sides.");
-    ImGui::SliderInt("max taps", &scattering.maxTaps, 1, 128);
+    ImGui::SliderInt("max taps", &scattering.maxTaps, 1, 128, "%d", kClamp);
+    ImGui::EndDisabled();
+
+    ImGui::Separator();
+    ImGui::TextDisabled(single ? "single scattering" : "single scattering (method single or both)");
+    ImGui::BeginDisabled(!single);
+    choiceCombo<CoefficientSource>("coefficients", scattering.coefficients, kSources,
+                                   [](CoefficientSource source) { return toString(source); });
+    helpTooltip(
+        "Where sigma_s' and sigma_a come from: the material's measurement, or per pixel from "
+        "the surface colour and the mean free path.");
+    ImGui::BeginDisabled(scattering.coefficients != CoefficientSource::Color);
+    // The three values, a button, then the label where the other labels are.
+    const ImGuiStyle& style = ImGui::GetStyle();
+    const float buttonWidth = ImGui::CalcTextSize("marble").x + 2.0f * style.FramePadding.x;
+    ImGui::SetNextItemWidth(
+        std::max(ImGui::CalcItemWidth() - buttonWidth - style.ItemInnerSpacing.x, 60.0f));
+    ImGui::SliderFloat3("##mean free path", &scattering.meanFreePathMm.x, kMinMeanFreePathMm,
+                        kMaxMeanFreePathMm, "%.3g", kLogarithmic | kClamp);
+    helpTooltip(
+        "Diffuse mean free path l_d = 1/sigma_tr per channel (R G B), in mm (times the radius "
+        "scale); used with coefficients 'color'.");
+    ImGui::SameLine(0.0f, style.ItemInnerSpacing.x);
+    if (ImGui::SmallButton("marble")) {
+        scattering.meanFreePathMm = kMarbleMeanFreePathMm;
+    }
+    helpTooltip("Jensen et al. 2001's marble: a marble-coloured scan gets marble back.");
+    ImGui::SameLine(0.0f, style.ItemInnerSpacing.x);
+    ImGui::TextUnformatted("mean free path (mm)");
+    ImGui::EndDisabled();
+
+    const Material* material = libraryMaterial(scattering.material);
+    bool materialEta = !scattering.eta.has_value();
+    // "###" keeps the checkbox's identity while its text shows the value.
+    char etaLabel[64] = "material's eta###materialEta";
+    if (material != nullptr && materialEta) {
+        std::snprintf(etaLabel, sizeof etaLabel, "material's eta (%.2f)###materialEta",
+                      material->eta);
+    }
+    if (ImGui::Checkbox(etaLabel, &materialEta)) {
+        if (materialEta) {
+            scattering.eta.reset();
+        } else {
+            // The explicit value starts where the material's was.
+            scattering.eta = std::clamp(
+                material != nullptr ? static_cast<float>(material->eta) : 1.3f, kMinEta, kMaxEta);
+        }
+    }
+    helpTooltip("The relative index of refraction: the material's, or the value below.");
+    if (scattering.eta) {
+        ImGui::SliderFloat("eta", &*scattering.eta, kMinEta, kMaxEta, "%.3f", kClamp);
+    }
+    ImGui::SliderFloat("phase g", &scattering.phaseG, -kMaxPhaseG, kMaxPhaseG, "%.2f", kClamp);
+    helpTooltip(
+        "Henyey-Greenstein asymmetry: below 0 scatters back towards the light, above 0 on "
+        "forwards, 0 evenly.");
+    ImGui::SliderInt("samples", &scattering.singleSamples, 1, kMaxSingleSamples, "%d", kClamp);
+    helpTooltip("Samples along the refracted view ray per pixel.");
+    ImGui::EndDisabled();
 }
 
 void ViewerPanel::drawFiles(PanelRequests& requests) {

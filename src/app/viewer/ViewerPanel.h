@@ -35,6 +35,32 @@ struct PanelStatus {
     int divisor = 1;      // output pixels per reconstructed pixel and side in the last frame
     std::string message;  // the last notice or error, shown at the bottom
     bool messageIsError = false;
+    std::string scatteringRefusal;  // AppliedScattering::refusal(): shown while it lasts
+};
+
+/// The scattering settings the pipeline renders with. The panel edits the viewer's settings
+/// freely, and some combinations are impossible (checkScatteringSettings: single scattering
+/// taking the measured coefficients of a Gaussian-only material); the renderer would refuse
+/// every frame of them. Those are not applied: the last scattering settings it accepted stay
+/// in effect (the picture stays, and every other setting still applies), and the reason is
+/// reported once per refused change, not every frame, until a possible combination comes.
+class AppliedScattering {
+  public:
+    explicit AppliedScattering(ScatteringSettings initial);
+
+    /// Offers the panel's scattering settings; they are taken when checkScatteringSettings
+    /// accepts them. Returns the reason when they are refused and differ from those last
+    /// offered; nothing otherwise.
+    std::optional<std::string> offer(const ScatteringSettings& wanted);
+    /// In effect: the last accepted (at first the initial ones).
+    const ScatteringSettings& settings() const { return applied_; }
+    /// Why the settings last offered are not in effect; empty when they are.
+    const std::string& refusal() const { return refusal_; }
+
+  private:
+    ScatteringSettings applied_;
+    std::string offered_;  // JSON of the settings last offered
+    std::string refusal_;
 };
 
 /// What the user asked for through the panel this frame.

@@ -17,7 +17,8 @@ namespace subscan::viewer {
 namespace {
 
 constexpr std::string_view kActionNames =
-    "orbit, pan, zoom, pick, reset, frame, resize, screenshot, mode, panel, exit";
+    "orbit, pan, zoom, pick, reset, frame, resize, screenshot, mode, panel, light, settings, "
+    "exit";
 // Beyond this a window is a typo, not a request (and larger than any GPU's texture limit).
 constexpr int kMaxWindowSide = 16384;
 
@@ -87,6 +88,17 @@ class ActionReader {
         return found->get<bool>();
     }
 
+    const nlohmann::json& object(std::string_view key) const {
+        const auto found = json_.find(key);
+        if (found == json_.end() || !found->is_object()) {
+            throw Error(fmt::format(
+                "'{}' must be an object in the settings file's form, like {{\"scattering\": "
+                "{{\"method\": \"single\"}}}}",
+                key));
+        }
+        return *found;
+    }
+
     /// The cursor position "x", "y": both or neither.
     std::optional<glm::dvec2> position() const {
         const std::optional<double> x = optionalNumber("x");
@@ -105,12 +117,15 @@ class ActionReader {
 };
 
 ScriptCommand parseCommand(const std::string& name, const ActionReader& reader) {
-    if (name == "orbit" || name == "pan") {
+    if (name == "orbit" || name == "pan" || name == "light") {
         reader.allowOnly({"dx", "dy"});
         const double dx = reader.optionalNumber("dx").value_or(0.0);
         const double dy = reader.optionalNumber("dy").value_or(0.0);
         if (name == "orbit") {
             return script::Orbit{dx, dy};
+        }
+        if (name == "light") {
+            return script::Light{dx, dy};
         }
         return script::Pan{dx, dy};
     }
@@ -146,6 +161,13 @@ ScriptCommand parseCommand(const std::string& name, const ActionReader& reader) 
     if (name == "panel") {
         reader.allowOnly({"show"});
         return script::ShowPanel{reader.boolean("show")};
+    }
+    if (name == "settings") {
+        // Whether the merged settings are possible depends on the ones in effect when the
+        // action runs (a material and the coefficients it needs may come from different
+        // actions), so only the form is checked here.
+        reader.allowOnly({"settings"});
+        return script::Settings{reader.object("settings").dump()};
     }
     if (name == "exit") {
         reader.allowOnly({});

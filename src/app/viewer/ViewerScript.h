@@ -48,6 +48,17 @@ struct SetMode {
 struct ShowPanel {  // `Tab`
     bool show = true;
 };
+/// A left drag with `L` held: turns the first directional light (ViewerCamera::dragLight),
+/// adding one first when there is none, as pressing `L` does.
+struct Light {
+    double dx = 0.0;
+    double dy = 0.0;
+};
+/// What the panel does: settings in the settings file's form merged into the current ones (a
+/// JSON merge patch, RFC 7386), e.g. {"scattering": {"method": "single"}}.
+struct Settings {
+    std::string patch;  // JSON text of an object
+};
 struct Exit {};
 
 }  // namespace script
@@ -55,7 +66,7 @@ struct Exit {};
 using ScriptCommand =
     std::variant<script::Orbit, script::Pan, script::Zoom, script::Pick, script::Reset,
                  script::FrameAll, script::Resize, script::Screenshot, script::SetMode,
-                 script::ShowPanel, script::Exit>;
+                 script::ShowPanel, script::Light, script::Settings, script::Exit>;
 
 struct ScriptAction {
     /// Frames count from the first frame that shows the scan (0); the actions of a frame run

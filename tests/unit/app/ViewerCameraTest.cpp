@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "app/viewer/ViewerCamera.h"
 
@@ -237,6 +238,69 @@ TEST(ViewerCameraTest, PointAtCentreDepthLiesOnTheCursorRay) {
     EXPECT_NEAR(projected.pixel.x, cursor.x, 1e-6);
     EXPECT_NEAR(projected.pixel.y, cursor.y, 1e-6);
     EXPECT_NEAR(projected.depth, viewer.distance(), kTolerance);
+}
+
+/// A direction in the frame of `camera`'s view: x right, y up, z towards the eye.
+glm::dvec3 inView(const ViewerCamera& camera, const glm::dvec3& view) {
+    return view.x * camera.right() + view.y * camera.up() - view.z * camera.forward();
+}
+
+TEST(ViewerCameraTest, DraggingTheLightTurnsItAroundTheViewsUpAndRightAxes) {
+    // 0.3 degrees a pixel: 300 pixels are a quarter turn, 150 an eighth.
+    const double eighth = 45.0 / ViewerCamera::kDegreesPerPixel;
+    const double quarter = 2.0 * eighth;
+    const double s = std::sqrt(0.5);
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+        const ViewerCamera camera = movedCamera(up);
+        const glm::dvec3 front = inView(camera, {0, 0, 1});  // from the eye's side
+        // Right moves a front light to the right, left to the left; up raises it, down lowers.
+        expectNear(camera.dragLight(front, quarter, 0.0), camera.right(), 1e-12);
+        expectNear(camera.dragLight(front, -quarter, 0.0), -camera.right(), 1e-12);
+        expectNear(camera.dragLight(front, eighth, 0.0), inView(camera, {s, 0, s}), 1e-12);
+        expectNear(camera.dragLight(front, 0.0, -eighth), inView(camera, {0, s, s}), 1e-12);
+        expectNear(camera.dragLight(front, 0.0, eighth), inView(camera, {0, -s, s}), 1e-12);
+        // Half a turn puts it behind the scene, against the eye.
+        expectNear(camera.dragLight(front, 2.0 * quarter, 0.0), camera.forward(), 1e-12);
+        // A light from the right, raised by an eighth, then carried a quarter to the right.
+        expectNear(camera.dragLight(camera.right(), quarter, -eighth), inView(camera, {0, s, -s}),
+                   1e-12);
+        // The length of the given direction does not matter; the result is a unit vector.
+        expectNear(camera.dragLight(7.0 * front, eighth, 0.0), inView(camera, {s, 0, s}), 1e-12);
+        expectNear(camera.dragLight(front, 0.0, 0.0), front, 1e-12);
+    }
+}
+
+TEST(ViewerCameraTest, DraggingTheLightKeepsElevationAcrossAndStopsShortOfThePoles) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+        const ViewerCamera camera = movedCamera(up);
+        const glm::dvec3 light = glm::normalize(inView(camera, {-0.3, 0.5, 0.8}));
+        // Across: the height above the view's horizon stays; back again: where it was.
+        const glm::dvec3 across = camera.dragLight(light, 237.0, 0.0);
+        EXPECT_NEAR(glm::dot(across, camera.up()), glm::dot(light, camera.up()), 1e-12);
+        EXPECT_NEAR(glm::length(across), 1.0, 1e-12);
+        expectNear(camera.dragLight(camera.dragLight(light, 80.0, -45.0), -80.0, 45.0), light,
+                   1e-12);
+        // Far up or down, the light stops kMaxPitchDegrees from the view's up axis, where a
+        // further drag across still turns it.
+        const double maxElevation = glm::radians(ViewerCamera::kMaxPitchDegrees);
+        for (const double sign : {1.0, -1.0}) {
+            const glm::dvec3 pole = camera.dragLight(light, 0.0, -sign * 1e5);
+            EXPECT_NEAR(glm::dot(pole, camera.up()), sign * std::sin(maxElevation), 1e-12);
+            const glm::dvec3 turned = camera.dragLight(pole, 300.0, 0.0);
+            EXPECT_NEAR(glm::dot(turned, camera.up()), sign * std::sin(maxElevation), 1e-12);
+            EXPECT_LT(glm::dot(turned, pole), 0.9999);
+        }
+        // A zero direction (no light to turn) starts from the eye's side.
+        expectNear(camera.dragLight(glm::dvec3(0.0), 0.0, 0.0), inView(camera, {0, 0, 1}), 1e-12);
+    }
+}
+
+TEST(ViewerCameraTest, TheDefaultLightComesFromTheUpperLeftOnTheEyesSide) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+        const ViewerCamera camera = movedCamera(up);
+        expectNear(camera.defaultLightDirection(),
+                   inView(camera, glm::dvec3(-1.0, 1.0, 1.0) / std::sqrt(3.0)), 1e-12);
+    }
 }
 
 }  // namespace

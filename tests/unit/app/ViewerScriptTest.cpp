@@ -72,6 +72,25 @@ TEST(ViewerScriptTest, ReadsEveryActionInFrameOrder) {
     EXPECT_TRUE(std::holds_alternative<script::Exit>(actions[12].command));
 }
 
+TEST(ViewerScriptTest, ReadsTheLightDragAndSettingsChanges) {
+    const auto actions = parseScript(nlohmann::json::parse(R"([
+        {"frame": 1, "action": "light", "dx": 40, "dy": -20},
+        {"frame": 1, "action": "light"},
+        {"frame": 2, "action": "settings",
+         "settings": {"scattering": {"method": "single", "eta": null}}}
+    ])"));
+    ASSERT_EQ(actions.size(), 3u);
+    const auto& light = std::get<script::Light>(actions[0].command);
+    EXPECT_EQ(light.dx, 40.0);
+    EXPECT_EQ(light.dy, -20.0);
+    const auto& still = std::get<script::Light>(actions[1].command);
+    EXPECT_EQ(still.dx, 0.0);  // pressing L alone: adds the light if there is none
+    EXPECT_EQ(still.dy, 0.0);
+    // Kept as written: a null in a merge patch removes the key (eta: back to the material's).
+    EXPECT_EQ(nlohmann::json::parse(std::get<script::Settings>(actions[2].command).patch),
+              nlohmann::json::parse(R"({"scattering": {"method": "single", "eta": null}})"));
+}
+
 TEST(ViewerScriptTest, RefusesWhatIsWrongNamingTheAction) {
     EXPECT_THAT(scriptError(R"({"frame": 0})"), HasSubstr("a script is a list of actions"));
     EXPECT_THAT(scriptError(R"([{"frame": 0, "action": "spin"}])"),
@@ -99,6 +118,12 @@ TEST(ViewerScriptTest, RefusesWhatIsWrongNamingTheAction) {
                 HasSubstr("render mode"));
     EXPECT_THAT(scriptError(R"([{"frame": 0, "action": "panel", "show": 1}])"),
                 HasSubstr("'show' must be true or false"));
+    EXPECT_THAT(scriptError(R"([{"frame": 0, "action": "light", "dz": 1}])"),
+                HasSubstr("unknown argument 'dz'"));
+    EXPECT_THAT(scriptError(R"([{"frame": 0, "action": "settings"}])"),
+                HasSubstr("'settings' must be an object in the settings file's form"));
+    EXPECT_THAT(scriptError(R"([{"frame": 0, "action": "settings", "settings": [1]}])"),
+                HasSubstr("'settings' must be an object"));
     EXPECT_THAT(scriptError(R"([3])"), HasSubstr("action 1: it is not an object"));
 }
 
