@@ -17,4 +17,5 @@ mkdir -p docs/images
 build/tools/subscan_figures stages "$scan" docs/images/stages-happy.png --yaw 0 --pitch 10 --distance 0.09 --size 400 400
 build/tools/subscan_figures compare "$scan" docs/images/compare-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 420 560
 build/tools/subscan_figures materials "$scan" docs/images/materials-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 420 560
+build/tools/subscan_figures single "$scan" docs/images/single-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 320 420
 ls -1 docs/images

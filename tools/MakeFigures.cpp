@@ -1,7 +1,9 @@
 // Renders the README's figures: the stages of the surface pipeline side by side (like the
 // paper's Figure 2), a points/splats/surface comparison, and the surface beside marble and skin
-// (like the paper's Figure 8). Run by scripts/make-figures.sh.
-//   subscan_figures stages|compare|materials SCAN OUT.png [--yaw D] [--pitch D] [--distance F] [--size W H]
+// (like the paper's Figure 8), and the two scattering paths under a grazing key light. Run by
+// scripts/make-figures.sh.
+//   subscan_figures stages|compare|materials|single SCAN OUT.png [--yaw D] [--pitch D]
+//                   [--distance F] [--size W H]
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -21,6 +23,7 @@ struct Panel {
     RenderMode mode;
     Stage stage;
     std::string material = {};  // sss panels
+    ScatteringMethod method = ScatteringMethod::Gaussian;
 };
 
 /// Side-by-side tiles, `columns` per row, separated by a `gap` of background.
@@ -44,7 +47,7 @@ Image8 montage(const std::vector<std::vector<std::uint8_t>>& tiles, int width, i
 int run(int argc, char** argv) {
     if (argc < 4) {
         std::fprintf(stderr,
-                     "usage: subscan_figures stages|compare|materials SCAN OUT.png [--yaw D] "
+                     "usage: subscan_figures stages|compare|materials|single SCAN OUT.png [--yaw D] "
                      "[--pitch D] [--distance F] [--size W H]\n");
         return 2;
     }
@@ -80,6 +83,12 @@ int run(int argc, char** argv) {
                   {RenderMode::Sss, Stage::Final, "marble-jimenez"},
                   {RenderMode::Sss, Stage::Final, "skin-jimenez"}};
         columns = 3;
+    } else if (kind == "single") {
+        panels = {{RenderMode::Surface, Stage::Final},
+                  {RenderMode::Sss, Stage::Final, "marble-jimenez", ScatteringMethod::Gaussian},
+                  {RenderMode::Sss, Stage::Final, "marble-jimenez", ScatteringMethod::Single},
+                  {RenderMode::Sss, Stage::Final, "marble-jimenez", ScatteringMethod::Both}};
+        columns = 4;
     } else if (kind == "compare") {
         panels = {{RenderMode::Points, Stage::Final},
                   {RenderMode::Splats, Stage::Final},
@@ -107,9 +116,17 @@ int run(int argc, char** argv) {
             settings.shading.headLight = glm::vec3(0.35f);
             settings.shading.lights.push_back({{-1.0f, 1.0f, 0.6f}, glm::vec3(0.9f)});
         }
+        if (kind == "single") {
+            // A grazing key light from the left, nearly in the image plane, and a dim head
+            // light: single scattering grows towards grazing light where the diffuse fades.
+            settings.shading.headLight = glm::vec3(0.15f);
+            settings.shading.ambient = glm::vec3(0.05f);
+            settings.shading.lights.push_back({{-1.0f, 0.25f, 0.15f}, glm::vec3(1.2f)});
+        }
         if (!panel.material.empty()) {
             settings.scattering.material = panel.material;
         }
+        settings.scattering.method = panel.method;
         renderer.render(camera, settings);
         tiles.push_back(renderer.readImage());
     }
