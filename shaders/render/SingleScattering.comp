@@ -309,7 +309,9 @@ void main() {
             int channel = k % 3;
             float xi = (float(k / 3) + 0.5) / float(channelSamples[channel]);
             float s = -log(1.0 - xi) / medium.sigmaT[channel];
-            vec3 density = vec3(channelSamples) * medium.sigmaT * exp(-medium.sigmaT * s);
+            vec3 viewExtinction = exp(-medium.sigmaT * s);
+            // Σ_j n_j σt_j e^(−σt_j s): the channels' free-path densities, combined.
+            float density = dot(vec3(channelSamples) * medium.sigmaT, viewExtinction);
             vec3 samplePoint = surfacePoint - s * eyeInside;
             Probe sampleProbe = probe(samplePoint, thicknessScale * s);
             if (sampleProbe.state == kOutside) {
@@ -348,8 +350,7 @@ void main() {
                 light += lightThrough(entry, toLight, lights.lightColor[i].rgb, eyeInside, medium);
             }
 #endif
-            single += medium.sigmaS * light * exp(-medium.sigmaT * s) /
-                      (density.r + density.g + density.b);
+            single += medium.sigmaS * light * viewExtinction / density;
         }
         single *= fresnelTransmittance(cosView, eta) / (eta * eta);
     }
