@@ -1,5 +1,6 @@
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -156,10 +157,50 @@ TEST(DipoleTest, CoefficientsFromReflectanceRecoverTheMeasuredMaterials) {
     }
 }
 
+/// α′ with totalDiffuseReflectance(α′, η) = R_d by bisection on [0, 1] (R_d rises with α′):
+/// independent of the table's interpolation.
+double bisectReducedAlbedo(double reflectance, double eta) {
+    double low = 0.0, high = 1.0;
+    for (int i = 0; i < 100; ++i) {
+        const double middle = 0.5 * (low + high);
+        (totalDiffuseReflectance(middle, eta) < reflectance ? low : high) = middle;
+    }
+    return 0.5 * (low + high);
+}
+
+TEST(DipoleTest, InversionMatchesBisection) {
+    for (const double eta : {1.0, 1.3, 1.5, 2.0}) {
+        const ReducedAlbedoTable table(eta);
+        // The GPU's table: u = √(1 − α′) at R_d = i/4095 · 0.999.
+        const std::vector<float> roots = reducedAlbedoRootTable(table, 4096);
+        ASSERT_EQ(roots.size(), 4096u);
+        for (int i = 0; i <= 1000; ++i) {
+            const double reflectance = 0.999 * i / 1000.0;
+            const double expected = bisectReducedAlbedo(reflectance, eta);
+            // The CPU table: linear in u over 4096 entries, ≤ 4.3e-8 in α′ (above).
+            EXPECT_NEAR(table.reducedAlbedo(reflectance), expected, 1e-6)
+                << "η " << eta << " R_d " << reflectance;
+        }
+        for (std::size_t i = 0; i < roots.size(); i += 91) {
+            const double reflectance = 0.999 * static_cast<double>(i) / 4095.0;
+            // Float storage (6e-8 relative) and the CPU table's interpolation, which at the
+            // bright end (u < 0.01, where its entries are 1/4095 apart in u) errs by up to
+            // 1.4e-7 in u: 0.2 % of the smallest u (8.6e-5, η = 1, R_d = 0.999), below the 1 %
+            // the GPU's coefficients are held to.
+            EXPECT_NEAR(roots[i], std::sqrt(1.0 - bisectReducedAlbedo(reflectance, eta)),
+                        5e-5 * roots[i] + 2e-7)
+                << "η " << eta << " entry " << i;
+        }
+        EXPECT_FLOAT_EQ(roots.front(), 1.0f);  // R_d = 0: α′ = 0
+        EXPECT_GT(roots.back(), 0.0f);         // clamped below α′ = 1, so σa > 0
+    }
+}
+
 TEST(DipoleTest, BadInputsAreErrors) {
     EXPECT_THROW(DipoleChannel(-1.0, 0.1, 1.3), Error);
     EXPECT_THROW(DipoleChannel(0.0, 0.0, 1.3), Error);
     EXPECT_THROW(ReducedAlbedoTable(1.3, 1), Error);
+    EXPECT_THROW(reducedAlbedoRootTable(ReducedAlbedoTable(1.3), 1), Error);
     const ReducedAlbedoTable table(1.3);
     EXPECT_THROW(coefficientsFromReflectance(table, {0.5, 0.5, 0.5}, {1.0, 0.0, 1.0}), Error);
 }
