@@ -10,7 +10,8 @@
 // strata.
 //   STAGE_RADIANCE_*   "scatteredRadiance" = "radiance" (diffuse + specular) + single
 //   STAGE_SCATTERED_*  "scatteredRadiance" += single (after the Gaussian blur)
-// Both write "singleScattering" alone and σs′, σa (mm⁻¹) per pixel for exports.
+// Frames that export (params.flags.y) also write "singleScattering" alone and σs′, σa (mm⁻¹)
+// per pixel.
 #include "shared/common.glsl"
 #include "shared/region.glsl"
 
@@ -266,10 +267,13 @@ void main() {
 #else
     vec4 base = imageLoad(inRadiance, pixel);
 #endif
+    bool exports = params.flags.y != 0u;
     if (isinf(depth)) {
-        imageStore(outSingle, pixel, vec4(0.0));
-        imageStore(outSigmaSPrime, pixel, vec4(0.0));
-        imageStore(outSigmaA, pixel, vec4(0.0));
+        if (exports) {
+            imageStore(outSingle, pixel, vec4(0.0));
+            imageStore(outSigmaSPrime, pixel, vec4(0.0));
+            imageStore(outSigmaA, pixel, vec4(0.0));
+        }
         imageStore(scatteredRadiance, pixel, base);
         return;
     }
@@ -277,7 +281,7 @@ void main() {
     float g = params.medium.y;
     vec3 sigmaSPrime = params.sigmaSPrime.rgb;
     vec3 sigmaA = params.sigmaA.rgb;
-    if (params.medium.w > 0.5) {
+    if (params.flags.x != 0u) {
         // DESIGN.md §6.4 with u = √(1 − α′): σt′ = σtr/(√3 u), σs′ = α′σt′ and
         // σa = σt′ − σs′ = σtr u/√3, written so that no difference of near-equal terms loses
         // a bright colour's small σa.
@@ -287,8 +291,10 @@ void main() {
         sigmaSPrime = (1.0 - root * root) * effectiveExtinction / (sqrt(3.0) * root);
         sigmaA = effectiveExtinction * root / sqrt(3.0);
     }
-    imageStore(outSigmaSPrime, pixel, vec4(sigmaSPrime, 1.0));
-    imageStore(outSigmaA, pixel, vec4(sigmaA, 1.0));
+    if (exports) {
+        imageStore(outSigmaSPrime, pixel, vec4(sigmaSPrime, 1.0));
+        imageStore(outSigmaA, pixel, vec4(sigmaA, 1.0));
+    }
 
     Medium medium;
     medium.sigmaS = sigmaSPrime / (1.0 - g) * params.medium.z;
@@ -354,6 +360,8 @@ void main() {
         }
         single *= fresnelTransmittance(cosView, eta) / (eta * eta);
     }
-    imageStore(outSingle, pixel, vec4(single, 1.0));
+    if (exports) {
+        imageStore(outSingle, pixel, vec4(single, 1.0));
+    }
     imageStore(scatteredRadiance, pixel, vec4(base.rgb + single, base.a));
 }

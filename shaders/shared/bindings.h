@@ -137,15 +137,16 @@ struct SingleScatterParams {
     vec4 sigmaSPrime;   // rgb: the material's reduced scattering coefficient (material source)
     vec4 sigmaA;        // rgb: the material's absorption coefficient (material source)
     vec4 meanFreePath;  // rgb: diffuse mean free path ld (colour source)
-    vec4 medium;        // x: eta, y: Henyey-Greenstein g, z: mm per scene unit / scale,
-                        // w: 1 for coefficients from the colour, 0 for the material's
+    vec4 medium;        // x: eta, y: Henyey-Greenstein g, z: mm per scene unit / scale
     vec4 sampling;      // x: samples along the refracted view ray, y: entries of the albedo
                         // root table, z: total reflectance of its last entry, w: most march steps
+    uvec4 flags;        // x: 1 for coefficients from the colour, 0 for the material's;
+                        // y: 1 to write the term and the coefficients alone (exports)
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(ScatterParams) == 48);
-static_assert(sizeof(SingleScatterParams) == 80);
+static_assert(sizeof(SingleScatterParams) == 96);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
 static_assert(sizeof(SurfaceParams) == 64);
 static_assert(sizeof(ShadeParams) == 3 * 16 + 2 * SUBSCAN_MAX_LIGHTS * 16 + 16);

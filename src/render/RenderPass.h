@@ -14,6 +14,14 @@
 
 namespace subscan {
 
+/// What a frame must leave in Renderer::resources(): the picture ("image", and in the surface
+/// modes "surfaceDepth", which the viewer picks the orbit centre from), or every image its
+/// passes write (exports, evaluation, tests of the passes). The surface mode's final
+/// full-resolution frames finish in one dispatch for the picture alone (FinishSurfacePass), and
+/// SingleScatteringPass leaves its term and coefficients out; the images skipped then still
+/// hold an earlier frame, if any.
+enum class FrameOutputs { Picture, Everything };
+
 /// Everything a pass may use while it runs. The frame-wide uniform blocks (FrameParams,
 /// PyramidLayout, SurfaceParams) are already bound.
 struct FrameContext {
@@ -34,6 +42,7 @@ struct FrameContext {
     /// Pixels [x, y, z, w) the cloud's bounding box projects to (projectedPixelBounds): no
     /// point lands outside them. Unset: anywhere in the image.
     std::optional<glm::ivec4> cloudPixels;
+    FrameOutputs outputs = FrameOutputs::Everything;
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }

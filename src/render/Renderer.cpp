@@ -152,6 +152,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
                          resourcesFor(divisor), layout, spacing_};
     context.cloudPixels = projectedPixelBounds(pipelineCamera_, cloudBounds_);
+    context.outputs = outputs;
     if (divisor != 1) {
         context.divisor = divisor;
         context.reducedFrom = glm::ivec2(camera.width, camera.height);

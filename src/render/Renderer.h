@@ -36,13 +36,6 @@ class SubsurfaceScatteringPass;
 class SingleScatteringPass;
 class PresentPass;
 
-/// What a frame must leave in Renderer::resources(): the picture ("image", and in the surface
-/// modes "surfaceDepth", which the viewer picks the orbit centre from), or every image its
-/// passes write (exports, evaluation, tests of the passes). The surface mode's final
-/// full-resolution frames finish in one dispatch for the picture alone (FinishSurfacePass);
-/// the images that dispatch skips then still hold an earlier frame, if any.
-enum class FrameOutputs { Picture, Everything };
-
 struct FrameResult {
     std::vector<PassTiming> passes;
     int divisor = 1;  // output pixels per pipeline pixel and side (RasterSettings::resolution)

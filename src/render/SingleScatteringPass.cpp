@@ -29,8 +29,7 @@ std::vector<std::string> stageNames(SingleScatteringBase base) {
 }  // namespace
 
 SingleScatteringPass::SingleScatteringPass(const ShaderSources& sources, SingleScatteringBase base)
-    : base_(base),
-      stages_(sources, "render/SingleScattering.comp", stageNames(base)) {}
+    : base_(base), stages_(sources, "render/SingleScattering.comp", stageNames(base)) {}
 
 std::vector<std::string_view> SingleScatteringPass::inputs() const {
     return {"surfaceDepth", "normals", "albedo",
@@ -47,18 +46,19 @@ gpu::SingleScatterParams SingleScatteringPass::parameters(const ScatteringSettin
     }
     params.meanFreePath = glm::vec4(settings.meanFreePathMm, 0.0f);
     params.medium = {static_cast<float>(scatteringEta(settings)), settings.phaseG,
-                     static_cast<float>(millimetresPerUnit(settings.unit) / settings.scale),
-                     settings.coefficients == CoefficientSource::Color ? 1.0f : 0.0f};
+                     static_cast<float>(millimetresPerUnit(settings.unit) / settings.scale), 0.0f};
     params.sampling = {static_cast<float>(settings.singleSamples),
                        static_cast<float>(kTableEntries),
                        static_cast<float>(ReducedAlbedoTable::kMaxReflectance),
                        static_cast<float>(kMaxMarchSteps)};
+    params.flags = {settings.coefficients == CoefficientSource::Color ? 1u : 0u, 1u, 0u, 0u};
     return params;
 }
 
 void SingleScatteringPass::execute(FrameContext& frame) {
     const ScatteringSettings& settings = frame.settings.scattering;
-    const gpu::SingleScatterParams params = parameters(settings);
+    gpu::SingleScatterParams params = parameters(settings);
+    params.flags.y = frame.outputs == FrameOutputs::Everything ? 1u : 0u;
     const double eta = params.medium.x;
     if (tableEta_ != eta) {
         const std::vector<float> roots =
@@ -94,14 +94,14 @@ void SingleScatteringPass::execute(FrameContext& frame) {
     single.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     sigmaSPrime.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
     sigmaA.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
-    if (frame.restricted()) {
+    if (frame.restricted() && frame.outputs == FrameOutputs::Everything) {
         // Exported whole; the pass writes only the points' region.
         single.clear();
         sigmaSPrime.clear();
         sigmaA.clear();
-        if (base_ == SingleScatteringBase::Radiance) {
-            resources.texture("scatteredRadiance").clear();
-        }
+    }
+    if (frame.restricted() && base_ == SingleScatteringBase::Radiance) {
+        resources.texture("scatteredRadiance").clear();
     }
     stages_.runOverRegion(lights.lightCount.x > 0 ? Lights : HeadLight, frame.region(0));
     glMemoryBarrier(kImageBarriers);

@@ -89,8 +89,8 @@ PassOutputs runPass(PassHarness& harness, SurfaceInputs& inputs,
         normals.insert(normals.end(), {float(n.x), float(n.y), float(n.z), 0.0f});
         const Rgb& a = inputs.albedo[i];
         albedo.insert(albedo.end(), {float(a[0]), float(a[1]), float(a[2]), 1.0f});
-        const float base = std::isinf(inputs.depth[i]) ? 0.0f : 0.25f;
-        radiance.insert(radiance.end(), {base, base, base, 1.0f});
+        const float value = std::isinf(inputs.depth[i]) ? 0.0f : 0.25f;
+        radiance.insert(radiance.end(), {value, value, value, 1.0f});
     }
     Texture& normalTexture = resources.ensureTexture("normals", TextureFormat::RGBA16F, w, h);
     normalTexture.uploadFloats(normals);
@@ -519,6 +519,36 @@ TEST(SingleScatteringGLTest, NoPixelIsBrighterThanTheBoundAndTheBackgroundIsUnto
         }
         EXPECT_GT(lit, 500) << toString(method);  // the sculpture covers ~1/4 of 96x80
     }
+}
+
+}  // namespace
+}  // namespace subscan
+
+namespace subscan {
+namespace {
+
+TEST(SingleScatteringGLTest, PictureFramesSkipOnlyTheExports) {
+    // Frames for the picture alone leave the term and the coefficients unwritten; the picture
+    // itself must be byte for byte the exporting frame's.
+    const PointCloud cloud = makeSyntheticScene("sculpture?points=30000");
+    const Camera camera = orbitCamera(cloud.bounds, OrbitView{}, 64, 56, 45.0);
+    Renderer renderer(test::glTestContext(), cloud);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Sss;
+    settings.scattering.method = ScatteringMethod::Single;
+    settings.scattering.unit = SceneUnit::Centimetre;
+    settings.shading.lights = {{{-1.0f, 1.0f, 0.5f}, glm::vec3(0.8f)}};
+    renderer.render(camera, settings, FrameOutputs::Everything);
+    const std::vector<std::uint8_t> exported = renderer.readImage();
+    // A frame of another light for the picture alone: its term would differ, but stays unwritten.
+    settings.shading.lights[0].radiance = glm::vec3(2.0f);
+    const std::vector<float> term = renderer.resources().texture("singleScattering").readFloats();
+    renderer.render(camera, settings, FrameOutputs::Picture);
+    EXPECT_EQ(renderer.resources().texture("singleScattering").readFloats(), term);
+    EXPECT_NE(renderer.readImage(), exported);
+    settings.shading.lights[0].radiance = glm::vec3(0.8f);
+    renderer.render(camera, settings, FrameOutputs::Picture);
+    EXPECT_EQ(renderer.readImage(), exported);
 }
 
 }  // namespace
