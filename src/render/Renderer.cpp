@@ -65,13 +65,18 @@ PresentPass& Renderer::present(const std::string& color, const std::string& dept
 }
 
 void Renderer::appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes) {
-    if (method != ScatteringMethod::Single) {
-        passes.push_back(&cached(subsurfaceScattering_, sources_));
-    }
-    if (method == ScatteringMethod::Single) {
-        passes.push_back(&cached(singleScattering_, sources_, SingleScatteringBase::Radiance));
-    } else if (method == ScatteringMethod::Both) {
-        passes.push_back(&cached(singleAfterGaussian_, sources_, SingleScatteringBase::Scattered));
+    switch (method) {
+        case ScatteringMethod::Gaussian:
+            passes.push_back(&cached(subsurfaceScattering_, sources_));
+            break;
+        case ScatteringMethod::Single:
+            passes.push_back(&cached(singleScattering_, sources_, SingleScatteringBase::Radiance));
+            break;
+        case ScatteringMethod::Both:
+            passes.push_back(&cached(subsurfaceScattering_, sources_));
+            passes.push_back(
+                &cached(singleAfterGaussian_, sources_, SingleScatteringBase::Scattered));
+            break;
     }
 }
 

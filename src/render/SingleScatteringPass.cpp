@@ -1,8 +1,5 @@
 #include "render/SingleScatteringPass.h"
 
-#include <fmt/format.h>
-
-#include "core/Error.h"
 #include "render/ShadePass.h"
 #include "sss/Dipole.h"
 #include "sss/MaterialLibrary.h"
