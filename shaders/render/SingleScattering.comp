@@ -131,12 +131,6 @@ float planeCrossing(vec3 start, vec3 toLight, Probe inside) {
     return dot(inside.normal, inside.surfacePoint - start) / dot(inside.normal, toLight);
 }
 
-vec2 windowPosition(vec3 viewPosition) {
-    vec4 clip = frame.projection * vec4(viewPosition, 1.0);
-    vec2 ndc = clip.xy / clip.w;
-    return vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
-}
-
 /// Where a light entered on its way to a sample: the straight distance, the surface's normal
 /// there, and whether it was found.
 struct Entry {

@@ -20,6 +20,13 @@ vec3 linearToSrgb(vec3 c) {
     return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, greaterThan(c, vec3(0.0031308)));
 }
 
+/// The window position (pixels, row 0 at the top) a view-space point projects to.
+vec2 windowPosition(vec3 viewPosition) {
+    vec4 clip = frame.projection * vec4(viewPosition, 1.0);
+    vec2 ndc = clip.xy / clip.w;
+    return vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
+}
+
 /// Projects a view-space point to the pixel containing it (row 0 at the top) and its linear
 /// depth; false when it falls outside the image or the near/far range.
 bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
@@ -27,10 +34,7 @@ bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
     if (!(depth >= frame.depthRange.x && depth <= frame.depthRange.y)) {
         return false;
     }
-    vec4 clip = frame.projection * vec4(viewPosition, 1.0);
-    vec2 ndc = clip.xy / clip.w;
-    vec2 window = vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
-    pixel = ivec2(floor(window));
+    pixel = ivec2(floor(windowPosition(viewPosition)));
     return all(greaterThanEqual(pixel, ivec2(0))) && all(lessThan(pixel, imageSizeOfFrame()));
 }
 
