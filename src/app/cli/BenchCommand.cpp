@@ -74,15 +74,9 @@ std::vector<BenchMode> parseModes(const std::string& list) {
                     "(sss:gaussian, sss:single or sss:both)",
                     name));
             }
-            bool known = false;
-            for (const ScatteringMethod method :
-                 {ScatteringMethod::Gaussian, ScatteringMethod::Single, ScatteringMethod::Both}) {
-                if (toString(method) == suffix) {
-                    entry.method = method;
-                    known = true;
-                }
-            }
-            if (!known) {
+            try {
+                entry.method = parseScatteringMethod(suffix);
+            } catch (const Error&) {
                 throw Error(fmt::format(
                     "--modes entry '{}' names the unknown scattering method '{}' (expected "
                     "sss:gaussian, sss:single or sss:both)",

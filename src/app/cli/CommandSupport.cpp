@@ -24,6 +24,17 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
+std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text) {
+    glm::vec3 value;
+    char comma1 = 0, comma2 = 0;
+    std::istringstream stream(text);
+    stream >> value.r >> comma1 >> value.g >> comma2 >> value.b;
+    if (!stream || comma1 != ',' || comma2 != ',' || !stream.eof()) {
+        return std::nullopt;
+    }
+    return value;
+}
+
 void addResolutionOption(CLI::App& command, std::string& resolution) {
     command
         .add_option("--resolution", resolution,
@@ -86,15 +97,12 @@ void ScatteringOptions::apply(ScatteringSettings& settings) const {
         settings.coefficients = parseCoefficientSource(coefficients);
     }
     if (!meanFreePath.empty()) {
-        glm::vec3 path;
-        char comma1 = 0, comma2 = 0;
-        std::istringstream stream(meanFreePath);
-        stream >> path.r >> comma1 >> path.g >> comma2 >> path.b;
-        if (!stream || comma1 != ',' || comma2 != ',' || !stream.eof()) {
+        const std::optional<glm::vec3> path = parseCommaSeparatedRgb(meanFreePath);
+        if (!path) {
             throw Error(fmt::format("--mean-free-path '{}' is not R,G,B (three millimetre values)",
                                     meanFreePath));
         }
-        settings.meanFreePathMm = path;
+        settings.meanFreePathMm = *path;
     }
     if (eta) {
         settings.eta = *eta;

@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include <CLI/CLI.hpp>
+#include <glm/vec3.hpp>
 
 #include "io/ScanLoader.h"
 #include "render/ScatteringSettings.h"
@@ -14,6 +15,9 @@ namespace subscan::cli {
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".
 LoadedScan loadScanForCommand(std::string_view source);
+
+/// "R,G,B": three numbers separated by commas (no spaces), or nullopt when `text` is not that.
+std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text);
 
 /// `--resolution full|half|auto` (RasterSettings::resolution), as render and bench take it.
 void addResolutionOption(CLI::App& command, std::string& resolution);

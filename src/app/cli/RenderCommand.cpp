@@ -54,17 +54,13 @@ glm::vec3 parseBackground(const std::string& text) {
         const unsigned long value = std::stoul(text.substr(1), nullptr, 16);
         return glm::vec3((value >> 16) & 255, (value >> 8) & 255, value & 255) / 255.0f;
     }
-    glm::vec3 color;
-    char comma1 = 0, comma2 = 0;
-    std::istringstream stream(text);
-    stream >> color.r >> comma1 >> color.g >> comma2 >> color.b;
-    if (!stream || comma1 != ',' || comma2 != ',' || !stream.eof() ||
-        glm::any(glm::lessThan(color, glm::vec3(0.0f))) ||
-        glm::any(glm::greaterThan(color, glm::vec3(1.0f)))) {
+    const std::optional<glm::vec3> color = parseCommaSeparatedRgb(text);
+    if (!color || glm::any(glm::lessThan(*color, glm::vec3(0.0f))) ||
+        glm::any(glm::greaterThan(*color, glm::vec3(1.0f)))) {
         throw Error(
             fmt::format("--background '{}' is not R,G,B with values in 0..1 or #rrggbb", text));
     }
-    return color;
+    return *color;
 }
 
 bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
