@@ -27,7 +27,7 @@ shared uint occupiedCount;
 
 bool visibleAt(ivec2 pixel, float depth) {
     vec3 x = viewPositionAt(vec2(pixel) + 0.5, depth);
-    vec3 toCamera = normalize(-x);
+    vec3 toCamera = towardsEye(x);
     float maxLevel = clamp(levelForRadius(surface.visibility.x, depth), 0.0,
                            float(levelCount() - 1u));
     uint levels = uint(maxLevel);

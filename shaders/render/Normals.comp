@@ -54,11 +54,11 @@ void main() {
     float length2 = dot(normal, normal);
     // Degenerate (a 1-texel level, or infinite depth): face the camera.
     normal = length2 > 0.0 && !isinf(length2) && !isnan(length2) ? normal * inversesqrt(length2)
-                                                                  : normalize(-centre);
+                                                                  : towardsEye(centre);
     if (isnan(normal.x)) {
         normal = vec3(0.0, 0.0, 1.0);
     }
-    if (dot(normal, -centre) < 0.0) {
+    if (dot(normal, towardsEye(centre)) < 0.0) {
         normal = -normal;
     }
     normalPyramid[texelIndex(level, texel)] = vec4(normal, 0.0);

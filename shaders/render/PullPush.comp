@@ -70,7 +70,8 @@ void main() {
         depths[c] = weight > 0.0 ? value.x / weight : kInfinity;
         front = min(front, depths[c]);
     }
-    float tolerance = surface.fill.z * float(1u << level) * front / frame.depthRange.z;
+    float tolerance = surface.fill.z * float(1u << level) * projectiveDepth(front) /
+                      frame.depthRange.z;
     float weightSum = 0.0;
     vec4 valueSum = vec4(0.0);
     for (int c = 0; c < 16; ++c) {

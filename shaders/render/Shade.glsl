@@ -11,6 +11,57 @@ layout(std140, binding = SUBSCAN_UBO_PASS) uniform ShadeBlock {
     ShadeParams shade;
 };
 
+layout(binding = SUBSCAN_TEXTURES_LIGHT_DEPTH) uniform sampler2D lightDepth[SUBSCAN_MAX_LIGHTS];
+
+/// Bilinear percentage-closer test of light `light`'s map around texel position `texel`
+/// (continuous, texel i spans [i, i + 1)): each of the 4 nearest texels is lit when its depth
+/// is not in front of the receiver's plane there by more than the bias.
+float litFraction(uint light, vec2 texel, float depth, vec2 slope) {
+    vec2 base = floor(texel - 0.5);
+    vec2 f = texel - 0.5 - base;
+    // Texels (0, 0), (1, 0), (0, 1), (1, 1) from `base`, clamped to the map (its border is empty).
+    ivec2 last = ivec2(shade.lightMap[light].yz) - 1;
+    ivec2 first = ivec2(base);
+    vec4 stored;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 at = clamp(first + ivec2(k % 2, k / 2), ivec2(0), last);
+        stored[k] = texelFetch(lightDepth[light], at, 0).r;
+    }
+    vec4 dx = vec4(0.0, 1.0, 0.0, 1.0) - f.x;
+    vec4 dy = vec4(0.0, 0.0, 1.0, 1.0) - f.y;
+    // A texel holds the depth of its nearest point, anywhere inside it, or where it holds
+    // none, what pull-push fills in from coarser levels biased towards the front: up to a
+    // texel's slope in front of the plane's value at its centre.
+    float tolerance = shade.shadow.x + abs(slope.x) + abs(slope.y);
+    vec4 receiver = depth + slope.x * dx + slope.y * dy - tolerance;
+    vec4 lit = vec4(greaterThanEqual(stored, receiver));
+    vec4 weight = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    return dot(lit, weight);
+}
+
+/// The share of directional light `light` that reaches view-space `position` with surface
+/// normal `normal` past the cloud's own surface, seen from the light (its light map): 4
+/// bilinear percentage-closer tests a soft edge's width apart, each texel compared with the
+/// receiver's tangent plane at that texel (no acne on tilted surfaces) less the bias.
+float shadowing(uint light, vec3 position, vec3 normal) {
+    vec4 map = shade.lightMap[light];
+    vec3 inLight = (shade.lightFromView[light] * vec4(position, 1.0)).xyz;
+    vec3 normalInLight = mat3(shade.lightFromView[light]) * normal;
+    // Texel coordinates: the map's view is centred on its axis, row 0 at the top.
+    vec2 texel = vec2(inLight.x, -inLight.y) * map.x + 0.5 * map.yz;
+    // Depth change per texel along the receiver's plane; the steepest 80 degrees.
+    const float kSteepest = 5.67;
+    vec2 slope = clamp(vec2(normalInLight.x, -normalInLight.y) / max(normalInLight.z, 1e-3),
+                       -kSteepest, kSteepest) / map.x;
+    float spread = 0.25 * shade.shadow.y * map.x;
+    float lit = 0.0;
+    for (int tap = 0; tap < 4; ++tap) {
+        vec2 offset = spread * vec2(tap % 2 == 0 ? -1.0 : 1.0, tap < 2 ? -1.0 : 1.0);
+        lit += litFraction(light, texel + offset, -inLight.z + dot(slope, offset), slope);
+    }
+    return 0.25 * lit;
+}
+
 void addLight(vec3 direction, vec3 radiance, vec3 normal, vec3 toEye, inout vec3 diffuse,
               inout vec3 specular) {
     float cosine = dot(normal, direction);
@@ -34,8 +85,11 @@ void shadePixel(ivec2 pixel, float depth, vec3 normal, vec3 albedo, out vec3 dif
     addLight(toEye, shade.headLight.rgb, normal, toEye, irradiance, specular);
 #if SHADE_DIRECTIONAL_LIGHTS
     for (uint i = 0u; i < shade.lightCount.x; ++i) {
-        addLight(shade.lightDirection[i].xyz, shade.lightColor[i].rgb, normal, toEye, irradiance,
-                 specular);
+        vec3 radiance = shade.lightColor[i].rgb;
+        if (shade.lightMap[i].w > 0.0 && dot(normal, shade.lightDirection[i].xyz) > 0.0) {
+            radiance *= shadowing(i, position, normal);
+        }
+        addLight(shade.lightDirection[i].xyz, radiance, normal, toEye, irradiance, specular);
     }
 #endif
     diffuse = albedo * irradiance;

@@ -75,7 +75,7 @@ void main() {
     imageStore(outSum, pixel, vec4(scatter.weight.rgb * source, 1.0));
 #elif STAGE_BLUR || STAGE_BLUR_ACCUMULATE
     float sigma = scatter.blur.x;
-    float sigmaPixels = sigma * frame.depthRange.z / depth;
+    float sigmaPixels = sigma * frame.depthRange.z / projectiveDepth(depth);
     float reach = 3.0 * sigmaPixels;
     int maxTaps = int(scatter.blur.y);
     // Every pixel while the kernel fits the tap budget; a larger stride beyond it.

@@ -51,6 +51,11 @@ using mat4 = glm::mat4;
 #define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
 #define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
 
+// ---- textures read with texelFetch/textureGather ----
+// sampler2D per directional light (units 9 .. 9 + SUBSCAN_MAX_LIGHTS - 1): its light map, the
+// linear depth of the cloud's reconstruction seen from the light (+inf: nothing)
+#define SUBSCAN_TEXTURES_LIGHT_DEPTH 9
+
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0
 #define SUBSCAN_IMAGE_OUT1 1
@@ -78,7 +83,8 @@ struct FrameParams {
     mat4 viewFromCloud;  // cloud-relative positions -> view space (built in double on the CPU)
     mat4 projection;     // view -> clip, OpenGL convention
     vec4 viewport;       // width, height, 1 / width, 1 / height
-    vec4 depthRange;     // near, far, focal length in pixels, unused
+    vec4 depthRange;     // near, far, focal length in pixels (orthographic: pixels per unit),
+                         // w: 1 for an orthographic view (a light's), 0 for a pinhole camera
     vec4 background;     // linear RGB, alpha unused
 };
 
@@ -121,6 +127,11 @@ struct ShadeParams {
     vec4 lightDirection[SUBSCAN_MAX_LIGHTS];
     vec4 lightColor[SUBSCAN_MAX_LIGHTS];
     uvec4 lightCount;  // x: how many of the directional lights are used
+    // Shadows (LightMaps): per light, view space -> its light map's view space, and the map's
+    // x: texels per scene unit, y: width, z: height (texels), w: 1 when it casts shadows.
+    mat4 lightFromView[SUBSCAN_MAX_LIGHTS];
+    vec4 lightMap[SUBSCAN_MAX_LIGHTS];
+    vec4 shadow;  // x: depth bias, y: width of a shadow's soft edge (both scene units)
 };
 
 // SubsurfaceScattering: one dispatch of the blur chain (DESIGN.md §6.1).
@@ -149,7 +160,8 @@ static_assert(sizeof(ScatterParams) == 48);
 static_assert(sizeof(SingleScatterParams) == 96);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
 static_assert(sizeof(SurfaceParams) == 64);
-static_assert(sizeof(ShadeParams) == 3 * 16 + 2 * SUBSCAN_MAX_LIGHTS * 16 + 16);
+static_assert(sizeof(ShadeParams) ==
+              3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 + SUBSCAN_MAX_LIGHTS * 64 + 16);
 static_assert(sizeof(FrameParams) == 2 * 64 + 3 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);

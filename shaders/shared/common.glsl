@@ -40,15 +40,25 @@ bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
 
 vec3 unpackColor(uint rgba8) { return srgbToLinear(unpackUnorm4x8(rgba8).rgb); }
 
+/// What a length at linear depth `depth` is divided by to give its size in pixels / focal
+/// length: the depth itself through a pinhole, 1 in an orthographic view (FrameParams).
+float projectiveDepth(float depth) { return frame.depthRange.w > 0.0 ? 1.0 : depth; }
+
 /// View-space position of a point seen at window position `window` (full-resolution pixels,
 /// row 0 at the top; a pixel's centre is its index + 0.5) at linear depth `depth`.
 vec3 viewPositionAt(vec2 window, float depth) {
     float focal = frame.depthRange.z;
     vec2 centred = vec2(window.x - 0.5 * frame.viewport.x, 0.5 * frame.viewport.y - window.y);
-    return vec3(centred * (depth / focal), -depth);
+    return vec3(centred * (projectiveDepth(depth) / focal), -depth);
 }
 
 /// The pyramid level whose texels span `worldRadius` at `depth` (fractional, unclamped).
 float levelForRadius(float worldRadius, float depth) {
-    return log2(worldRadius * frame.depthRange.z / depth);
+    return log2(worldRadius * frame.depthRange.z / projectiveDepth(depth));
+}
+
+/// The unit direction from view-space `position` towards the eye: along +z in an
+/// orthographic view, where every ray is parallel.
+vec3 towardsEye(vec3 position) {
+    return frame.depthRange.w > 0.0 ? vec3(0.0, 0.0, 1.0) : normalize(-position);
 }

@@ -12,12 +12,20 @@
 namespace subscan {
 
 glm::dmat4 Camera::projection() const {
+    if (orthographic()) {
+        const double halfHeight = 0.5 * orthographicHeight;
+        const double halfWidth = halfHeight * width / static_cast<double>(height);
+        return glm::ortho(-halfWidth, halfWidth, -halfHeight, halfHeight, nearPlane, farPlane);
+    }
     return glm::perspective(glm::radians(fovyDegrees),
                             static_cast<double>(width) / static_cast<double>(height), nearPlane,
                             farPlane);
 }
 
 double Camera::focalLengthPixels() const {
+    if (orthographic()) {
+        return static_cast<double>(height) / orthographicHeight;
+    }
     return 0.5 * static_cast<double>(height) / std::tan(0.5 * glm::radians(fovyDegrees));
 }
 
@@ -38,9 +46,7 @@ glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds) {
     glm::dvec2 low(std::numeric_limits<double>::infinity());
     glm::dvec2 high(-std::numeric_limits<double>::infinity());
     for (int corner = 0; corner < 8; ++corner) {
-        const glm::dvec3 p((corner & 1) ? bounds.max.x : bounds.min.x,
-                           (corner & 2) ? bounds.max.y : bounds.min.y,
-                           (corner & 4) ? bounds.max.z : bounds.min.z);
+        const glm::dvec3 p = bounds.corner(corner);
         const glm::dvec4 viewPosition = camera.view * glm::dvec4(p, 1.0);
         if (!(-viewPosition.z > camera.nearPlane)) {
             return whole;

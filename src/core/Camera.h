@@ -20,9 +20,14 @@ struct Camera {
     double nearPlane = 0.01;
     double farPlane = 100.0;
     glm::dmat4 view{1.0};
+    /// > 0: an orthographic camera (a directional light's view) whose image is this many scene
+    /// units tall; fovyDegrees is then unused. 0: a pinhole camera.
+    double orthographicHeight = 0.0;
 
+    bool orthographic() const { return orthographicHeight > 0.0; }
     glm::dmat4 projection() const;
-    /// Pixels per unit of (view-space x or y) / depth: f = height / (2 tan(fovy / 2)).
+    /// Pinhole: pixels per unit of (view-space x or y) / depth, f = height / (2 tan(fovy / 2)).
+    /// Orthographic: pixels per scene unit, height / orthographicHeight.
     double focalLengthPixels() const;
     /// Eye position in file coordinates.
     glm::dvec3 eye() const;

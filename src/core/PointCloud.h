@@ -35,6 +35,10 @@ struct Bounds {
     bool empty() const { return !(min.x <= max.x); }
     glm::dvec3 center() const { return 0.5 * (min + max); }
     glm::dvec3 extent() const { return max - min; }
+    /// Corner 0..7: bit 0 picks max.x over min.x, bit 1 max.y, bit 2 max.z.
+    glm::dvec3 corner(int i) const {
+        return {(i & 1) ? max.x : min.x, (i & 2) ? max.y : min.y, (i & 4) ? max.z : min.z};
+    }
     void add(const glm::dvec3& p) {
         min = glm::min(min, p);
         max = glm::max(max, p);
@@ -73,7 +77,7 @@ struct PointAttributes {
 /// would be undefined behaviour); NaN stays NaN.
 inline float saturateToFloat(double value) {
     constexpr double kLargest = std::numeric_limits<float>::max();
-    return value > kLargest ? std::numeric_limits<float>::infinity()
+    return value > kLargest    ? std::numeric_limits<float>::infinity()
            : value < -kLargest ? -std::numeric_limits<float>::infinity()
                                : static_cast<float>(value);
 }

@@ -15,7 +15,8 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
                       1.0f / static_cast<float>(camera.width),
                       1.0f / static_cast<float>(camera.height)};
     frame.depthRange = {static_cast<float>(camera.nearPlane), static_cast<float>(camera.farPlane),
-                        static_cast<float>(camera.focalLengthPixels()), 0.0f};
+                        static_cast<float>(camera.focalLengthPixels()),
+                        camera.orthographic() ? 1.0f : 0.0f};
     const glm::vec3& background = settings.raster.backgroundSrgb;
     frame.background = {srgbToLinear(background.r), srgbToLinear(background.g),
                         srgbToLinear(background.b), 1.0f};

@@ -51,20 +51,6 @@ RasterPath RasterizePointsPass::resolvePath(RasterPath requested,
     return requested;
 }
 
-void RasterizePointsPass::ensurePixelStorage(int width, int height, bool int64) {
-    if (int64) {
-        const std::size_t bytes = static_cast<std::size_t>(width) *
-                                  static_cast<std::size_t>(height) * sizeof(std::uint64_t);
-        if (depthIndex_.size() != bytes) {
-            depthIndex_ = Buffer(bytes, nullptr, "RasterizePoints.key");
-        }
-        return;
-    }
-    if (pointIndex_.width() != width || pointIndex_.height() != height) {
-        pointIndex_ = Texture(TextureFormat::R32UI, width, height, "RasterizePoints.index");
-    }
-}
-
 void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& frame, bool perPixel) {
     program.use();
     const TexelRegion region = frame.cloudRegion();
@@ -87,11 +73,11 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
     }
 }
 
-std::vector<std::uint32_t> RasterizePointsPass::readWinners() const {
+std::vector<std::uint32_t> RasterizePointsPass::readWinners(const FrameResources& resources) const {
     if (!lastFrameInt64_) {
-        return pointIndex_.readUints();
+        return resources.texture("pointIndex").readUints();
     }
-    const std::vector<std::uint64_t> keys = depthIndex_.read<std::uint64_t>();
+    const std::vector<std::uint64_t> keys = resources.buffer("depthIndex").read<std::uint64_t>();
     std::vector<std::uint32_t> winners(keys.size());
     for (std::size_t i = 0; i < keys.size(); ++i) {
         winners[i] = static_cast<std::uint32_t>(keys[i] & 0xFFFFFFFFu);
@@ -105,7 +91,6 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     const bool int64 =
         resolvePath(frame.settings.raster.path, frame.capabilities) == RasterPath::Int64;
     lastFrameInt64_ = int64;
-    ensurePixelStorage(width, height, int64);
     Texture& depth = frame.resources.ensureTexture("depth", TextureFormat::R32F, width, height);
     Texture& color = frame.resources.ensureTexture("color", TextureFormat::RGBA16F, width, height);
 
@@ -114,21 +99,27 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     depth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
     color.clear();
     if (int64) {
-        depthIndex_.fill(kEmptyIndex);  // both halves all ones: no depth, no point
-        depthIndex_.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
+        const std::size_t pixels =
+            static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+        Buffer& depthIndex =
+            frame.resources.ensureBuffer("depthIndex", pixels * sizeof(std::uint64_t));
+        depthIndex.fill(kEmptyIndex);  // both halves all ones: no depth, no point
+        depthIndex.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
         runPerChunk(int64Stage_, frame, false);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         depth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     } else {
-        pointIndex_.clearUint(kEmptyIndex);
+        Texture& pointIndex =
+            frame.resources.ensureTexture("pointIndex", TextureFormat::R32UI, width, height);
+        pointIndex.clearUint(kEmptyIndex);
         depth.bindImageBits(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
         runPerChunk(depthStage_, frame, false);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         depth.bindImageBits(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-        pointIndex_.bindImage(SUBSCAN_IMAGE_OUT2, GL_READ_WRITE);
+        pointIndex.bindImage(SUBSCAN_IMAGE_OUT2, GL_READ_WRITE);
         runPerChunk(indexStage_, frame, false);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        pointIndex_.bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+        pointIndex.bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     }
     color.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     runPerChunk(int64 ? resolve64_ : resolve32_, frame, true);

@@ -11,6 +11,8 @@ namespace subscan {
 /// ties to the smaller index. Writes "depth" (R32F linear depth, +inf where empty) and "color"
 /// (RGBA16F linear). One 64-bit atomicMin pass where the driver has 64-bit atomics, else two
 /// 32-bit passes (depth, then index among points at that depth); both give the same winner.
+/// Its per-pixel words live in the frame's resources ("depthIndex" or "pointIndex"), so one
+/// pass serves views of any size (the camera's, the lights').
 class RasterizePointsPass final : public RenderPass {
   public:
     RasterizePointsPass(const ShaderSources& sources, const GlCapabilities& capabilities);
@@ -24,12 +26,12 @@ class RasterizePointsPass final : public RenderPass {
     /// forced without 64-bit atomics.
     static RasterPath resolvePath(RasterPath requested, const GlCapabilities& capabilities);
 
-    /// The winning point index per pixel of the last frame (0xFFFFFFFF where empty), row 0 at
-    /// the top: for checking the rasterizer against a CPU reference.
-    std::vector<std::uint32_t> readWinners() const;
+    /// The winning point index per pixel of the last frame rendered into `resources`
+    /// (0xFFFFFFFF where empty), row 0 at the top: for checking the rasterizer against a CPU
+    /// reference.
+    std::vector<std::uint32_t> readWinners(const FrameResources& resources) const;
 
   private:
-    void ensurePixelStorage(int width, int height, bool int64);
     void runPerChunk(const Program& program, FrameContext& frame, bool perPixel);
 
     Program depthStage_;
@@ -38,8 +40,6 @@ class RasterizePointsPass final : public RenderPass {
     Program int64Stage_;  // only where 64-bit atomics exist
     Program resolve64_;
     UniformBlock<gpu::RasterParams> params_{"RasterizePoints.params"};
-    Texture pointIndex_;  // R32UI, the two-pass path's winners
-    Buffer depthIndex_;   // the 64-bit path's keys
     bool lastFrameInt64_ = false;
 };
 

@@ -1,7 +1,9 @@
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/Camera.h"
@@ -13,6 +15,8 @@
 #include "shared/bindings.h"
 
 namespace subscan {
+
+class LightMaps;
 
 /// What a frame must leave in Renderer::resources(): the picture ("image", and in the surface
 /// modes "surfaceDepth", which the viewer picks the orbit centre from), or every image its
@@ -43,6 +47,8 @@ struct FrameContext {
     /// point lands outside them. Unset: anywhere in the image.
     std::optional<glm::ivec4> cloudPixels;
     FrameOutputs outputs = FrameOutputs::Everything;
+    /// The directional lights' maps, current for this frame's settings; null: no shadows.
+    const LightMaps* lightMaps = nullptr;
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }
@@ -83,5 +89,15 @@ class RenderPass {
     virtual std::vector<std::string_view> outputs() const = 0;
     virtual void execute(FrameContext& frame) = 0;
 };
+
+/// The pass in `slot`, built from `arguments` on first use: a frame compiles the shaders of
+/// the passes it runs, not of every mode.
+template <class Pass, class... Arguments>
+Pass& lazyPass(std::unique_ptr<Pass>& slot, Arguments&&... arguments) {
+    if (!slot) {
+        slot = std::make_unique<Pass>(std::forward<Arguments>(arguments)...);
+    }
+    return *slot;
+}
 
 }  // namespace subscan

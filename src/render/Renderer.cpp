@@ -8,13 +8,8 @@
 #include "core/Error.h"
 #include "core/Spacing.h"
 #include "render/DrawPointsPass.h"
-#include "render/FillRemovalPass.h"
 #include "render/FinishSurfacePass.h"
-#include "render/HiddenPointRemovalPass.h"
-#include "render/MinDepthPyramidPass.h"
-#include "render/NormalsPass.h"
 #include "render/PresentPass.h"
-#include "render/PullPushPass.h"
 #include "render/RasterizePointsPass.h"
 #include "render/ShadePass.h"
 #include "render/SingleScatteringPass.h"
@@ -35,14 +30,6 @@ double usableSpacing(const PointCloud& cloud, std::optional<double> spacing) {
     return diagonal > 0.0 ? 1e-3 * diagonal : 1e-3;
 }
 
-template <class Pass, class... Arguments>
-Pass& cached(std::unique_ptr<Pass>& slot, Arguments&&... arguments) {
-    if (!slot) {
-        slot = std::make_unique<Pass>(std::forward<Arguments>(arguments)...);
-    }
-    return *slot;
-}
-
 }  // namespace
 
 double FrameResult::totalMilliseconds() const {
@@ -56,63 +43,66 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
       cloud_(cloud, context.capabilities(), maxChunkPoints),
       spacing_(usableSpacing(cloud, spacing)),
       resolutionChooser_(cloud),
-      cloudBounds_(cloud.bounds) {}
+      cloudBounds_(cloud.bounds),
+      reconstruction_(sources_, context.capabilities()),
+      lightMaps_(context, reconstruction_) {}
 
 Renderer::~Renderer() = default;
 
 PresentPass& Renderer::present(const std::string& color, const std::string& depth) {
-    return cached(presents_[{color, depth}], sources_, color, depth);
+    return lazyPass(presents_[{color, depth}], sources_, color, depth);
 }
 
 void Renderer::appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes) {
     switch (method) {
         case ScatteringMethod::Gaussian:
-            passes.push_back(&cached(subsurfaceScattering_, sources_));
+            passes.push_back(&lazyPass(subsurfaceScattering_, sources_));
             break;
         case ScatteringMethod::Single:
-            passes.push_back(&cached(singleScattering_, sources_, SingleScatteringBase::Radiance));
+            passes.push_back(
+                &lazyPass(singleScattering_, sources_, SingleScatteringBase::Radiance));
             break;
         case ScatteringMethod::Both:
-            passes.push_back(&cached(subsurfaceScattering_, sources_));
+            passes.push_back(&lazyPass(subsurfaceScattering_, sources_));
             passes.push_back(
-                &cached(singleAfterGaussian_, sources_, SingleScatteringBase::Scattered));
+                &lazyPass(singleAfterGaussian_, sources_, SingleScatteringBase::Scattered));
             break;
     }
+}
+
+void Renderer::appendPoints(RenderMode mode, std::vector<RenderPass*>& passes) {
+    if (mode == RenderMode::PointsGl || mode == RenderMode::Splats) {
+        passes.push_back(&lazyPass(drawPoints_, sources_));
+    } else {
+        reconstruction_.appendRasterization(passes);
+    }
+}
+
+void Renderer::appendShading(bool split, std::vector<RenderPass*>& passes) {
+    passes.push_back(split ? &lazyPass(shadeSplit_, sources_, ShadeOutputs::Split)
+                           : &lazyPass(shade_, sources_, ShadeOutputs::Radiance));
 }
 
 std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, LevelZero levelZero) {
     const RasterSettings& raster = settings.raster;
     std::vector<RenderPass*> passes;
-    if (raster.mode == RenderMode::PointsGl || raster.mode == RenderMode::Splats) {
-        passes.push_back(&cached(drawPoints_, sources_));
-    } else {
-        passes.push_back(&cached(rasterize_, sources_, capabilities()));
-    }
+    appendPoints(raster.mode, passes);
     const bool stageView = !isFinalImage(raster.stage);
     const bool surface = reconstructsSurface(raster.mode);
     const bool scatters = raster.mode == RenderMode::Sss && raster.stage == Stage::Final;
     if (surface) {
-        passes.push_back(&cached(minDepthPyramid_, sources_));
-        passes.push_back(&cached(hiddenPointRemoval_, sources_));
-        PullPushPass& pullPush = cached(pullPush_, sources_);
-        FillRemovalPass& fillRemoval = cached(fillRemoval_, sources_);
-        NormalsPass& normals = cached(normals_, sources_);
-        pullPush.setLevelZero(levelZero);
-        fillRemoval.setLevelZero(levelZero);
-        normals.setLevelZero(levelZero);
-        passes.insert(passes.end(), {&pullPush, &fillRemoval, &normals});
+        reconstruction_.appendSurface(passes, levelZero);
         if (levelZero == LevelZero::Fused) {
-            passes.push_back(&cached(finishSurface_, sources_));
+            passes.push_back(&lazyPass(finishSurface_, sources_));
             return passes;
         }
-        passes.push_back(scatters ? &cached(shadeSplit_, sources_, ShadeOutputs::Split)
-                                  : &cached(shade_, sources_, ShadeOutputs::Radiance));
+        appendShading(scatters, passes);
     } else if (stageView && raster.stage != Stage::Depth) {
         throw Error(fmt::format("the stage '{}' exists only in the surface and sss modes",
                                 toString(raster.stage)));
     }
     if (stageView) {
-        passes.push_back(&cached(stageViews_[raster.stage], sources_, raster.stage));
+        passes.push_back(&lazyPass(stageViews_[raster.stage], sources_, raster.stage));
         passes.push_back(&present("stage", ""));
     } else if (scatters) {
         appendScattering(settings.scattering.method, passes);
@@ -139,6 +129,14 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
         runnerTiming_ = settings.raster.timing;
     }
 
+    // The lights' views first: their maps are current before the camera's shading reads them.
+    const bool shadows = reconstructsSurface(settings.raster.mode) &&
+                         isFinalImage(settings.raster.stage) && settings.shading.castsShadows();
+    std::vector<PassTiming> lightTimings;
+    if (shadows) {
+        lightTimings = lightMaps_.update(cloud_, cloudBounds_, settings, spacing_, *runner_);
+    }
+
     // The point modes draw every pixel: at reduced resolution they would lose points.
     const int divisor = reconstructsSurface(settings.raster.mode)
                             ? resolutionChooser_.divisor(settings.raster.resolution, camera,
@@ -158,11 +156,14 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
                          resourcesFor(divisor), layout, spacing_};
     context.cloudPixels = projectedPixelBounds(pipelineCamera_, cloudBounds_);
     context.outputs = outputs;
+    context.lightMaps = shadows ? &lightMaps_ : nullptr;
     if (divisor != 1) {
         context.divisor = divisor;
         context.reducedFrom = glm::ivec2(camera.width, camera.height);
     }
-    return {runner_->run(passes, context), divisor};
+    std::vector<PassTiming> timings = runner_->run(passes, context);
+    timings.insert(timings.begin(), lightTimings.begin(), lightTimings.end());
+    return {std::move(timings), divisor};
 }
 
 std::vector<std::uint8_t> Renderer::readImage() const {
@@ -170,7 +171,7 @@ std::vector<std::uint8_t> Renderer::readImage() const {
 }
 
 std::size_t Renderer::resourceBytes() const {
-    return fullResources_.bytes() + reducedResources_.bytes();
+    return fullResources_.bytes() + reducedResources_.bytes() + lightMaps_.bytes();
 }
 
 }  // namespace subscan

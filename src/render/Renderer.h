@@ -15,7 +15,9 @@
 #include "render/FrameResources.h"
 #include "render/FrameUniforms.h"
 #include "render/GpuPointCloud.h"
+#include "render/LightMaps.h"
 #include "render/PassRunner.h"
+#include "render/Reconstruction.h"
 #include "render/ReducedResolution.h"
 #include "render/RenderSettings.h"
 #include "shared/bindings.h"
@@ -24,12 +26,7 @@ namespace subscan {
 
 class RasterizePointsPass;
 class DrawPointsPass;
-class MinDepthPyramidPass;
-class HiddenPointRemovalPass;
-class PullPushPass;
-class FillRemovalPass;
 class FinishSurfacePass;
-class NormalsPass;
 class ShadePass;
 class StageViewPass;
 class SubsurfaceScatteringPass;
@@ -73,10 +70,18 @@ class Renderer {
     /// Output pixels per pipeline pixel and side in the last frame (FrameResult::divisor).
     int pipelineDivisor() const { return lastDivisor_; }
     /// The compute rasterizer, once a frame has used it (null before).
-    const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
+    const RasterizePointsPass* rasterizePass() const { return reconstruction_.rasterizePass(); }
+    /// The directional lights' maps (shadows), as the last frame that cast shadows left them.
+    const LightMaps& lightMaps() const { return lightMaps_; }
 
   private:
+    /// The frame as named sub-pipelines: points -> reconstruction -> shading -> scattering ->
+    /// present (or a stage view).
     std::vector<RenderPass*> passesFor(const RenderSettings& settings, LevelZero levelZero);
+    /// The points as the mode draws them: compute-rasterized, or GL_POINTS for the baselines.
+    void appendPoints(RenderMode mode, std::vector<RenderPass*>& passes);
+    /// Deferred shading of the reconstructed surface, split into its parts for scattering.
+    void appendShading(bool split, std::vector<RenderPass*>& passes);
     /// The scattering passes of the sss mode's final picture, by ScatteringSettings::method.
     void appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes);
     PresentPass& present(const std::string& color, const std::string& depth);
@@ -100,13 +105,9 @@ class Renderer {
     FrameResources fullResources_;
     FrameResources reducedResources_;
     FrameUniforms uniforms_;
-    std::unique_ptr<RasterizePointsPass> rasterize_;
+    Reconstruction reconstruction_;  // for the camera and the lights
+    LightMaps lightMaps_;
     std::unique_ptr<DrawPointsPass> drawPoints_;
-    std::unique_ptr<MinDepthPyramidPass> minDepthPyramid_;
-    std::unique_ptr<HiddenPointRemovalPass> hiddenPointRemoval_;
-    std::unique_ptr<PullPushPass> pullPush_;
-    std::unique_ptr<FillRemovalPass> fillRemoval_;
-    std::unique_ptr<NormalsPass> normals_;
     std::unique_ptr<FinishSurfacePass> finishSurface_;
     std::unique_ptr<ShadePass> shade_;
     std::unique_ptr<ShadePass> shadeSplit_;

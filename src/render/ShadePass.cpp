@@ -4,6 +4,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "render/LightMaps.h"
+
 namespace subscan {
 
 ShadePass::ShadePass(const ShaderSources& sources, ShadeOutputs outputs)
@@ -18,7 +20,9 @@ std::vector<std::string_view> ShadePass::outputs() const {
     return {"radiance"};
 }
 
-gpu::ShadeParams ShadePass::parameters(const ShadingSettings& settings, const Camera& camera) {
+gpu::ShadeParams ShadePass::parameters(const FrameContext& frame) {
+    const ShadingSettings& settings = frame.settings.shading;
+    const Camera& camera = frame.camera;
     gpu::ShadeParams params{};
     params.headLight = glm::vec4(settings.headLight, 0.0f);
     params.ambient = glm::vec4(settings.ambient, 0.0f);
@@ -31,6 +35,9 @@ gpu::ShadeParams ShadePass::parameters(const ShadingSettings& settings, const Ca
         params.lightColor[i] = glm::vec4(settings.lights[i].radiance, 0.0f);
     }
     params.lightCount = {static_cast<std::uint32_t>(count), 0, 0, 0};
+    if (frame.lightMaps != nullptr) {
+        frame.lightMaps->prepareShading(params, camera, settings, frame.spacing);
+    }
     return params;
 }
 
@@ -39,7 +46,7 @@ void ShadePass::execute(FrameContext& frame) {
     const int width = frame.width();
     const int height = frame.height();
     Texture& radiance = resources.ensureTexture("radiance", TextureFormat::RGBA16F, width, height);
-    params_.set(parameters(frame.settings.shading, frame.camera));
+    params_.set(parameters(frame));
     params_.bind(SUBSCAN_UBO_PASS);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     resources.texture("normals").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);

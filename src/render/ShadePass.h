@@ -23,8 +23,9 @@ class ShadePass final : public RenderPass {
     std::vector<std::string_view> outputs() const override;
     void execute(FrameContext& frame) override;
 
-    /// The shader's parameters for these settings and camera (directions into view space).
-    static gpu::ShadeParams parameters(const ShadingSettings& settings, const Camera& camera);
+    /// The shader's parameters for the frame's settings and camera (directions into view
+    /// space); with the frame's light maps, also their shadow parameters, and the maps bound.
+    static gpu::ShadeParams parameters(const FrameContext& frame);
 
   private:
     ShadeOutputs outputs_;

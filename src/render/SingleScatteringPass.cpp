@@ -74,7 +74,7 @@ void SingleScatteringPass::execute(FrameContext& frame) {
     Texture& sigmaA = resources.ensureTexture("sigmaA", TextureFormat::RGBA32F, width, height);
     params_.set(params);
     params_.bind(SUBSCAN_UBO_PASS);
-    const gpu::ShadeParams lights = ShadePass::parameters(frame.settings.shading, frame.camera);
+    const gpu::ShadeParams lights = ShadePass::parameters(frame);
     lights_.set(lights);
     lights_.bind(SUBSCAN_UBO_LIGHTS);
     albedoRoots_.bindTexels(SUBSCAN_TEXELS_ALBEDO_ROOTS, TextureFormat::R32F);

@@ -44,16 +44,32 @@ void to_json(nlohmann::json& json, const ShadingSettings& settings) {
         {"specular", settings.specular},
         {"shininess", settings.shininess},
         {"lights", lights},
+        {"shadows", settings.shadows},
+        {"shadow_bias", settings.shadowBias},
+        {"shadow_softness", settings.shadowSoftness},
+        {"light_map_resolution", settings.lightMapResolution},
     };
 }
 
 void from_json(const nlohmann::json& json, ShadingSettings& settings) {
     rejectUnknownKeys(json, "shading",
-                      {"head_light", "ambient", "specular", "shininess", "lights"});
+                      {"head_light", "ambient", "specular", "shininess", "lights", "shadows",
+                       "shadow_bias", "shadow_softness", "light_map_resolution"});
     readSetting(json, "head_light", settings.headLight, 0.0f, 100.0f);
     readSetting(json, "ambient", settings.ambient, 0.0f, 100.0f);
     readSetting(json, "specular", settings.specular, 0.0f, 1.0f);
     readSetting(json, "shininess", settings.shininess, 1.0f, 10000.0f);
+    readSetting(json, "shadows", settings.shadows);
+    readSetting(json, "shadow_bias", settings.shadowBias, 0.0f, 1000.0f);
+    readSetting(json, "shadow_softness", settings.shadowSoftness, 0.0f, 1000.0f);
+    readSetting(json, "light_map_resolution", settings.lightMapResolution, 0,
+                kMaxLightMapResolution);
+    if (settings.lightMapResolution != 0 && settings.lightMapResolution < kMinLightMapResolution) {
+        throw Error(
+            fmt::format("the setting 'light_map_resolution' must be 0 (from the point "
+                        "spacing) or {} to {}",
+                        kMinLightMapResolution, kMaxLightMapResolution));
+    }
     if (const auto lights = json.find("lights"); lights != json.end()) {
         if (!lights->is_array() || lights->size() > SUBSCAN_MAX_LIGHTS) {
             throw Error(fmt::format("the setting 'lights' must be a list of at most {} lights",

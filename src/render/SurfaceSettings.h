@@ -23,12 +23,18 @@ struct SurfaceSettings {
     int fillDirections = 8;            // of 8 directions, how many must find points
     float normalRadius = 1.5f;         // normal smoothing (x h)
     bool restrictToPoints = true;      // passes skip the screen outside the points' bounds
+
+    bool operator==(const SurfaceSettings&) const = default;
 };
 
 struct DirectionalLight {
     glm::vec3 direction{0.0f, 1.0f, 0.0f};  // towards the light, world space
     glm::vec3 radiance{1.0f};
 };
+
+/// Explicit light map resolutions (ShadingSettings::lightMapResolution).
+inline constexpr int kMinLightMapResolution = 16;
+inline constexpr int kMaxLightMapResolution = 8192;
 
 /// Deferred shading (DESIGN.md §5 step 6). Radiances are linear RGB.
 struct ShadingSettings {
@@ -37,6 +43,15 @@ struct ShadingSettings {
     float specular = 0.08f;                // Blinn-Phong reflectance
     float shininess = 40.0f;               // Blinn-Phong exponent
     std::vector<DirectionalLight> lights;  // at most SUBSCAN_MAX_LIGHTS
+    // Shadows of the directional lights (the head light casts none), from each light's own
+    // reconstruction of the cloud: its light map (DESIGN.md §5.9, render/LightMaps.h).
+    bool shadows = true;
+    float shadowBias = 2.0f;      // x h: how far behind the light map's surface shadow begins
+    float shadowSoftness = 2.0f;  // x h: the width over which a shadow's edge fades
+    int lightMapResolution = 0;   // texels along a light map's longer side; 0: from h (LightMaps)
+
+    /// Whether a frame in a surface mode needs light maps.
+    bool castsShadows() const { return shadows && !lights.empty(); }
 };
 
 void to_json(nlohmann::json& json, const SurfaceSettings& settings);

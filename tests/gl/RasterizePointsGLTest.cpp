@@ -121,7 +121,7 @@ PointCloud testCloud(const Camera& camera, std::uint32_t seed) {
 /// how many pixels hold a point.
 std::size_t expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
                                    const Reference& reference) {
-    const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners();
+    const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners(renderer.resources());
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
     const std::vector<float> color = renderer.resources().texture("color").readFloats();
     std::size_t covered = 0;

@@ -172,9 +172,7 @@ TEST(ViewerCameraTest, FrameAllContainsTheBoundsFromAnyDirectionAndAspect) {
             camera.frameAll(size.x, size.y);
             const Camera view = camera.camera(size.x, size.y);
             for (int corner = 0; corner < 8; ++corner) {
-                const glm::dvec3 p((corner & 1) ? kScene.max.x : kScene.min.x,
-                                   (corner & 2) ? kScene.max.y : kScene.min.y,
-                                   (corner & 4) ? kScene.max.z : kScene.min.z);
+                const glm::dvec3 p = kScene.corner(corner);
                 const Projected projected = project(view, p);
                 EXPECT_GE(projected.pixel.x, 0.0);
                 EXPECT_LE(projected.pixel.x, size.x);

@@ -25,9 +25,7 @@ TEST(CameraTest, AutoFramingKeepsEveryCornerInsideTheImageAndDepthRange) {
                 const Camera camera =
                     orbitCamera(bounds, {yaw, pitch, std::nullopt, up}, 160, 90, 45);
                 for (int corner = 0; corner < 8; ++corner) {
-                    const glm::dvec3 p((corner & 1) ? bounds.max.x : bounds.min.x,
-                                       (corner & 2) ? bounds.max.y : bounds.min.y,
-                                       (corner & 4) ? bounds.max.z : bounds.min.z);
+                    const glm::dvec3 p = bounds.corner(corner);
                     const glm::dvec4 view = camera.view * glm::dvec4(p, 1.0);
                     const glm::dvec4 clip = camera.projection() * view;
                     EXPECT_GT(-view.z, camera.nearPlane);
@@ -130,6 +128,27 @@ TEST(CameraTest, ProjectedPixelBoundsAreTheWholeImageWhenTheBoxReachesBehindTheC
     const Camera framed = orbitCamera(bounds, {0, 0, 10.0, UpAxis::Y}, 64, 48, 45);
     const glm::ivec4 aside = projectedPixelBounds(framed, box({30, -1, -1}, {32, 1, 1}));
     EXPECT_LE(aside.z, aside.x);
+}
+
+TEST(CameraTest, OrthographicCameraMapsSceneUnitsToPixelsAtEveryDepth) {
+    Camera camera;
+    camera.width = 200;
+    camera.height = 100;
+    camera.orthographicHeight = 4.0;  // 25 pixels per unit
+    camera.nearPlane = 1.0;
+    camera.farPlane = 9.0;
+    ASSERT_TRUE(camera.orthographic());
+    EXPECT_DOUBLE_EQ(camera.focalLengthPixels(), 25.0);
+    for (const double depth : {1.5, 4.0, 8.5}) {
+        // 2 units right of and 1 unit above the axis: 50 and 25 pixels from the middle.
+        const glm::dvec4 clip = camera.projection() * glm::dvec4(2.0, 1.0, -depth, 1.0);
+        EXPECT_DOUBLE_EQ(clip.w, 1.0);
+        EXPECT_NEAR((clip.x + 1.0) * 0.5 * camera.width, 150.0, 1e-9);
+        EXPECT_NEAR((1.0 - clip.y) * 0.5 * camera.height, 25.0, 1e-9);
+    }
+    // The projected box: x 100 + 25 * [-1, 1], y 50 - 25 * [-1, 1], plus the 2-pixel margin.
+    EXPECT_EQ(projectedPixelBounds(camera, box({-1, -1, -5}, {1, 1, -3})),
+              glm::ivec4(73, 23, 128, 78));
 }
 
 }  // namespace

@@ -1,0 +1,150 @@
+#include "render/LightMaps.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+#include "core/Error.h"
+
+namespace subscan {
+
+namespace {
+
+constexpr int kAutoMinResolution = 64;
+constexpr int kAutoMaxResolution = 2048;
+
+}  // namespace
+
+Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int resolution,
+                   double spacing) {
+    const glm::dvec3 direction = glm::normalize(towardsLight);
+    const glm::dvec3 centre = bounds.center();
+    const double radius = std::max(0.5 * glm::length(bounds.extent()), spacing);
+    // Any up vector not along the light will do: the map is sampled through its matrices.
+    const glm::dvec3 up =
+        std::abs(direction.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
+    const double eyeDistance = 2.0 * radius;
+    glm::dmat4 view = glm::lookAt(centre + eyeDistance * direction, centre, up);
+
+    glm::dvec3 low(std::numeric_limits<double>::infinity());
+    glm::dvec3 high(-std::numeric_limits<double>::infinity());
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 p = bounds.corner(corner);
+        const glm::dvec3 v(view * glm::dvec4(p, 1.0));
+        low = glm::min(low, v);
+        high = glm::max(high, v);
+    }
+    // Centre the box's projection on the view axis.
+    const glm::dvec2 middle = 0.5 * (glm::dvec2(low) + glm::dvec2(high));
+    view = glm::translate(glm::dmat4(1.0), glm::dvec3(-middle, 0.0)) * view;
+    const glm::dvec2 extent = glm::max(glm::dvec2(high) - glm::dvec2(low), glm::dvec2(spacing));
+    const double longer = std::max(extent.x, extent.y);
+    if (resolution == 0) {
+        resolution = std::clamp(static_cast<int>(std::ceil(longer / spacing)), kAutoMinResolution,
+                                kAutoMaxResolution);
+    }
+    const double texel = longer / resolution;
+    Camera camera;
+    camera.view = view;
+    // Whole texels; the slack keeps an extent of exactly `resolution` texels from rounding up.
+    const auto texels = [&](double length) {
+        return std::max(1, static_cast<int>(std::ceil(length / texel - 1e-6)));
+    };
+    camera.width = texels(extent.x) + 2 * kLightMapMargin;
+    camera.height = texels(extent.y) + 2 * kLightMapMargin;
+    camera.orthographicHeight = camera.height * texel;
+    // Depths are -z; a margin of a few texels keeps the box's own corners inside.
+    const double depthMargin = 4.0 * texel;
+    camera.nearPlane = std::max(-high.z - depthMargin, 0.5 * (-high.z));
+    camera.farPlane = -low.z + depthMargin;
+    return camera;
+}
+
+LightMaps::LightMaps(GlContext& context, Reconstruction& reconstruction)
+    : context_(context), reconstruction_(reconstruction) {}
+
+std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Bounds& cloudBounds,
+                                          const RenderSettings& settings, double spacing,
+                                          PassRunner& runner) {
+    const std::vector<DirectionalLight>& lights = settings.shading.lights;
+    const std::size_t count = std::min<std::size_t>(lights.size(), SUBSCAN_MAX_LIGHTS);
+    maps_.resize(count);
+    keys_.resize(count);
+    // The light's view reconstructs the surface like the camera's, without intermediate stages.
+    RenderSettings lightSettings = settings;
+    lightSettings.raster.mode = RenderMode::Surface;
+    lightSettings.raster.stage = Stage::Final;
+    lightSettings.raster.resolution = Resolution::Full;
+
+    std::vector<PassTiming> timings;
+    for (std::size_t i = 0; i < count; ++i) {
+        const Key key{glm::normalize(glm::dvec3(lights[i].direction)),
+                      settings.shading.lightMapResolution, settings.surface, settings.raster.path};
+        if (maps_[i].depth.id() != 0 && keys_[i] == key) {
+            continue;
+        }
+        const Camera camera = lightCamera(cloudBounds, key.towardsLight, key.resolution, spacing);
+        const int limit = context_.capabilities().maxTextureSize;
+        if (camera.width > limit || camera.height > limit) {
+            throw Error(
+                fmt::format("a light map of {}x{} texels is larger than the GPU allows "
+                            "({} per side): lower 'light_map_resolution'",
+                            camera.width, camera.height, limit));
+        }
+        const gpu::PyramidLayout& layout =
+            uniforms_.update(camera, lightSettings, spacing, cloud.origin());
+        FrameContext frame{camera,     cloud,  lightSettings, context_.capabilities(),
+                           resources_, layout, spacing};
+        frame.cloudPixels = projectedPixelBounds(camera, cloudBounds);
+        std::vector<RenderPass*> passes;
+        reconstruction_.appendAll(passes, SurfaceOutputs::Depth);
+        for (PassTiming& timing : runner.run(passes, frame)) {
+            timing.pass = "LightMap." + timing.pass;
+            timings.push_back(std::move(timing));
+        }
+
+        Map& map = maps_[i];
+        if (map.depth.width() != camera.width || map.depth.height() != camera.height) {
+            map.depth = Texture(TextureFormat::R32F, camera.width, camera.height, "LightMap.depth");
+            map.depth.clampToEdge();
+        }
+        glCopyImageSubData(resources_.texture("surfaceDepth").id(), GL_TEXTURE_2D, 0, 0, 0, 0,
+                           map.depth.id(), GL_TEXTURE_2D, 0, 0, 0, 0, camera.width, camera.height,
+                           1);
+        map.camera = camera;
+        keys_[i] = key;
+        ++builds_;
+    }
+    return timings;
+}
+
+std::size_t LightMaps::bytes() const {
+    std::size_t total = resources_.bytes();
+    for (const Map& map : maps_) {
+        total += static_cast<std::size_t>(map.depth.width()) * map.depth.height() * sizeof(float);
+    }
+    return total;
+}
+
+void LightMaps::prepareShading(gpu::ShadeParams& params, const Camera& camera,
+                               const ShadingSettings& settings, double spacing) const {
+    const glm::dmat4 worldFromView = glm::inverse(camera.view);
+    const std::size_t count = std::min<std::size_t>(maps_.size(), params.lightCount.x);
+    for (std::size_t i = 0; i < count; ++i) {
+        const Map& map = maps_[i];
+        params.lightFromView[i] = glm::mat4(map.camera.view * worldFromView);
+        params.lightMap[i] = {static_cast<float>(map.camera.focalLengthPixels()),
+                              static_cast<float>(map.camera.width),
+                              static_cast<float>(map.camera.height), 1.0f};
+        map.depth.bindSampler(SUBSCAN_TEXTURES_LIGHT_DEPTH + static_cast<GLuint>(i));
+    }
+    params.shadow = {static_cast<float>(settings.shadowBias * spacing),
+                     static_cast<float>(settings.shadowSoftness * spacing), 0.0f, 0.0f};
+}
+
+}  // namespace subscan

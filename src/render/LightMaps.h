@@ -1,0 +1,80 @@
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "core/Camera.h"
+#include "core/PointCloud.h"
+#include "gpu/GlContext.h"
+#include "gpu/GlObjects.h"
+#include "render/FrameResources.h"
+#include "render/FrameUniforms.h"
+#include "render/GpuPointCloud.h"
+#include "render/PassRunner.h"
+#include "render/Reconstruction.h"
+#include "render/RenderSettings.h"
+#include "shared/bindings.h"
+
+namespace subscan {
+
+/// A directional light's orthographic view of `bounds` (file coordinates), looking along
+/// -towardsLight: `resolution` texels span the longer side of the box's projection — 0 chooses
+/// one texel per point spacing h, within 64..2048 (a 2048² map costs about a 1080p frame to
+/// build, and it is built only when the light moves) — with kLightMapMargin empty texels on
+/// every side (the filter's reach). Near and far hug the box.
+Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int resolution,
+                   double spacing);
+inline constexpr int kLightMapMargin = 4;
+
+/// The reconstruction seen from each directional light (DESIGN.md §5.9): per light the
+/// reconstruction of the cloud in the light's orthographic view, kept as a depth map along
+/// the light ("surface depth": linear depth, +inf where the light meets nothing). A map is
+/// rebuilt only when its light, the settings that shape it (surface settings, raster path,
+/// resolution) change; moving the camera costs nothing. All lights share one set of
+/// pipeline images; each map keeps only its depth.
+class LightMaps {
+  public:
+    struct Map {
+        Camera camera;  // the light's view, file coordinates
+        Texture depth;  // R32F, row 0 at the top
+    };
+
+    LightMaps(GlContext& context, Reconstruction& reconstruction);
+
+    /// Brings the maps up to date with `settings.shading` (one per directional light) and
+    /// returns the timings of the passes that ran: empty when every map was current.
+    std::vector<PassTiming> update(const GpuPointCloud& cloud, const Bounds& cloudBounds,
+                                   const RenderSettings& settings, double spacing,
+                                   PassRunner& runner);
+    const std::vector<Map>& maps() const { return maps_; }
+    /// Maps built so far (a light's first map counts): for tests of the caching.
+    std::size_t builds() const { return builds_; }
+    /// Bytes of the maps and of the pipeline images they are built in.
+    std::size_t bytes() const;
+
+    /// The shadow parameters of ShadeParams for a frame seen by `camera`, and the maps bound
+    /// to their texture units (SUBSCAN_TEXTURES_LIGHT_DEPTH + light).
+    void prepareShading(gpu::ShadeParams& params, const Camera& camera,
+                        const ShadingSettings& settings, double spacing) const;
+
+  private:
+    /// What a map depends on besides the cloud.
+    struct Key {
+        glm::dvec3 towardsLight{0.0};
+        int resolution = 0;
+        SurfaceSettings surface;
+        RasterPath path = RasterPath::Auto;
+        bool operator==(const Key&) const = default;
+    };
+
+    GlContext& context_;
+    Reconstruction& reconstruction_;
+    FrameResources resources_;  // the pipeline images of the map being built
+    FrameUniforms uniforms_;
+    std::vector<Map> maps_;
+    std::vector<Key> keys_;
+    std::size_t builds_ = 0;
+};
+
+}  // namespace subscan
