@@ -2,6 +2,7 @@
 // An includer may define SHADE_DIRECTIONAL_LIGHTS 0 for frames with the head light alone: on
 // llvmpipe the loop over the directional lights costs even when it runs zero times.
 #include "shared/common.glsl"
+#include "shared/lightmap.glsl"
 
 #ifndef SHADE_DIRECTIONAL_LIGHTS
 #define SHADE_DIRECTIONAL_LIGHTS 1
@@ -11,22 +12,14 @@ layout(std140, binding = SUBSCAN_UBO_PASS) uniform ShadeBlock {
     ShadeParams shade;
 };
 
-layout(binding = SUBSCAN_TEXTURES_LIGHT_DEPTH) uniform sampler2D lightDepth[SUBSCAN_MAX_LIGHTS];
-
-/// Bilinear percentage-closer test of light `light`'s map around texel position `texel`
-/// (continuous, texel i spans [i, i + 1)): each of the 4 nearest texels is lit when its depth
-/// is not in front of the receiver's plane there by more than the bias.
+/// Bilinear percentage-closer test of light `light`'s map around texel position `texel`: each
+/// of the 4 nearest texels is lit when its depth is not in front of the receiver's plane there
+/// (depth `depth` at `texel`, `slope` per texel) by more than the tolerance.
 float litFraction(uint light, vec2 texel, float depth, vec2 slope) {
-    vec2 base = floor(texel - 0.5);
-    vec2 f = texel - 0.5 - base;
-    // Texels (0, 0), (1, 0), (0, 1), (1, 1) from `base`, clamped to the map (its border is empty).
-    ivec2 last = ivec2(shade.lightMap[light].yz) - 1;
-    ivec2 first = ivec2(base);
-    vec4 stored;
-    for (int k = 0; k < 4; ++k) {
-        ivec2 at = clamp(first + ivec2(k % 2, k / 2), ivec2(0), last);
-        stored[k] = texelFetch(lightDepth[light], at, 0).r;
-    }
+    vec4 texels[4];
+    vec2 f;
+    lightMapTexels(light, shade.lightMap[light], texel, texels, f);
+    vec4 stored = vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
     vec4 dx = vec4(0.0, 1.0, 0.0, 1.0) - f.x;
     vec4 dy = vec4(0.0, 0.0, 1.0, 1.0) - f.y;
     // A texel holds the depth of its nearest point, anywhere inside it, or where it holds
@@ -42,13 +35,11 @@ float litFraction(uint light, vec2 texel, float depth, vec2 slope) {
 /// The share of directional light `light` that reaches view-space `position` with surface
 /// normal `normal` past the cloud's own surface, seen from the light (its light map): 4
 /// bilinear percentage-closer tests a soft edge's width apart, each texel compared with the
-/// receiver's tangent plane at that texel (no acne on tilted surfaces) less the bias.
+/// receiver's tangent plane at that texel (no acne on tilted surfaces) less the tolerance.
 float shadowing(uint light, vec3 position, vec3 normal) {
     vec4 map = shade.lightMap[light];
-    vec3 inLight = (shade.lightFromView[light] * vec4(position, 1.0)).xyz;
+    vec3 at = lightMapPosition(shade.lightFromView[light], map, position);
     vec3 normalInLight = mat3(shade.lightFromView[light]) * normal;
-    // Texel coordinates: the map's view is centred on its axis, row 0 at the top.
-    vec2 texel = vec2(inLight.x, -inLight.y) * map.x + 0.5 * map.yz;
     // Depth change per texel along the receiver's plane; the steepest 80 degrees.
     const float kSteepest = 5.67;
     vec2 slope = clamp(vec2(normalInLight.x, -normalInLight.y) / max(normalInLight.z, 1e-3),
@@ -57,7 +48,7 @@ float shadowing(uint light, vec3 position, vec3 normal) {
     float lit = 0.0;
     for (int tap = 0; tap < 4; ++tap) {
         vec2 offset = spread * vec2(tap % 2 == 0 ? -1.0 : 1.0, tap < 2 ? -1.0 : 1.0);
-        lit += litFraction(light, texel + offset, -inLight.z + dot(slope, offset), slope);
+        lit += litFraction(light, at.xy + offset, at.z + dot(slope, offset), slope);
     }
     return 0.25 * lit;
 }

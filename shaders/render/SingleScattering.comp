@@ -15,15 +15,21 @@
 #include "shared/common.glsl"
 #include "shared/region.glsl"
 
-// The stages come in pairs by what they add to (RADIANCE_*, SCATTERED_*): *_HEAD_LIGHT for
-// frames lit by the head light alone, *_LIGHTS with the directional lights' loop, which costs
-// on llvmpipe even when it runs zero times.
-#ifdef STAGE_SCATTERED_LIGHTS
+// The stages come in threes by what they add to (RADIANCE_*, SCATTERED_*): *_HEAD_LIGHT for
+// frames lit by the head light alone (the directional lights' loop costs on llvmpipe even
+// when it runs zero times), *_LIGHTS with the loop marching through the camera's depth, and
+// *_LIGHT_MAPS with the loop reading each light's entries from its light map.
+#ifdef STAGE_SCATTERED_HEAD_LIGHT
 #define ADD_TO_SCATTERED 1
-#define DIRECTIONAL_LIGHTS STAGE_SCATTERED_LIGHTS
+#define DIRECTIONAL_LIGHTS (STAGE_SCATTERED_LIGHTS || STAGE_SCATTERED_LIGHT_MAPS)
+#define LIGHT_MAP_ENTRIES STAGE_SCATTERED_LIGHT_MAPS
 #else
 #define ADD_TO_SCATTERED 0
-#define DIRECTIONAL_LIGHTS STAGE_RADIANCE_LIGHTS
+#define DIRECTIONAL_LIGHTS (STAGE_RADIANCE_LIGHTS || STAGE_RADIANCE_LIGHT_MAPS)
+#define LIGHT_MAP_ENTRIES STAGE_RADIANCE_LIGHT_MAPS
+#endif
+#if LIGHT_MAP_ENTRIES
+#include "shared/lightmap.glsl"
 #endif
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
@@ -223,6 +229,44 @@ Entry localSlabEntry(float s, vec3 toLight, vec3 normal, float cosView) {
     return entry;
 }
 
+#if LIGHT_MAP_ENTRIES
+/// Where directional light `light` entered on its way to `samplePoint`, from its light map:
+/// the first surface the light meets above the sample (depth interpolated bilinearly where the
+/// 4 nearest texels hold surface, else the nearest texel's), at the straight distance between
+/// them along the light, with that surface's normal. kInside (no light) where the sample lies
+/// in front of that surface by more than the tolerance `slack` — outside the medium as the light
+/// sees it, e.g. past the far face of a thin part —, kOffScreen where the map holds no surface.
+Entry lightMapEntry(uint light, vec3 samplePoint, float slack) {
+    Entry entry;
+    entry.state = kOffScreen;
+    entry.distance = 0.0;
+    entry.normal = vec3(0.0);
+    vec4 map = lights.lightMap[light];
+    vec3 at = lightMapPosition(lights.lightFromView[light], map, samplePoint);
+    vec4 texels[4];
+    vec2 f;
+    lightMapTexels(light, map, at.xy, texels, f);
+    vec4 weights = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    vec4 depths = vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
+    int nearest = 0;
+    for (int k = 1; k < 4; ++k) {
+        nearest = weights[k] > weights[nearest] ? k : nearest;
+    }
+    bool allSurface = !any(isinf(depths));
+    float surfaceDepth = allSurface ? dot(weights, depths) : depths[nearest];
+    if (isinf(surfaceDepth)) {
+        return entry;
+    }
+    vec3 normal = texels[nearest].gba;
+    // Light view -> camera view: the inverse of a rotation is its transpose.
+    entry.normal = normalize(transpose(mat3(lights.lightFromView[light])) * normal);
+    float distanceAlong = at.z - surfaceDepth;
+    entry.state = distanceAlong >= -slack ? kOutside : kInside;
+    entry.distance = max(distanceAlong, 0.0);
+    return entry;
+}
+#endif
+
 struct Medium {
     vec3 sigmaS;  // unreduced, per scene unit
     vec3 sigmaT;  // per scene unit
@@ -301,6 +345,7 @@ void main() {
     vec3 single = vec3(0.0);
     if (cosView > 0.0 && any(greaterThan(medium.sigmaS, vec3(0.0)))) {
         vec3 eyeInside = refractedDirection(toEye, normal, eta);
+        float cosViewInside = dot(eyeInside, normal);
         float sigmaTMin = min(medium.sigmaT.r, min(medium.sigmaT.g, medium.sigmaT.b));
         int samples = int(params.sampling.x);
         ivec3 channelSamples = (ivec3(samples + 2) - ivec3(0, 1, 2)) / 3;
@@ -335,6 +380,17 @@ void main() {
             for (uint i = 0u; i < lights.lightCount.x; ++i) {
                 vec3 toLight = lights.lightDirection[i].xyz;
                 Entry entry;
+#if LIGHT_MAP_ENTRIES
+                // The camera's and the light's reconstructions of one surface differ by a
+                // fraction of the point spacing: a sample that close below the camera's surface
+                // may lie that far in front of the light's (the shadows' tolerance). Deeper
+                // samples need none, so that a thin part's far face cuts off exactly.
+                float slack = max(lights.shadow.x - s * cosViewInside, 0.0);
+                entry = lightMapEntry(i, samplePoint, slack);
+                if (entry.state == kOffScreen) {
+                    entry = localSlabEntry(s, toLight, normal, cosView);
+                }
+#else
                 if (!local) {
                     // kExtinctionDepths of the least extinct channel along a straight path
                     // whose refracted length is shortened by cos θi/cos θi′ (at most 1/0.05).
@@ -347,6 +403,7 @@ void main() {
                 if (local || entry.state == kOffScreen) {
                     entry = localSlabEntry(s, toLight, normal, cosView);
                 }
+#endif
                 light += lightThrough(entry, toLight, lights.lightColor[i].rgb, eyeInside, medium);
             }
 #endif

@@ -51,10 +51,10 @@ using mat4 = glm::mat4;
 #define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
 #define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
 
-// ---- textures read with texelFetch/textureGather ----
-// sampler2D per directional light (units 9 .. 9 + SUBSCAN_MAX_LIGHTS - 1): its light map, the
-// linear depth of the cloud's reconstruction seen from the light (+inf: nothing)
-#define SUBSCAN_TEXTURES_LIGHT_DEPTH 9
+// ---- textures read with texelFetch ----
+// sampler2D per directional light (units 9 .. 9 + SUBSCAN_MAX_LIGHTS - 1): its light map
+// (shared/lightmap.glsl)
+#define SUBSCAN_TEXTURES_LIGHT_MAPS 9
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0

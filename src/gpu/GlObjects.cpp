@@ -207,11 +207,6 @@ void Texture::bindSampler(GLuint unit) const {
     glBindTextureUnit(unit, id());
 }
 
-void Texture::clampToEdge() {
-    glTextureParameteri(id(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(id(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-}
-
 void Texture::clear(const glm::vec4& value) {
     glClearTexImage(id(), 0, info(format_).pixelFormat, GL_FLOAT, &value.x);
 }

@@ -146,8 +146,6 @@ class Texture {
     /// atomics on float bits (positive floats order like their bit patterns).
     void bindImageBits(GLuint unit, GLenum access) const;
     void bindSampler(GLuint unit) const;
-    /// Reads past the edge return the edge texel (the default wraps around).
-    void clampToEdge();
     /// Sets every texel to `value` (as many components as the format has).
     void clear(const glm::vec4& value = glm::vec4(0.0f));
     /// Sets every texel of an R32UI texture to `value`.

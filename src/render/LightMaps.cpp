@@ -20,6 +20,19 @@ constexpr int kAutoMaxResolution = 2048;
 
 }  // namespace
 
+bool usesLightMaps(const RenderSettings& settings) {
+    const RasterSettings& raster = settings.raster;
+    if (!reconstructsSurface(raster.mode) || !isFinalImage(raster.stage) ||
+        settings.shading.lights.empty()) {
+        return false;
+    }
+    const ScatteringSettings& scattering = settings.scattering;
+    const bool singleFromMaps = raster.mode == RenderMode::Sss && raster.stage == Stage::Final &&
+                                scattering.method != ScatteringMethod::Gaussian &&
+                                scattering.lightPath == LightPath::LightMap;
+    return settings.shading.shadows || singleFromMaps;
+}
+
 Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int resolution,
                    double spacing) {
     const glm::dvec3 direction = glm::normalize(towardsLight);
@@ -65,8 +78,9 @@ Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int res
     return camera;
 }
 
-LightMaps::LightMaps(GlContext& context, Reconstruction& reconstruction)
-    : context_(context), reconstruction_(reconstruction) {}
+LightMaps::LightMaps(GlContext& context, const ShaderSources& sources,
+                     Reconstruction& reconstruction)
+    : context_(context), sources_(sources), reconstruction_(reconstruction) {}
 
 std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Bounds& cloudBounds,
                                           const RenderSettings& settings, double spacing,
@@ -85,7 +99,7 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
     for (std::size_t i = 0; i < count; ++i) {
         const Key key{glm::normalize(glm::dvec3(lights[i].direction)),
                       settings.shading.lightMapResolution, settings.surface, settings.raster.path};
-        if (maps_[i].depth.id() != 0 && keys_[i] == key) {
+        if (maps_[i].texture.id() != 0 && keys_[i] == key) {
             continue;
         }
         const Camera camera = lightCamera(cloudBounds, key.towardsLight, key.resolution, spacing);
@@ -102,19 +116,20 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
                            resources_, layout, spacing};
         frame.cloudPixels = projectedPixelBounds(camera, cloudBounds);
         std::vector<RenderPass*> passes;
-        reconstruction_.appendAll(passes, SurfaceOutputs::Depth);
+        reconstruction_.appendAll(passes, SurfaceOutputs::DepthAndNormals);
+        passes.push_back(&lazyPass(pack_, sources_));
         for (PassTiming& timing : runner.run(passes, frame)) {
             timing.pass = "LightMap." + timing.pass;
             timings.push_back(std::move(timing));
         }
 
         Map& map = maps_[i];
-        if (map.depth.width() != camera.width || map.depth.height() != camera.height) {
-            map.depth = Texture(TextureFormat::R32F, camera.width, camera.height, "LightMap.depth");
-            map.depth.clampToEdge();
+        if (map.texture.width() != camera.width || map.texture.height() != camera.height) {
+            map.texture =
+                Texture(TextureFormat::RGBA32F, camera.width, camera.height, "LightMap.texture");
         }
-        glCopyImageSubData(resources_.texture("surfaceDepth").id(), GL_TEXTURE_2D, 0, 0, 0, 0,
-                           map.depth.id(), GL_TEXTURE_2D, 0, 0, 0, 0, camera.width, camera.height,
+        glCopyImageSubData(resources_.texture("lightMap").id(), GL_TEXTURE_2D, 0, 0, 0, 0,
+                           map.texture.id(), GL_TEXTURE_2D, 0, 0, 0, 0, camera.width, camera.height,
                            1);
         map.camera = camera;
         keys_[i] = key;
@@ -126,7 +141,8 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
 std::size_t LightMaps::bytes() const {
     std::size_t total = resources_.bytes();
     for (const Map& map : maps_) {
-        total += static_cast<std::size_t>(map.depth.width()) * map.depth.height() * sizeof(float);
+        total += static_cast<std::size_t>(map.texture.width()) * map.texture.height() * 4 *
+                 sizeof(float);
     }
     return total;
 }
@@ -140,8 +156,9 @@ void LightMaps::prepareShading(gpu::ShadeParams& params, const Camera& camera,
         params.lightFromView[i] = glm::mat4(map.camera.view * worldFromView);
         params.lightMap[i] = {static_cast<float>(map.camera.focalLengthPixels()),
                               static_cast<float>(map.camera.width),
-                              static_cast<float>(map.camera.height), 1.0f};
-        map.depth.bindSampler(SUBSCAN_TEXTURES_LIGHT_DEPTH + static_cast<GLuint>(i));
+                              static_cast<float>(map.camera.height),
+                              settings.shadows ? 1.0f : 0.0f};
+        map.texture.bindSampler(SUBSCAN_TEXTURES_LIGHT_MAPS + static_cast<GLuint>(i));
     }
     params.shadow = {static_cast<float>(settings.shadowBias * spacing),
                      static_cast<float>(settings.shadowSoftness * spacing), 0.0f, 0.0f};

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "render/FrameResources.h"
 #include "render/FrameUniforms.h"
 #include "render/GpuPointCloud.h"
+#include "render/LightMapPass.h"
 #include "render/PassRunner.h"
 #include "render/Reconstruction.h"
 #include "render/RenderSettings.h"
@@ -27,20 +29,25 @@ Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int res
                    double spacing);
 inline constexpr int kLightMapMargin = 4;
 
+/// Whether a frame with these settings reads light maps: a final picture of the surface
+/// modes with directional lights that cast shadows, or whose single scattering finds its
+/// entries in the maps (ScatteringSettings::lightPath).
+bool usesLightMaps(const RenderSettings& settings);
+
 /// The reconstruction seen from each directional light (DESIGN.md §5.9): per light the
-/// reconstruction of the cloud in the light's orthographic view, kept as a depth map along
-/// the light ("surface depth": linear depth, +inf where the light meets nothing). A map is
-/// rebuilt only when its light, the settings that shape it (surface settings, raster path,
-/// resolution) change; moving the camera costs nothing. All lights share one set of
-/// pipeline images; each map keeps only its depth.
+/// reconstruction of the cloud in the light's orthographic view, kept as its light map
+/// (LightMapPass: depth along the light, +inf where it meets nothing, and normal). A map is
+/// rebuilt only when its light or the settings that shape it (surface settings, raster path,
+/// resolution) change; moving the camera costs nothing. All lights share one set of pipeline
+/// images; each map keeps only its own texture.
 class LightMaps {
   public:
     struct Map {
-        Camera camera;  // the light's view, file coordinates
-        Texture depth;  // R32F, row 0 at the top
+        Camera camera;    // the light's view, file coordinates
+        Texture texture;  // RGBA32F (LightMapPass), row 0 at the top
     };
 
-    LightMaps(GlContext& context, Reconstruction& reconstruction);
+    LightMaps(GlContext& context, const ShaderSources& sources, Reconstruction& reconstruction);
 
     /// Brings the maps up to date with `settings.shading` (one per directional light) and
     /// returns the timings of the passes that ran: empty when every map was current.
@@ -53,8 +60,9 @@ class LightMaps {
     /// Bytes of the maps and of the pipeline images they are built in.
     std::size_t bytes() const;
 
-    /// The shadow parameters of ShadeParams for a frame seen by `camera`, and the maps bound
-    /// to their texture units (SUBSCAN_TEXTURES_LIGHT_DEPTH + light).
+    /// The light-map parameters of ShadeParams for a frame seen by `camera` (shadows as
+    /// `settings` say), and the maps bound to their texture units (SUBSCAN_TEXTURES_LIGHT_MAPS
+    /// + light).
     void prepareShading(gpu::ShadeParams& params, const Camera& camera,
                         const ShadingSettings& settings, double spacing) const;
 
@@ -69,9 +77,11 @@ class LightMaps {
     };
 
     GlContext& context_;
+    const ShaderSources& sources_;
     Reconstruction& reconstruction_;
     FrameResources resources_;  // the pipeline images of the map being built
     FrameUniforms uniforms_;
+    std::unique_ptr<LightMapPass> pack_;
     std::vector<Map> maps_;
     std::vector<Key> keys_;
     std::size_t builds_ = 0;

@@ -45,7 +45,7 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
       resolutionChooser_(cloud),
       cloudBounds_(cloud.bounds),
       reconstruction_(sources_, context.capabilities()),
-      lightMaps_(context, reconstruction_) {}
+      lightMaps_(context, sources_, reconstruction_) {}
 
 Renderer::~Renderer() = default;
 
@@ -130,10 +130,9 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     }
 
     // The lights' views first: their maps are current before the camera's shading reads them.
-    const bool shadows = reconstructsSurface(settings.raster.mode) &&
-                         isFinalImage(settings.raster.stage) && settings.shading.castsShadows();
+    const bool lightMaps = usesLightMaps(settings);
     std::vector<PassTiming> lightTimings;
-    if (shadows) {
+    if (lightMaps) {
         lightTimings = lightMaps_.update(cloud_, cloudBounds_, settings, spacing_, *runner_);
     }
 
@@ -156,7 +155,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
                          resourcesFor(divisor), layout, spacing_};
     context.cloudPixels = projectedPixelBounds(pipelineCamera_, cloudBounds_);
     context.outputs = outputs;
-    context.lightMaps = shadows ? &lightMaps_ : nullptr;
+    context.lightMaps = lightMaps ? &lightMaps_ : nullptr;
     if (divisor != 1) {
         context.divisor = divisor;
         context.reducedFrom = glm::ivec2(camera.width, camera.height);

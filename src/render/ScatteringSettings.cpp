@@ -18,6 +18,10 @@ constexpr std::pair<CoefficientSource, std::string_view> kSources[] = {
     {CoefficientSource::Material, "material"},
     {CoefficientSource::Color, "color"},
 };
+constexpr std::pair<LightPath, std::string_view> kLightPaths[] = {
+    {LightPath::Screen, "screen"},
+    {LightPath::LightMap, "light_map"},
+};
 constexpr std::pair<AlbedoPlacement, std::string_view> kPlacements[] = {
     {AlbedoPlacement::PreScatter, "pre"},
     {AlbedoPlacement::PostScatter, "post"},
@@ -56,6 +60,12 @@ std::string toString(ScatteringMethod method) {
 ScatteringMethod parseScatteringMethod(std::string_view text) {
     return parseName(kMethods, text, "scattering method");
 }
+std::string toString(LightPath path) {
+    return nameOf(kLightPaths, path);
+}
+LightPath parseLightPath(std::string_view text) {
+    return parseName(kLightPaths, text, "light path");
+}
 std::string toString(CoefficientSource source) {
     return nameOf(kSources, source);
 }
@@ -88,6 +98,7 @@ void to_json(nlohmann::json& json, const ScatteringSettings& settings) {
         {"eta", settings.eta ? nlohmann::json(*settings.eta) : nlohmann::json(nullptr)},
         {"phase_g", settings.phaseG},
         {"single_samples", settings.singleSamples},
+        {"light_path", toString(settings.lightPath)},
     };
 }
 
@@ -129,7 +140,7 @@ void checkScatteringSettings(const ScatteringSettings& settings) {
 void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
     rejectUnknownKeys(json, "scattering",
                       {"method", "material", "unit", "scale", "albedo", "max_taps", "coefficients",
-                       "mean_free_path_mm", "eta", "phase_g", "single_samples"});
+                       "mean_free_path_mm", "eta", "phase_g", "single_samples", "light_path"});
     readEnum(json, "method", settings.method, kMethods, "scattering method");
     readEnum(json, "coefficients", settings.coefficients, kSources, "coefficient source");
     if (const auto found = json.find("material"); found != json.end()) {
@@ -154,6 +165,7 @@ void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
     }
     readSetting(json, "phase_g", settings.phaseG, -1e30f, 1e30f);
     readSetting(json, "single_samples", settings.singleSamples, -1000000, 1000000);
+    readEnum(json, "light_path", settings.lightPath, kLightPaths, "light path");
     checkScatteringSettings(settings);
 }
 

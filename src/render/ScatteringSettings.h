@@ -27,6 +27,13 @@ enum class ScatteringMethod { Gaussian, Single, Both };
 /// the reconstructed colour and the diffuse mean free path (§6.4).
 enum class CoefficientSource { Material, Color };
 
+/// How single scattering finds where a directional light entered on its way to a sample
+/// (DESIGN.md §6.3): by marching towards it through the camera's reconstructed depth (Screen:
+/// only surfaces the camera sees), or from the light's own reconstruction (LightMap: the first
+/// surface the light meets, seen or not, e.g. the back of a thin part). The head light needs
+/// neither: its entry lies on the sample's own line of sight.
+enum class LightPath { Screen, LightMap };
+
 /// The diffuse mean free path ld = 1/σtr of Jensen et al. 2001's measured marble (mm, R G B):
 /// with it a marble-coloured scan gets marble's own σs′ and σa back from its colour.
 inline constexpr glm::vec3 kMarbleMeanFreePathMm{8.51f, 5.57f, 3.95f};
@@ -45,6 +52,7 @@ struct ScatteringSettings {
     std::optional<float> eta;  // unset: the material's; set: overrides it for both sources
     float phaseG = 0.0f;       // Henyey-Greenstein asymmetry, -1 < g < 1
     int singleSamples = 8;     // samples along the refracted view ray
+    LightPath lightPath = LightPath::LightMap;
 };
 
 /// The relative index of refraction single scattering uses (ScatteringSettings::eta's rule).
@@ -57,6 +65,8 @@ std::string toString(ScatteringMethod method);
 ScatteringMethod parseScatteringMethod(std::string_view text);
 std::string toString(CoefficientSource source);
 CoefficientSource parseCoefficientSource(std::string_view text);
+std::string toString(LightPath path);
+LightPath parseLightPath(std::string_view text);
 std::string toString(AlbedoPlacement placement);
 AlbedoPlacement parseAlbedoPlacement(std::string_view text);
 std::string toString(SceneUnit unit);

@@ -16,11 +16,11 @@ glm::vec4 rgbVector(const Rgb& value) {
             static_cast<float>(value[2]), 0.0f};
 }
 
-enum Stage { HeadLight, Lights };
+enum LightStage { HeadLight, MarchedLights, MappedLights };
 
 std::vector<std::string> stageNames(SingleScatteringBase base) {
     const std::string prefix = base == SingleScatteringBase::Radiance ? "RADIANCE" : "SCATTERED";
-    return {prefix + "_HEAD_LIGHT", prefix + "_LIGHTS"};
+    return {prefix + "_HEAD_LIGHT", prefix + "_LIGHTS", prefix + "_LIGHT_MAPS"};
 }
 
 }  // namespace
@@ -100,7 +100,11 @@ void SingleScatteringPass::execute(FrameContext& frame) {
     if (frame.restricted() && base_ == SingleScatteringBase::Radiance) {
         resources.texture("scatteredRadiance").clear();
     }
-    stages_.runOverRegion(lights.lightCount.x > 0 ? Lights : HeadLight, frame.region(0));
+    const LightStage stage =
+        lights.lightCount.x == 0                                                  ? HeadLight
+        : frame.lightMaps != nullptr && settings.lightPath == LightPath::LightMap ? MappedLights
+                                                                                  : MarchedLights;
+    stages_.runOverRegion(stage, frame.region(0));
     glMemoryBarrier(kImageBarriers);
 }
 

@@ -50,8 +50,6 @@ struct ShadingSettings {
     float shadowSoftness = 2.0f;  // x h: the width over which a shadow's edge fades
     int lightMapResolution = 0;   // texels along a light map's longer side; 0: from h (LightMaps)
 
-    /// Whether a frame in a surface mode needs light maps.
-    bool castsShadows() const { return shadows && !lights.empty(); }
 };
 
 void to_json(nlohmann::json& json, const SurfaceSettings& settings);

@@ -1,5 +1,6 @@
 // `subscan bench` on llvmpipe: a smoke test of its JSON with few frames at a small size.
 #include <algorithm>
+#include <filesystem>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -135,21 +136,50 @@ TEST(BenchCommandGLTest, BadScatteringSuffixIsOneSentence) {
     const auto unknown =
         runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface,sss:fast"});
     EXPECT_EQ(unknown.exitCode, 1);
-    EXPECT_THAT(unknown.err, ::testing::HasSubstr("'sss:fast' names the unknown scattering "
-                                                  "method 'fast' (expected sss:gaussian, "
-                                                  "sss:single or sss:both)"));
+    EXPECT_THAT(unknown.err, ::testing::HasSubstr("--modes entry 'sss:fast': 'fast' is neither a "
+                                                  "scattering method of the sss mode "
+                                                  "(sss:gaussian, sss:single or sss:both) nor "
+                                                  "no-shadows (surface and sss)"));
     EXPECT_EQ(std::count(unknown.err.begin(), unknown.err.end(), '\n'), 1) << unknown.err;
 
-    const auto notSss =
-        runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface:single"});
-    EXPECT_EQ(notSss.exitCode, 1);
-    EXPECT_THAT(notSss.err, ::testing::HasSubstr("'surface:single': only the sss mode takes a "
-                                                 "scattering method after ':'"));
+    for (const char* mode : {"surface:single", "points:no-shadows", "sss:single:both"}) {
+        const auto refused =
+            runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", mode});
+        EXPECT_EQ(refused.exitCode, 1) << mode;
+        EXPECT_THAT(refused.err, ::testing::HasSubstr(std::string("--modes entry '") + mode))
+            << mode;
+    }
 
     const auto twice = runSubscan(
         {"bench", "synthetic:sphere", "--frames", "2", "--modes", "sss:single,sss:single"});
     EXPECT_EQ(twice.exitCode, 1);
     EXPECT_THAT(twice.err, ::testing::HasSubstr("--modes names 'sss:single' twice"));
+}
+
+TEST(BenchCommandGLTest, RunsWithLightMapsReportWhatBuildingThemCosts) {
+    test::TempDir dir;
+    const std::filesystem::path settings =
+        dir.write("light.json", R"({"shading": {"lights": [{"direction": [1, 1, 0.5]}]}})");
+    const auto result = runSubscan({"bench", "synthetic:sphere?points=4000", "--frames", "4",
+                                    "--warmup", "1", "--width", "64", "--height", "48", "--modes",
+                                    "surface,surface:no-shadows,sss:single:no-shadows",
+                                    "--settings", settings.string(), "--json"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const nlohmann::json report = nlohmann::json::parse(result.out);
+    const nlohmann::json& shadowed = report["modes"]["surface"];
+    EXPECT_EQ(shadowed["light_maps"], 1);
+    EXPECT_GT(shadowed["light_map_build_ms"].get<double>(), 0.0);
+    // The light stands still while the camera moves: no frame of the path rebuilt its map.
+    for (const auto& [pass, ms] : shadowed["per_pass_ms"].items()) {
+        EXPECT_FALSE(pass.starts_with("LightMap.")) << pass;
+    }
+    EXPECT_FALSE(report["modes"]["surface:no-shadows"].contains("light_map_build_ms"));
+    // Without shadows single scattering still finds its entries in the light's map.
+    EXPECT_EQ(report["modes"]["sss:single:no-shadows"]["light_maps"], 1);
+    EXPECT_EQ(report["modes"]["sss:single:no-shadows"]["scattering_method"], "single");
+    // Memory counts the maps and the images they are built in.
+    EXPECT_GT(shadowed["gpu_memory_mb"].get<double>(),
+              report["modes"]["surface:no-shadows"]["gpu_memory_mb"].get<double>());
 }
 
 TEST(BenchCommandGLTest, UnknownModeIsOneSentence) {

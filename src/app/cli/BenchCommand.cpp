@@ -14,6 +14,7 @@
 
 #include <epoxy/gl.h>
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/cli/CommandSupport.h"
@@ -42,12 +43,14 @@ struct BenchOptions {
     bool software = false;
 };
 
-/// One entry of --modes: a render mode, and for `sss:METHOD` the scattering method that
-/// replaces the settings' one. Its name (as given) names the run in the output.
+/// One entry of --modes: a render mode, then optional suffixes after ':' — `sss:METHOD` the
+/// scattering method that replaces the settings' one, `:no-shadows` (surface and sss) the
+/// directional lights without their light maps. Its name (as given) names the run.
 struct BenchMode {
     std::string name;
     RenderMode mode = RenderMode::Points;
     std::optional<ScatteringMethod> method;
+    bool noShadows = false;
 };
 
 /// The passes that turn the points into a surface (DESIGN.md §5), whose sum is a run's
@@ -56,6 +59,34 @@ constexpr std::string_view kReconstructionPasses[] = {"RasterizePoints",    "Min
                                                       "HiddenPointRemoval", "PullPush",
                                                       "FillRemoval",        "Normals"};
 constexpr std::string_view kSingleScatteringPass = "SingleScattering";
+constexpr std::string_view kLightMapPassPrefix = "LightMap.";
+constexpr std::string_view kNoShadows = "no-shadows";
+
+BenchMode parseMode(const std::string& name) {
+    BenchMode entry{name};
+    std::stringstream parts(name);
+    std::string part;
+    std::getline(parts, part, ':');
+    entry.mode = parseRenderMode(part);
+    while (std::getline(parts, part, ':')) {
+        if (part == kNoShadows && reconstructsSurface(entry.mode)) {
+            entry.noShadows = true;
+            continue;
+        }
+        if (entry.mode == RenderMode::Sss && !entry.method) {
+            try {
+                entry.method = parseScatteringMethod(part);
+                continue;
+            } catch (const Error&) {
+            }
+        }
+        throw Error(
+            fmt::format("--modes entry '{}': '{}' is neither a scattering method of the sss mode "
+                        "(sss:gaussian, sss:single or sss:both) nor no-shadows (surface and sss)",
+                        name, part));
+    }
+    return entry;
+}
 
 std::vector<BenchMode> parseModes(const std::string& list) {
     std::vector<BenchMode> modes;
@@ -63,30 +94,10 @@ std::vector<BenchMode> parseModes(const std::string& list) {
     std::stringstream stream(list);
     std::string name;
     while (std::getline(stream, name, ',')) {
-        BenchMode entry{name};
-        const std::size_t colon = name.find(':');
-        entry.mode = parseRenderMode(name.substr(0, colon));
-        if (colon != std::string::npos) {
-            const std::string suffix = name.substr(colon + 1);
-            if (entry.mode != RenderMode::Sss) {
-                throw Error(fmt::format(
-                    "--modes entry '{}': only the sss mode takes a scattering method after ':' "
-                    "(sss:gaussian, sss:single or sss:both)",
-                    name));
-            }
-            try {
-                entry.method = parseScatteringMethod(suffix);
-            } catch (const Error&) {
-                throw Error(fmt::format(
-                    "--modes entry '{}' names the unknown scattering method '{}' (expected "
-                    "sss:gaussian, sss:single or sss:both)",
-                    name, suffix));
-            }
-        }
         if (!names.insert(name).second) {
             throw Error(fmt::format("--modes names '{}' twice", name));
         }
-        modes.push_back(std::move(entry));
+        modes.push_back(parseMode(name));
     }
     if (modes.empty()) {
         throw Error("--modes names no render mode");
@@ -115,6 +126,32 @@ struct ModeRun {
         if (mode.method) {
             settings.scattering.method = *mode.method;
         }
+        if (mode.noShadows) {
+            settings.shading.shadows = false;
+        }
+    }
+
+    bool usesLightMaps() const { return subscan::usesLightMaps(settings); }
+
+    /// The cost of building every light's map (the sum of the light-map passes of a frame
+    /// that rebuilds them), median of `builds`: each turns the lights by a thousandth of a
+    /// radian, which a map cannot keep.
+    double lightMapBuildMs(const Camera& camera, int builds) {
+        RenderSettings turned = settings;
+        std::vector<double> totals;
+        for (int build = 0; build < builds; ++build) {
+            for (DirectionalLight& light : turned.shading.lights) {
+                light.direction = glm::normalize(light.direction) + glm::vec3(1e-3f, 0.0f, 0.0f);
+            }
+            double total = 0.0;
+            for (const PassTiming& pass : renderer.render(camera, turned).passes) {
+                total += pass.pass.starts_with(kLightMapPassPrefix) ? pass.milliseconds : 0.0;
+            }
+            glFinish();
+            totals.push_back(total);
+        }
+        renderer.render(camera, settings);  // the run's own lights again
+        return median(totals);
     }
 
     /// Renders one frame and waits for it: a frame is done when its image is, with no overlap
@@ -131,6 +168,7 @@ struct ModeRun {
     std::map<std::string, std::vector<double>> passMs;
     std::vector<double> reconstructionMs;  // per frame, the sum of kReconstructionPasses
     int reducedFrames = 0;
+    std::optional<double> lightMapMs;  // lightMapBuildMs(), for runs that use light maps
 };
 
 nlohmann::json summary(const ModeRun& run, std::size_t points) {
@@ -171,6 +209,10 @@ nlohmann::json summary(const ModeRun& run, std::size_t points) {
             single != run.passMs.end()) {
             result["single_scattering_ratio"] = mean(single->second) / reconstruction;
         }
+    }
+    if (run.lightMapMs) {
+        result["light_map_build_ms"] = *run.lightMapMs;
+        result["light_maps"] = run.renderer.lightMaps().maps().size();
     }
     return result;
 }
@@ -214,8 +256,12 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
             run->reducedFrames += result.divisor == 1 ? 0 : 1;
         }
     }
+    constexpr int kLightMapBuilds = 5;
     std::vector<nlohmann::json> summaries;
     for (const std::unique_ptr<ModeRun>& run : runs) {
+        if (run->usesLightMaps()) {
+            run->lightMapMs = run->lightMapBuildMs(cameraAt(0), kLightMapBuilds);
+        }
         summaries.push_back(summary(*run, scan.cloud.size()));
     }
     return summaries;
@@ -262,19 +308,22 @@ int runBench(const BenchOptions& options) {
     }
     fmt::print("{} | {} points | {}x{} | {} frames\n", report["renderer"].get<std::string>(),
                scan.cloud.size(), options.width, options.height, options.frames);
-    fmt::print("{:<12} {:>9} {:>9} {:>11} {:>14} {:>8} {:>8} {:>10} {:>13}\n", "mode", "avg fps",
-               "1% low", "median ms", "points/s", "GPU MB", "reduced", "recon ms", "single/recon");
+    fmt::print("{:<22} {:>9} {:>9} {:>11} {:>14} {:>8} {:>8} {:>10} {:>13} {:>13}\n", "mode",
+               "avg fps", "1% low", "median ms", "points/s", "GPU MB", "reduced", "recon ms",
+               "single/recon", "light map ms");
     for (const BenchMode& mode : modes) {
         const nlohmann::json& m = report["modes"][mode.name];
         const auto optional = [&m](const char* key, int decimals) {
             return m.contains(key) ? fmt::format("{:.{}f}", m[key].get<double>(), decimals)
                                    : std::string("-");
         };
-        fmt::print("{:<12} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f} {:>8} {:>10} {:>13}\n",
-                   mode.name, m["avg_fps"].get<double>(), m["low1_fps"].get<double>(),
-                   m["frame_ms_median"].get<double>(), m["points_per_second"].get<double>(),
-                   m["gpu_memory_mb"].get<double>(), m["reduced_resolution_frames"].get<int>(),
-                   optional("reconstruction_ms", 2), optional("single_scattering_ratio", 3));
+        fmt::print(
+            "{:<22} {:>9.2f} {:>9.2f} {:>11.2f} {:>14.3g} {:>8.1f} {:>8} {:>10} {:>13} {:>13}\n",
+            mode.name, m["avg_fps"].get<double>(), m["low1_fps"].get<double>(),
+            m["frame_ms_median"].get<double>(), m["points_per_second"].get<double>(),
+            m["gpu_memory_mb"].get<double>(), m["reduced_resolution_frames"].get<int>(),
+            optional("reconstruction_ms", 2), optional("single_scattering_ratio", 3),
+            optional("light_map_build_ms", 2));
     }
     return 0;
 }
@@ -297,7 +346,8 @@ Command addBenchCommand(CLI::App& parent) {
     bench->add_option("--modes", options->modes,
                       "Comma-separated modes (default points-gl,points,surface,sss); "
                       "sss:gaussian, sss:single and sss:both run the sss mode with that "
-                      "scattering method (plain sss: the settings' method), each its own run");
+                      "scattering method (plain sss: the settings' method), each its own run; "
+                      "a further :no-shadows (surface, sss) turns the light maps off");
     addResolutionOption(*bench, options->resolution);
     bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
         ->check(CLI::ExistingFile);

@@ -75,6 +75,11 @@ void ScatteringOptions::add(CLI::App& command) {
     command.add_option("--phase-g", phaseG, "Henyey-Greenstein asymmetry g, -1 < g < 1");
     command.add_option("--single-samples", singleSamples,
                        "Samples along the refracted view ray (1..64)");
+    command
+        .add_option("--light-path", lightPath,
+                    "Where single scattering finds a directional light's entry: light_map (the "
+                    "light's own reconstruction, default) | screen (a march through the camera's)")
+        ->check(CLI::IsMember({"screen", "light_map"}));
 }
 
 void ScatteringOptions::apply(ScatteringSettings& settings) const {
@@ -112,6 +117,9 @@ void ScatteringOptions::apply(ScatteringSettings& settings) const {
     }
     if (singleSamples) {
         settings.singleSamples = *singleSamples;
+    }
+    if (!lightPath.empty()) {
+        settings.lightPath = parseLightPath(lightPath);
     }
     checkScatteringSettings(settings);
 }

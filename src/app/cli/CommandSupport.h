@@ -35,6 +35,7 @@ struct ScatteringOptions {
     std::optional<float> eta;
     std::optional<float> phaseG;
     std::optional<int> singleSamples;
+    std::string lightPath;
 
     void add(CLI::App& command);
     /// Writes the given options over `settings`; throws subscan::Error naming the option or the

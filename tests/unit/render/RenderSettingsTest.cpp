@@ -245,5 +245,41 @@ TEST(RenderSettingsTest, ImpossibleScatteringValuesAreNamed) {
     EXPECT_EQ(readSettingsFile(gaussian).scattering.coefficients, CoefficientSource::Material);
 }
 
+TEST(RenderSettingsTest, LightMapSettingsRoundTripAndRefuseImpossibleValues) {
+    RenderSettings settings;
+    settings.shading.shadows = false;
+    settings.shading.shadowBias = 3.5f;
+    settings.shading.shadowSoftness = 0.5f;
+    settings.shading.lightMapResolution = 512;
+    settings.scattering.lightPath = LightPath::Screen;
+    const RenderSettings back = nlohmann::json(settings).get<RenderSettings>();
+    EXPECT_FALSE(back.shading.shadows);
+    EXPECT_EQ(back.shading.shadowBias, 3.5f);
+    EXPECT_EQ(back.shading.shadowSoftness, 0.5f);
+    EXPECT_EQ(back.shading.lightMapResolution, 512);
+    EXPECT_EQ(back.scattering.lightPath, LightPath::Screen);
+    // Defaults: shadows on, the light maps' entries for single scattering.
+    EXPECT_TRUE(RenderSettings{}.shading.shadows);
+    EXPECT_EQ(RenderSettings{}.scattering.lightPath, LightPath::LightMap);
+
+    const auto refusal = [](const nlohmann::json& json) {
+        try {
+            json.get<RenderSettings>();
+        } catch (const Error& error) {
+            return std::string(error.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_THAT(refusal({{"shading", {{"light_map_resolution", 8}}}}),
+                ::testing::HasSubstr("'light_map_resolution' must be 0 (from the point spacing) "
+                                     "or 16 to 8192"));
+    EXPECT_THAT(refusal({{"shading", {{"light_map_resolution", 9000}}}}),
+                ::testing::HasSubstr("'light_map_resolution' = 9000 is outside 0..8192"));
+    EXPECT_THAT(refusal({{"shading", {{"shadow_bias", -1}}}}),
+                ::testing::HasSubstr("'shadow_bias' = -1 is outside"));
+    EXPECT_THAT(refusal({{"scattering", {{"light_path", "shadow_map"}}}}),
+                ::testing::HasSubstr("shadow_map"));
+}
+
 }  // namespace
 }  // namespace subscan

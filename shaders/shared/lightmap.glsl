@@ -1,0 +1,28 @@
+// The directional lights' maps (LightMaps, LightMapPass): per light, rgba32f texels of its
+// reconstruction seen from the light — the depth along the light (+inf where it meets nothing)
+// and the surface normal in the light's view space. Shadows (render/Shade.glsl) and single
+// scattering's entries (render/SingleScattering.comp) read them. Include after
+// shared/common.glsl.
+
+layout(binding = SUBSCAN_TEXTURES_LIGHT_MAPS) uniform sampler2D lightMaps[SUBSCAN_MAX_LIGHTS];
+
+/// Where view-space `position` lies in a light's map (ShadeParams.lightFromView and .lightMap):
+/// xy the continuous texel position (texel i spans [i, i + 1), row 0 at the top: the map's view
+/// is centred on its axis), z the depth along the light.
+vec3 lightMapPosition(mat4 lightFromView, vec4 map, vec3 position) {
+    vec3 inLight = (lightFromView * vec4(position, 1.0)).xyz;
+    return vec3(vec2(inLight.x, -inLight.y) * map.x + 0.5 * map.yz, -inLight.z);
+}
+
+/// The 4 texels around continuous texel position `texel` of light `light`'s map — (0, 0),
+/// (1, 0), (0, 1), (1, 1) from `base` = floor(texel - 0.5), clamped to the map, whose border is
+/// empty — and the bilinear fraction `f`.
+void lightMapTexels(uint light, vec4 map, vec2 texel, out vec4 texels[4], out vec2 f) {
+    vec2 base = floor(texel - 0.5);
+    f = texel - 0.5 - base;
+    ivec2 last = ivec2(map.yz) - 1;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 at = clamp(ivec2(base) + ivec2(k % 2, k / 2), ivec2(0), last);
+        texels[k] = texelFetch(lightMaps[light], at, 0);
+    }
+}
