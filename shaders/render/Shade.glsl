@@ -53,6 +53,30 @@ float shadowing(uint light, vec3 position, vec3 normal) {
     return 0.25 * lit;
 }
 
+/// The irradiance of directional light `light` that entered where the light first meets the
+/// cloud and diffused through it to view-space `position` (after Jimenez et al. 2010): the
+/// entry's irradiance c cos θ_entry times the profile integrated over a plane t deep,
+/// T(t) = Σ w_i e^(−t²/2v_i), t the distance to the entry's tangent plane (a plane-parallel
+/// slab's thickness, whatever the light's angle). It fades in over the shadow tolerance, so that
+/// the light's own first surface (t ≈ 0), which it lights directly, gets none.
+vec3 transmittedIrradiance(uint light, vec3 position) {
+    vec4 map = shade.lightMap[light];
+    vec3 at = lightMapPosition(shade.lightFromView[light], map, position);
+    vec3 entryNormal;
+    float entryDepth = lightMapSurface(light, map, at.xy, entryNormal);
+    float cosEntry = max(entryNormal.z, 0.0);  // the light travels along -z in its view
+    float thickness = (at.z - entryDepth) * cosEntry;
+    if (isinf(entryDepth) || !(thickness > shade.shadow.x)) {
+        return vec3(0.0);
+    }
+    vec3 through = vec3(0.0);
+    for (uint i = 0u; i < shade.profileCount.x; ++i) {
+        through += shade.profile[i].rgb * exp(-thickness * thickness / (2.0 * shade.profile[i].w));
+    }
+    float fade = smoothstep(shade.shadow.x, 2.0 * shade.shadow.x, thickness);
+    return shade.lightColor[light].rgb * cosEntry * fade * through;
+}
+
 void addLight(vec3 direction, vec3 radiance, vec3 normal, vec3 toEye, inout vec3 diffuse,
               inout vec3 specular) {
     float cosine = dot(normal, direction);
@@ -81,6 +105,9 @@ void shadePixel(ivec2 pixel, float depth, vec3 normal, vec3 albedo, out vec3 dif
             radiance *= shadowing(i, position, normal);
         }
         addLight(shade.lightDirection[i].xyz, radiance, normal, toEye, irradiance, specular);
+        if (shade.profileCount.x > 0u) {
+            irradiance += transmittedIrradiance(i, position);
+        }
     }
 #endif
     diffuse = albedo * irradiance;

@@ -238,26 +238,16 @@ Entry localSlabEntry(float s, vec3 toLight, vec3 normal, float cosView) {
 /// sees it, e.g. past the far face of a thin part —, kOffScreen where the map holds no surface.
 Entry lightMapEntry(uint light, vec3 samplePoint, float slack) {
     Entry entry;
-    entry.state = kOffScreen;
-    entry.distance = 0.0;
-    entry.normal = vec3(0.0);
     vec4 map = lights.lightMap[light];
     vec3 at = lightMapPosition(lights.lightFromView[light], map, samplePoint);
-    vec4 texels[4];
-    vec2 f;
-    lightMapTexels(light, map, at.xy, texels, f);
-    vec4 weights = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    vec4 depths = vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
-    int nearest = 0;
-    for (int k = 1; k < 4; ++k) {
-        nearest = weights[k] > weights[nearest] ? k : nearest;
-    }
-    bool allSurface = !any(isinf(depths));
-    float surfaceDepth = allSurface ? dot(weights, depths) : depths[nearest];
+    vec3 normal;
+    float surfaceDepth = lightMapSurface(light, map, at.xy, normal);
     if (isinf(surfaceDepth)) {
+        entry.state = kOffScreen;
+        entry.distance = 0.0;
+        entry.normal = vec3(0.0);
         return entry;
     }
-    vec3 normal = texels[nearest].gba;
     // Light view -> camera view: the inverse of a rotation is its transpose.
     entry.normal = normalize(transpose(mat3(lights.lightFromView[light])) * normal);
     float distanceAlong = at.z - surfaceDepth;

@@ -73,6 +73,7 @@ using mat4 = glm::mat4;
 // ---- limits ----
 #define SUBSCAN_MAX_PYRAMID_LEVELS 16  // 1 + ceil(log2(65536)): the largest image side
 #define SUBSCAN_MAX_LIGHTS 4           // directional lights besides the head light
+#define SUBSCAN_MAX_PROFILE_GAUSSIANS 12  // terms of a diffusion profile the shading transmits
 
 // ---- compute work group sizes ----
 #define SUBSCAN_POINTS_GROUP_SIZE 256
@@ -132,6 +133,10 @@ struct ShadeParams {
     mat4 lightFromView[SUBSCAN_MAX_LIGHTS];
     vec4 lightMap[SUBSCAN_MAX_LIGHTS];
     vec4 shadow;  // x: depth bias, y: width of a shadow's soft edge (both scene units)
+    // Transmission through thin parts (sss mode): the diffusion profile's Gaussians, rgb: weight,
+    // w: variance (scene units²); count.x of them, 0 for none.
+    vec4 profile[SUBSCAN_MAX_PROFILE_GAUSSIANS];
+    uvec4 profileCount;
 };
 
 // SubsurfaceScattering: one dispatch of the blur chain (DESIGN.md §6.1).
@@ -160,8 +165,9 @@ static_assert(sizeof(ScatterParams) == 48);
 static_assert(sizeof(SingleScatterParams) == 96);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
 static_assert(sizeof(SurfaceParams) == 64);
-static_assert(sizeof(ShadeParams) ==
-              3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 + SUBSCAN_MAX_LIGHTS * 64 + 16);
+static_assert(sizeof(ShadeParams) == 3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 +
+                                        SUBSCAN_MAX_LIGHTS * 64 + 16 +
+                                        SUBSCAN_MAX_PROFILE_GAUSSIANS * 16 + 16);
 static_assert(sizeof(FrameParams) == 2 * 64 + 3 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);

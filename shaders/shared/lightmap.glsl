@@ -26,3 +26,20 @@ void lightMapTexels(uint light, vec4 map, vec2 texel, out vec4 texels[4], out ve
         texels[k] = texelFetch(lightMaps[light], at, 0);
     }
 }
+
+/// The surface a light's map holds at continuous texel position `texel`: its depth along the
+/// light, interpolated bilinearly where the 4 nearest texels hold surface (else the nearest
+/// texel's; +inf where that holds none), and the nearest texel's normal (light view space).
+float lightMapSurface(uint light, vec4 map, vec2 texel, out vec3 normal) {
+    vec4 texels[4];
+    vec2 f;
+    lightMapTexels(light, map, texel, texels, f);
+    vec4 weights = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    vec4 depths = vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
+    int nearest = 0;
+    for (int k = 1; k < 4; ++k) {
+        nearest = weights[k] > weights[nearest] ? k : nearest;
+    }
+    normal = texels[nearest].gba;
+    return any(isinf(depths)) ? depths[nearest] : dot(weights, depths);
+}

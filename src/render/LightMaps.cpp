@@ -30,7 +30,13 @@ bool usesLightMaps(const RenderSettings& settings) {
     const bool singleFromMaps = raster.mode == RenderMode::Sss && raster.stage == Stage::Final &&
                                 scattering.method != ScatteringMethod::Gaussian &&
                                 scattering.lightPath == LightPath::LightMap;
-    return settings.shading.shadows || singleFromMaps;
+    return settings.shading.shadows || singleFromMaps || transmitsLight(settings);
+}
+
+bool transmitsLight(const RenderSettings& settings) {
+    return settings.raster.mode == RenderMode::Sss && isFinalImage(settings.raster.stage) &&
+           settings.scattering.method != ScatteringMethod::Single &&
+           settings.scattering.transmission && !settings.shading.lights.empty();
 }
 
 Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int resolution,

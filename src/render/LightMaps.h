@@ -30,9 +30,12 @@ Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int res
 inline constexpr int kLightMapMargin = 4;
 
 /// Whether a frame with these settings reads light maps: a final picture of the surface
-/// modes with directional lights that cast shadows, or whose single scattering finds its
-/// entries in the maps (ScatteringSettings::lightPath).
+/// modes with directional lights that cast shadows, whose single scattering finds its entries
+/// in the maps (ScatteringSettings::lightPath), or that transmit light into the blur.
 bool usesLightMaps(const RenderSettings& settings);
+/// Whether the sss mode's shading adds the directional lights' light through thin parts to
+/// the diffuse light its Gaussian blur spreads (ScatteringSettings::transmission).
+bool transmitsLight(const RenderSettings& settings);
 
 /// The reconstruction seen from each directional light (DESIGN.md §5.9): per light the
 /// reconstruction of the cloud in the light's orthographic view, kept as its light map

@@ -99,6 +99,7 @@ void to_json(nlohmann::json& json, const ScatteringSettings& settings) {
         {"phase_g", settings.phaseG},
         {"single_samples", settings.singleSamples},
         {"light_path", toString(settings.lightPath)},
+        {"transmission", settings.transmission},
     };
 }
 
@@ -140,7 +141,8 @@ void checkScatteringSettings(const ScatteringSettings& settings) {
 void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
     rejectUnknownKeys(json, "scattering",
                       {"method", "material", "unit", "scale", "albedo", "max_taps", "coefficients",
-                       "mean_free_path_mm", "eta", "phase_g", "single_samples", "light_path"});
+                       "mean_free_path_mm", "eta", "phase_g", "single_samples", "light_path",
+                       "transmission"});
     readEnum(json, "method", settings.method, kMethods, "scattering method");
     readEnum(json, "coefficients", settings.coefficients, kSources, "coefficient source");
     if (const auto found = json.find("material"); found != json.end()) {
@@ -166,6 +168,7 @@ void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
     readSetting(json, "phase_g", settings.phaseG, -1e30f, 1e30f);
     readSetting(json, "single_samples", settings.singleSamples, -1000000, 1000000);
     readEnum(json, "light_path", settings.lightPath, kLightPaths, "light path");
+    readSetting(json, "transmission", settings.transmission);
     checkScatteringSettings(settings);
 }
 

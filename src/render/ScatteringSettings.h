@@ -53,6 +53,9 @@ struct ScatteringSettings {
     float phaseG = 0.0f;       // Henyey-Greenstein asymmetry, -1 < g < 1
     int singleSamples = 8;     // samples along the refracted view ray
     LightPath lightPath = LightPath::LightMap;
+    // Light of the directional lights through thin parts into the Gaussian blur: the light
+    // map's thickness and the profile (Jimenez et al. 2010; DESIGN.md §5.9).
+    bool transmission = true;
 };
 
 /// The relative index of refraction single scattering uses (ScatteringSettings::eta's rule).

@@ -2,9 +2,14 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "core/Error.h"
+
 #include "render/LightMaps.h"
+#include "sss/MaterialLibrary.h"
+#include "sss/ProfileFit.h"
 
 namespace subscan {
 
@@ -19,6 +24,31 @@ std::vector<std::string_view> ShadePass::outputs() const {
     }
     return {"radiance"};
 }
+
+namespace {
+
+static_assert(kMaxFittedGaussians <= SUBSCAN_MAX_PROFILE_GAUSSIANS,
+              "every fitted profile must fit the shading's transmission");
+
+/// The material's diffusion profile in scene units, for light through thin parts; its
+/// zero-variance terms (a delta) transmit nothing through any thickness.
+void setTransmissionProfile(gpu::ShadeParams& params, const ScatteringSettings& settings) {
+    const double unitsPerMm = settings.scale / millimetresPerUnit(settings.unit);
+    std::uint32_t count = 0;
+    for (const Gaussian& term : findMaterial(settings.material).gaussians.gaussians) {
+        const double variance = term.varianceMm2 * unitsPerMm * unitsPerMm;
+        if (variance > 0.0) {
+            if (count == SUBSCAN_MAX_PROFILE_GAUSSIANS) {
+                throw Error(fmt::format("the material '{}' has more than {} Gaussians to transmit",
+                                        settings.material, SUBSCAN_MAX_PROFILE_GAUSSIANS));
+            }
+            params.profile[count++] = {term.weight[0], term.weight[1], term.weight[2], variance};
+        }
+    }
+    params.profileCount = {count, 0, 0, 0};
+}
+
+}  // namespace
 
 gpu::ShadeParams ShadePass::parameters(const FrameContext& frame) {
     const ShadingSettings& settings = frame.settings.shading;
@@ -37,6 +67,9 @@ gpu::ShadeParams ShadePass::parameters(const FrameContext& frame) {
     params.lightCount = {static_cast<std::uint32_t>(count), 0, 0, 0};
     if (frame.lightMaps != nullptr) {
         frame.lightMaps->prepareShading(params, camera, settings, frame.spacing);
+        if (transmitsLight(frame.settings)) {
+            setTransmissionProfile(params, frame.settings.scattering);
+        }
     }
     return params;
 }

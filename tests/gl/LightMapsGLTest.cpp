@@ -18,6 +18,7 @@
 #include "core/Camera.h"
 #include "render/LightMaps.h"
 #include "render/Renderer.h"
+#include "sss/GaussianSet.h"
 #include "sss/MaterialLibrary.h"
 #include "sss/SingleScattering.h"
 #include "support/GlTestSupport.h"
@@ -336,6 +337,59 @@ TEST(LightMapsGLTest, SlabLitFromBehindGetsNothingThroughTheScreenMarch) {
     }
     const BackLitSlab mapped = renderBackLitSlab(0.38, towardsLight, LightPath::LightMap);
     EXPECT_GT(mapped.single[16 * 32 + 16][1], 0.0);
+}
+
+/// The diffuse light (before the blur) at the middle of a slab of skin between two plates of
+/// points 6 mm wide (millimetres), seen from the front, lit by one directional light.
+constexpr double kTransmissionSpacing = 0.05;  // mm: a tenth of the thinnest slab
+
+double transmittedDiffuse(double thickness, const glm::dvec3& towardsLight, bool transmission) {
+    constexpr double spacing = kTransmissionSpacing;
+    PointCloudBuilder builder({.color = true}, 2 * 14400);
+    addPlate(builder, 0.0, 6.0, {0.0, 0.0}, 0.0, Facing::Z, spacing);
+    addPlate(builder, -thickness, 6.0, {0.0, 0.0}, 0.0, Facing::Z, spacing);
+    Renderer renderer(test::glTestContext(), finish(builder), spacing);
+    RenderSettings settings = lightOnly(towardsLight);
+    settings.raster.mode = RenderMode::Sss;
+    settings.scattering.material = "skin-deon";
+    settings.scattering.unit = SceneUnit::Millimetre;
+    settings.scattering.transmission = transmission;
+    Camera camera;
+    camera.width = camera.height = 16;
+    camera.fovyDegrees = 10.0;
+    camera.view = glm::lookAt(glm::dvec3(0.0, 0.0, 12.0), glm::dvec3(0.0), glm::dvec3(0, 1, 0));
+    camera.nearPlane = 5.0;
+    camera.farPlane = 30.0;
+    renderer.render(camera, settings, FrameOutputs::Everything);
+    return renderer.resources().texture("diffuse").readFloats()[4 * (8 * 16 + 8) + 1];  // green
+}
+
+TEST(LightMapsGLTest, TransmissionThroughASlabFollowsTheProfile) {
+    const GaussianSet& profile = findMaterial("skin-deon").gaussians;
+    const glm::dvec3 behind = glm::normalize(glm::dvec3(0.3, 0.2, -1.0));
+    const auto transmitted = [&](double thickness) {
+        // T(t) = Σ w_i e^(−t²/2v_i): the profile integrated over the plane t deep; a white
+        // plate, a light of value 1 arriving at cos θ = −z.
+        double through = 0.0;
+        for (const Gaussian& term : profile.gaussians) {
+            through += term.weight[1] * std::exp(-thickness * thickness / (2.0 * term.varianceMm2));
+        }
+        return -behind.z * through;
+    };
+    // A light-map texel (about h wide) holds its nearest point: the back face lies up to half
+    // a texel's slope, h tan θ / 2, nearer the light than the truth; the diffuse light is a
+    // half float besides (1 %).
+    const double tangent = std::sqrt(1.0 - behind.z * behind.z) / -behind.z;
+    const double slack = 0.5 * kTransmissionSpacing * tangent;
+    for (const double thickness : {0.5, 1.0, 2.0}) {
+        const double value = transmittedDiffuse(thickness, behind, true);
+        EXPECT_GE(value, 0.99 * transmitted(thickness + slack)) << thickness << " mm";
+        EXPECT_LE(value, 1.01 * transmitted(thickness)) << thickness << " mm";
+        EXPECT_EQ(transmittedDiffuse(thickness, behind, false), 0.0f) << thickness << " mm";
+    }
+    // Lit from the front, the front face is the light's own first surface: Lambert alone.
+    const glm::dvec3 front = glm::normalize(glm::dvec3(0.3, 0.2, 1.0));
+    EXPECT_NEAR(transmittedDiffuse(0.5, front, true), front.z, 0.002);
 }
 
 TEST(LightMapsGLTest, LightMapHoldsTheDepthOfThePlaneItSees) {
