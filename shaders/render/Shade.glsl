@@ -73,7 +73,7 @@ vec3 transmittedIrradiance(uint light, vec3 position) {
     for (uint i = 0u; i < shade.profileCount.x; ++i) {
         through += shade.profile[i].rgb * exp(-thickness * thickness / (2.0 * shade.profile[i].w));
     }
-    float fade = smoothstep(shade.shadow.x, 2.0 * shade.shadow.x, thickness);
+    float fade = smoothstep(shade.shadow.x, 3.0 * shade.shadow.x, thickness);
     return shade.lightColor[light].rgb * cosEntry * fade * through;
 }
 

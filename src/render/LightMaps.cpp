@@ -89,8 +89,8 @@ LightMaps::LightMaps(GlContext& context, const ShaderSources& sources,
     : context_(context), sources_(sources), reconstruction_(reconstruction) {}
 
 std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Bounds& cloudBounds,
-                                          const RenderSettings& settings, double spacing,
-                                          PassRunner& runner) {
+                                          const Camera& camera, const RenderSettings& settings,
+                                          double spacing, PassRunner& runner) {
     const std::vector<DirectionalLight>& lights = settings.shading.lights;
     const std::size_t count = std::min<std::size_t>(lights.size(), SUBSCAN_MAX_LIGHTS);
     maps_.resize(count);
@@ -103,24 +103,24 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
 
     std::vector<PassTiming> timings;
     for (std::size_t i = 0; i < count; ++i) {
-        const Key key{glm::normalize(glm::dvec3(lights[i].direction)),
+        const Key key{towardsLightInWorld(lights[i], camera.view),
                       settings.shading.lightMapResolution, settings.surface, settings.raster.path};
         if (maps_[i].texture.id() != 0 && keys_[i] == key) {
             continue;
         }
-        const Camera camera = lightCamera(cloudBounds, key.towardsLight, key.resolution, spacing);
+        const Camera view = lightCamera(cloudBounds, key.towardsLight, key.resolution, spacing);
         const int limit = context_.capabilities().maxTextureSize;
-        if (camera.width > limit || camera.height > limit) {
+        if (view.width > limit || view.height > limit) {
             throw Error(
                 fmt::format("a light map of {}x{} texels is larger than the GPU allows "
                             "({} per side): lower 'light_map_resolution'",
-                            camera.width, camera.height, limit));
+                            view.width, view.height, limit));
         }
         const gpu::PyramidLayout& layout =
-            uniforms_.update(camera, lightSettings, spacing, cloud.origin());
-        FrameContext frame{camera,     cloud,  lightSettings, context_.capabilities(),
+            uniforms_.update(view, lightSettings, spacing, cloud.origin());
+        FrameContext frame{view,       cloud,  lightSettings, context_.capabilities(),
                            resources_, layout, spacing};
-        frame.cloudPixels = projectedPixelBounds(camera, cloudBounds);
+        frame.cloudPixels = projectedPixelBounds(view, cloudBounds);
         std::vector<RenderPass*> passes;
         reconstruction_.appendAll(passes, SurfaceOutputs::DepthAndNormals);
         passes.push_back(&lazyPass(pack_, sources_));
@@ -130,14 +130,13 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
         }
 
         Map& map = maps_[i];
-        if (map.texture.width() != camera.width || map.texture.height() != camera.height) {
+        if (map.texture.width() != view.width || map.texture.height() != view.height) {
             map.texture =
-                Texture(TextureFormat::RGBA32F, camera.width, camera.height, "LightMap.texture");
+                Texture(TextureFormat::RGBA32F, view.width, view.height, "LightMap.texture");
         }
         glCopyImageSubData(resources_.texture("lightMap").id(), GL_TEXTURE_2D, 0, 0, 0, 0,
-                           map.texture.id(), GL_TEXTURE_2D, 0, 0, 0, 0, camera.width, camera.height,
-                           1);
-        map.camera = camera;
+                           map.texture.id(), GL_TEXTURE_2D, 0, 0, 0, 0, view.width, view.height, 1);
+        map.camera = view;
         keys_[i] = key;
         ++builds_;
     }

@@ -52,11 +52,12 @@ class LightMaps {
 
     LightMaps(GlContext& context, const ShaderSources& sources, Reconstruction& reconstruction);
 
-    /// Brings the maps up to date with `settings.shading` (one per directional light) and
-    /// returns the timings of the passes that ran: empty when every map was current.
+    /// Brings the maps up to date with `settings.shading` (one per directional light; those
+    /// fixed to the view as `camera` turns them) and returns the timings of the passes that
+    /// ran: empty when every map was current.
     std::vector<PassTiming> update(const GpuPointCloud& cloud, const Bounds& cloudBounds,
-                                   const RenderSettings& settings, double spacing,
-                                   PassRunner& runner);
+                                   const Camera& camera, const RenderSettings& settings,
+                                   double spacing, PassRunner& runner);
     const std::vector<Map>& maps() const { return maps_; }
     /// Maps built so far (a light's first map counts): for tests of the caching.
     std::size_t builds() const { return builds_; }

@@ -133,7 +133,8 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     const bool lightMaps = usesLightMaps(settings);
     std::vector<PassTiming> lightTimings;
     if (lightMaps) {
-        lightTimings = lightMaps_.update(cloud_, cloudBounds_, settings, spacing_, *runner_);
+        lightTimings =
+            lightMaps_.update(cloud_, cloudBounds_, camera, settings, spacing_, *runner_);
     }
 
     // The point modes draw every pixel: at reduced resolution they would lose points.

@@ -59,8 +59,8 @@ gpu::ShadeParams ShadePass::parameters(const FrameContext& frame) {
     params.specular = {settings.specular, settings.shininess, 0.0f, 0.0f};
     const std::size_t count = std::min<std::size_t>(settings.lights.size(), SUBSCAN_MAX_LIGHTS);
     for (std::size_t i = 0; i < count; ++i) {
-        const glm::dvec3 direction =
-            glm::dvec3(camera.view * glm::dvec4(glm::dvec3(settings.lights[i].direction), 0.0));
+        const glm::dvec3 direction = glm::dvec3(
+            camera.view * glm::dvec4(towardsLightInWorld(settings.lights[i], camera.view), 0.0));
         params.lightDirection[i] = glm::vec4(glm::normalize(direction), 0.0);
         params.lightColor[i] = glm::vec4(settings.lights[i].radiance, 0.0f);
     }

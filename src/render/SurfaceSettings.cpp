@@ -1,5 +1,9 @@
 #include "render/SurfaceSettings.h"
 
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+
 #include "render/SettingsJson.h"
 #include "shared/bindings.h"
 
@@ -32,11 +36,30 @@ void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
     readSetting(json, "restrict_to_points", settings.restrictToPoints);
 }
 
+namespace {
+
+constexpr std::pair<LightSpace, std::string_view> kLightSpaces[] = {
+    {LightSpace::World, "world"},
+    {LightSpace::View, "view"},
+};
+
+}  // namespace
+
+glm::dvec3 towardsLightInWorld(const DirectionalLight& light, const glm::dmat4& view) {
+    const glm::dvec3 direction = glm::normalize(glm::dvec3(light.direction));
+    if (light.space == LightSpace::World) {
+        return direction;
+    }
+    // View space -> world: the transpose of the view's rotation.
+    return glm::normalize(glm::transpose(glm::dmat3(view)) * direction);
+}
+
 void to_json(nlohmann::json& json, const ShadingSettings& settings) {
     nlohmann::json lights = nlohmann::json::array();
     for (const DirectionalLight& light : settings.lights) {
-        lights.push_back(
-            {{"direction", toJson(light.direction)}, {"radiance", toJson(light.radiance)}});
+        lights.push_back({{"direction", toJson(light.direction)},
+                          {"radiance", toJson(light.radiance)},
+                          {"space", nameOf(kLightSpaces, light.space)}});
     }
     json = {
         {"head_light", toJson(settings.headLight)},
@@ -78,9 +101,10 @@ void from_json(const nlohmann::json& json, ShadingSettings& settings) {
         settings.lights.clear();
         for (const nlohmann::json& entry : *lights) {
             DirectionalLight light;
-            rejectUnknownKeys(entry, "lights", {"direction", "radiance"});
+            rejectUnknownKeys(entry, "lights", {"direction", "radiance", "space"});
             readSetting(entry, "direction", light.direction, -1e6f, 1e6f);
             readSetting(entry, "radiance", light.radiance, 0.0f, 100.0f);
+            readEnum(entry, "space", light.space, kLightSpaces, "light space");
             if (!(glm::dot(light.direction, light.direction) > 0.0f)) {
                 throw Error("a light's 'direction' must not be zero");
             }

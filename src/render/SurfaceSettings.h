@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json_fwd.hpp>
 
@@ -27,10 +28,21 @@ struct SurfaceSettings {
     bool operator==(const SurfaceSettings&) const = default;
 };
 
+/// Where a directional light's direction is fixed: in the scene (World; it stays put while
+/// the camera moves) or to the camera (View: x right, y up, z towards the eye; it turns with
+/// the camera, like a photographer's key light, and its light map is rebuilt whenever the
+/// camera turns).
+enum class LightSpace { World, View };
+
 struct DirectionalLight {
-    glm::vec3 direction{0.0f, 1.0f, 0.0f};  // towards the light, world space
+    glm::vec3 direction{0.0f, 1.0f, 0.0f};  // towards the light, in `space`
     glm::vec3 radiance{1.0f};
+    LightSpace space = LightSpace::World;
 };
+
+/// The unit direction towards `light` in the scene's coordinates for a camera whose
+/// world-to-view matrix is `view`.
+glm::dvec3 towardsLightInWorld(const DirectionalLight& light, const glm::dmat4& view);
 
 /// Explicit light map resolutions (ShadingSettings::lightMapResolution).
 inline constexpr int kMinLightMapResolution = 16;
@@ -49,7 +61,6 @@ struct ShadingSettings {
     float shadowBias = 2.0f;      // x h: how far behind the light map's surface shadow begins
     float shadowSoftness = 2.0f;  // x h: the width over which a shadow's edge fades
     int lightMapResolution = 0;   // texels along a light map's longer side; 0: from h (LightMaps)
-
 };
 
 void to_json(nlohmann::json& json, const SurfaceSettings& settings);

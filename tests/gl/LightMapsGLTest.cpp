@@ -478,6 +478,40 @@ TEST(LightMapsGLTest, MapsAreRebuiltOnlyWhenTheirLightOrItsSettingsChange) {
     settings.shading.shadows = true;
     renderer.render(camera, settings);
     EXPECT_EQ(maps.builds(), 7u) << "frames without shadows build no map";
+
+    // A light fixed to the view turns with the camera: its map follows, the other's stays.
+    settings.raster.mode = RenderMode::Surface;
+    settings.shading.lights[1].space = LightSpace::View;
+    settings.shading.lights[1].direction = glm::vec3(-0.5f, 0.5f, 0.7f);
+    renderer.render(camera, settings);
+    EXPECT_EQ(maps.builds(), 8u);
+    renderer.render(camera, settings);
+    EXPECT_EQ(maps.builds(), 8u);
+    renderer.render(lookingAt({0.9, 1.2, 1.4}, {0.1, 0.0, 0.0}, {0.0, 1.0, 0.0}), settings);
+    EXPECT_EQ(maps.builds(), 9u);
+}
+
+TEST(LightMapsGLTest, ALightFixedToTheViewShadesLikeTheSameLightInTheScene) {
+    PointCloudBuilder builder({.color = true}, 170000);
+    addPlate(builder, 0.0, 2.0, {0.0, 0.0});
+    addPlate(builder, 0.6, 0.6, {0.35, 0.0});
+    Renderer renderer(test::glTestContext(), finish(builder), kSpacing);
+    const Camera camera = lookingAt({0.4, 2.5, 1.5}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
+    const glm::dvec3 inView(-0.4, 0.6, 0.5);
+    RenderSettings settings = lightOnly(inView);
+    settings.shading.lights[0].space = LightSpace::View;
+    const Shaded viewLight = renderShaded(renderer, camera, settings);
+    settings.shading.lights[0].space = LightSpace::World;
+    settings.shading.lights[0].direction =
+        glm::vec3(glm::transpose(glm::dmat3(camera.view)) * glm::normalize(inView));
+    const Shaded sceneLight = renderShaded(renderer, camera, settings);
+    ASSERT_EQ(viewLight.radiance.size(), sceneLight.radiance.size());
+    std::size_t different = 0;
+    for (std::size_t i = 0; i < viewLight.radiance.size(); ++i) {
+        // The same direction up to float rounding of its two routes: 1e-3 of a unit radiance.
+        different += std::abs(viewLight.radiance[i] - sceneLight.radiance[i]) > 1e-3f ? 1 : 0;
+    }
+    EXPECT_EQ(different, 0u);
 }
 
 }  // namespace

@@ -317,7 +317,13 @@ DirectionalLight& Viewer::firstLight() {
 
 void Viewer::dragLight(double dxPixels, double dyPixels) {
     DirectionalLight& light = firstLight();
-    light.direction = glm::vec3(camera_.dragLight(glm::dvec3(light.direction), dxPixels, dyPixels));
+    // The drag turns the light in the scene; a light fixed to the view keeps its direction
+    // relative to the camera afterwards.
+    const glm::dmat4 view = camera_.camera(1, 1).view;
+    const glm::dvec3 turned =
+        camera_.dragLight(towardsLightInWorld(light, view), dxPixels, dyPixels);
+    light.direction =
+        glm::vec3(light.space == LightSpace::World ? turned : glm::dmat3(view) * turned);
 }
 
 void Viewer::flyWithKeys(double seconds) {

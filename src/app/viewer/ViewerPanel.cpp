@@ -39,6 +39,8 @@ constexpr SceneUnit kUnits[] = {SceneUnit::Millimetre, SceneUnit::Centimetre, Sc
 constexpr ScatteringMethod kMethods[] = {ScatteringMethod::Gaussian, ScatteringMethod::Single,
                                          ScatteringMethod::Both};
 constexpr CoefficientSource kSources[] = {CoefficientSource::Material, CoefficientSource::Color};
+constexpr LightPath kLightPaths[] = {LightPath::LightMap, LightPath::Screen};
+constexpr LightSpace kLightSpaces[] = {LightSpace::World, LightSpace::View};
 // The ranges checkScatteringSettings allows, a little inside where its bounds are open.
 constexpr float kMinMeanFreePathMm = 0.01f;
 constexpr float kMaxMeanFreePathMm = 1000.0f;
@@ -391,7 +393,16 @@ void ViewerPanel::drawShading(ShadingSettings& shading) {
             !(glm::dot(light.direction, light.direction) > 1e-6f)) {
             light.direction = before;  // a zero direction has no light to give
         }
-        helpTooltip("Towards the light, in scene coordinates.");
+        helpTooltip(
+            light.space == LightSpace::World
+                ? "Towards the light, in scene coordinates."
+                : "Towards the light, in the view's coordinates (x right, y up, z to you).");
+        choiceCombo<LightSpace>("fixed to", light.space, kLightSpaces, [](LightSpace space) {
+            return space == LightSpace::World ? "scene" : "view";
+        });
+        helpTooltip(
+            "scene: the light stays put while you orbit; view: it turns with the camera (its "
+            "shadows are recomputed whenever the view turns).");
         ImGui::ColorEdit3("radiance", &light.radiance.x, kRadiance);
         ImGui::PopID();
     }
@@ -403,6 +414,25 @@ void ViewerPanel::drawShading(ShadingSettings& shading) {
         shading.lights.push_back({glm::vec3(-0.5f, 0.8f, 0.4f), glm::vec3(1.0f)});
     }
     ImGui::EndDisabled();
+
+    ImGui::Separator();
+    ImGui::Checkbox("shadows", &shading.shadows);
+    helpTooltip(
+        "The directional lights cast shadows: each light reconstructs the scan from its own "
+        "direction (its light map), again only when it turns. Hold L and drag to turn light 1.");
+    ImGui::BeginDisabled(!shading.shadows);
+    ImGui::SliderFloat("shadow bias (h)", &shading.shadowBias, 0.0f, 20.0f, "%.2f", kClamp);
+    helpTooltip("How far behind the light's surface, in point spacings, a shadow begins.");
+    ImGui::SliderFloat("soft edge (h)", &shading.shadowSoftness, 0.0f, 20.0f, "%.2f", kClamp);
+    helpTooltip("The width over which a shadow's edge fades, in point spacings.");
+    ImGui::EndDisabled();
+    int resolution = shading.lightMapResolution;
+    if (ImGui::SliderInt("light map texels", &resolution, 0, 4096, resolution == 0 ? "auto" : "%d",
+                         kClamp)) {
+        // 1..15 would be refused; below the smallest useful size means automatic.
+        shading.lightMapResolution = resolution < kMinLightMapResolution ? 0 : resolution;
+    }
+    helpTooltip("Texels along a light map's longer side; auto: one per point spacing, 64 to 2048.");
 }
 
 void ViewerPanel::drawScattering(ScatteringSettings& scattering) {
@@ -458,6 +488,10 @@ void ViewerPanel::drawScattering(ScatteringSettings& scattering) {
                                  [](AlbedoPlacement placement) { return toString(placement); });
     helpTooltip("Where the colour enters the blur: before it, after it, or sqrt on both sides.");
     ImGui::SliderInt("max taps", &scattering.maxTaps, 1, 128, "%d", kClamp);
+    ImGui::Checkbox("transmission", &scattering.transmission);
+    helpTooltip(
+        "Directional light through thin parts (ears, fingers, rims lit from behind), from the "
+        "light map's thickness and the material's profile.");
     ImGui::EndDisabled();
 
     ImGui::Separator();
@@ -465,6 +499,11 @@ void ViewerPanel::drawScattering(ScatteringSettings& scattering) {
     ImGui::BeginDisabled(!single);
     choiceCombo<CoefficientSource>("coefficients", scattering.coefficients, kSources,
                                    [](CoefficientSource source) { return toString(source); });
+    choiceCombo<LightPath>("light entry", scattering.lightPath, kLightPaths,
+                           [](LightPath path) { return toString(path); });
+    helpTooltip(
+        "Where a directional light entered: light_map, the first surface the light meets (also "
+        "the back of a thin part); screen, a march through what the camera sees.");
     helpTooltip(
         "Where sigma_s' and sigma_a come from: the material's measurement, or per pixel from "
         "the surface colour and the mean free path.");

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <glm/ext/matrix_transform.hpp>
+
 #include "core/Error.h"
 #include "render/GpuPointCloud.h"
 #include "render/RenderSettings.h"
@@ -252,7 +254,12 @@ TEST(RenderSettingsTest, LightMapSettingsRoundTripAndRefuseImpossibleValues) {
     settings.shading.shadowSoftness = 0.5f;
     settings.shading.lightMapResolution = 512;
     settings.scattering.lightPath = LightPath::Screen;
+    settings.scattering.transmission = false;
+    settings.shading.lights.push_back({{0, 0, 1}, {1, 1, 1}, LightSpace::View});
     const RenderSettings back = nlohmann::json(settings).get<RenderSettings>();
+    ASSERT_EQ(back.shading.lights.size(), 1u);
+    EXPECT_EQ(back.shading.lights[0].space, LightSpace::View);
+    EXPECT_FALSE(back.scattering.transmission);
     EXPECT_FALSE(back.shading.shadows);
     EXPECT_EQ(back.shading.shadowBias, 3.5f);
     EXPECT_EQ(back.shading.shadowSoftness, 0.5f);
@@ -279,6 +286,22 @@ TEST(RenderSettingsTest, LightMapSettingsRoundTripAndRefuseImpossibleValues) {
                 ::testing::HasSubstr("'shadow_bias' = -1 is outside"));
     EXPECT_THAT(refusal({{"scattering", {{"light_path", "shadow_map"}}}}),
                 ::testing::HasSubstr("shadow_map"));
+    EXPECT_THAT(
+        refusal({{"shading", {{"lights", {{{"direction", {0, 1, 0}}, {"space", "eye"}}}}}}}),
+        ::testing::HasSubstr("eye"));
+}
+
+TEST(RenderSettingsTest, ALightFixedToTheViewPointsWhereTheViewSays) {
+    // A camera at +x looking at the origin: the view's +z (towards the eye) is the scene's +x,
+    // its +x (right) the scene's -z.
+    const glm::dmat4 view = glm::lookAt(glm::dvec3(5, 0, 0), glm::dvec3(0), glm::dvec3(0, 1, 0));
+    const auto inWorld = [&](glm::vec3 direction, LightSpace space) {
+        return towardsLightInWorld({direction, glm::vec3(1.0f), space}, view);
+    };
+    const glm::dvec3 towardsEye = inWorld({0, 0, 2}, LightSpace::View);
+    EXPECT_NEAR(towardsEye.x, 1.0, 1e-12);
+    EXPECT_NEAR(inWorld({1, 0, 0}, LightSpace::View).z, -1.0, 1e-12);
+    EXPECT_NEAR(inWorld({0, 3, 0}, LightSpace::World).y, 1.0, 1e-12);  // normalised, as given
 }
 
 }  // namespace
