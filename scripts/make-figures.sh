@@ -18,4 +18,6 @@ build/tools/subscan_figures stages "$scan" docs/images/stages-happy.png --yaw 0 
 build/tools/subscan_figures compare "$scan" docs/images/compare-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 420 560
 build/tools/subscan_figures materials "$scan" docs/images/materials-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 420 560
 build/tools/subscan_figures single "$scan" docs/images/single-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 320 420
+build/tools/subscan_figures shadows "$scan" docs/images/shadows-happy.png --yaw 0 --pitch 10 --distance 0.3 --size 300 460
+build/tools/subscan_figures backlit "$scan" docs/images/backlit-happy.png --yaw 0 --pitch 10 --distance 0.3 --size 300 460
 ls -1 docs/images

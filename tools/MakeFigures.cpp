@@ -1,9 +1,9 @@
 // Renders the README's figures: the stages of the surface pipeline side by side (like the
 // paper's Figure 2), a points/splats/surface comparison, and the surface beside marble and skin
-// (like the paper's Figure 8), and the two scattering paths under a grazing key light. Run by
-// scripts/make-figures.sh.
-//   subscan_figures stages|compare|materials|single SCAN OUT.png [--yaw D] [--pitch D]
-//                   [--distance F] [--size W H]
+// (like the paper's Figure 8), the two scattering paths under a grazing key light, shadows of a
+// side light, and light through thin parts lit from behind. Run by scripts/make-figures.sh.
+//   subscan_figures stages|compare|materials|single|shadows|backlit SCAN OUT.png [--yaw D]
+//                   [--pitch D] [--distance F] [--size W H]
 #include <cstdio>
 #include <string>
 #include <string_view>
@@ -24,6 +24,8 @@ struct Panel {
     Stage stage;
     std::string material = {};  // sss panels
     ScatteringMethod method = ScatteringMethod::Gaussian;
+    bool keyLight = true;   // shadows: the side light shines
+    bool lightMaps = true;  // shadows: it casts shadows; backlit: transmission, light_map
 };
 
 /// Side-by-side tiles, `columns` per row, separated by a `gap` of background.
@@ -47,8 +49,8 @@ Image8 montage(const std::vector<std::vector<std::uint8_t>>& tiles, int width, i
 int run(int argc, char** argv) {
     if (argc < 4) {
         std::fprintf(stderr,
-                     "usage: subscan_figures stages|compare|materials|single SCAN OUT.png [--yaw D] "
-                     "[--pitch D] [--distance F] [--size W H]\n");
+                     "usage: subscan_figures stages|compare|materials|single|shadows|backlit SCAN "
+                     "OUT.png [--yaw D] [--pitch D] [--distance F] [--size W H]\n");
         return 2;
     }
     const std::string_view kind = argv[1];
@@ -73,7 +75,7 @@ int run(int argc, char** argv) {
     std::vector<Panel> panels;
     int columns = 2;
     if (kind == "stages") {
-        panels = {{RenderMode::Points, Stage::Final},     {RenderMode::Surface, Stage::Depth},
+        panels = {{RenderMode::Points, Stage::Final},       {RenderMode::Surface, Stage::Depth},
                   {RenderMode::Surface, Stage::Visibility}, {RenderMode::Surface, Stage::Pull},
                   {RenderMode::Surface, Stage::Push},       {RenderMode::Surface, Stage::Fill},
                   {RenderMode::Surface, Stage::Normals},    {RenderMode::Surface, Stage::Final}};
@@ -88,6 +90,18 @@ int run(int argc, char** argv) {
                   {RenderMode::Sss, Stage::Final, "marble-jimenez", ScatteringMethod::Gaussian},
                   {RenderMode::Sss, Stage::Final, "marble-jimenez", ScatteringMethod::Single},
                   {RenderMode::Sss, Stage::Final, "marble-jimenez", ScatteringMethod::Both}};
+        columns = 4;
+    } else if (kind == "shadows") {
+        panels = {{RenderMode::Surface, Stage::Final, {}, {}, false},
+                  {RenderMode::Surface, Stage::Final, {}, {}, true, false},
+                  {RenderMode::Surface, Stage::Final, {}, {}, true, true}};
+        columns = 3;
+    } else if (kind == "backlit") {
+        panels = {
+            {RenderMode::Sss, Stage::Final, "skin-deon", ScatteringMethod::Gaussian, true, false},
+            {RenderMode::Sss, Stage::Final, "skin-deon", ScatteringMethod::Gaussian},
+            {RenderMode::Sss, Stage::Final, "marble", ScatteringMethod::Single, true, false},
+            {RenderMode::Sss, Stage::Final, "marble", ScatteringMethod::Single}};
         columns = 4;
     } else if (kind == "compare") {
         panels = {{RenderMode::Points, Stage::Final},
@@ -122,6 +136,27 @@ int run(int argc, char** argv) {
             settings.shading.headLight = glm::vec3(0.15f);
             settings.shading.ambient = glm::vec3(0.05f);
             settings.shading.lights.push_back({{-1.0f, 0.25f, 0.15f}, glm::vec3(1.2f)});
+        }
+        if (kind == "shadows") {
+            // Today's default (head light and ambient) beside a key light from the left.
+            if (panel.keyLight) {
+                settings.shading.headLight = glm::vec3(0.25f);
+                settings.shading.ambient = glm::vec3(0.08f);
+                settings.shading.lights.push_back({{-1.0f, 0.5f, 0.35f}, glm::vec3(0.9f)});
+            }
+            settings.shading.shadows = panel.lightMaps;
+        }
+        if (kind == "backlit") {
+            // A light from behind and above, a dim head light: thin parts glow where the light
+            // comes through (transmission for the blur, the light map's entries for single
+            // scattering); without them, only the head light's share is left.
+            settings.shading.headLight = glm::vec3(0.2f);
+            settings.shading.ambient = glm::vec3(0.03f);
+            settings.shading.lights.push_back({{0.3f, 0.5f, -1.0f}, glm::vec3(2.0f)});
+            settings.scattering.scale = 2.0f;
+            settings.scattering.transmission = panel.lightMaps;
+            settings.scattering.lightPath =
+                panel.lightMaps ? LightPath::LightMap : LightPath::Screen;
         }
         if (!panel.material.empty()) {
             settings.scattering.material = panel.material;
