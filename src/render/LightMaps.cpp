@@ -122,7 +122,7 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
                            resources_, layout, spacing};
         frame.cloudPixels = projectedPixelBounds(view, cloudBounds);
         std::vector<RenderPass*> passes;
-        reconstruction_.appendAll(passes, SurfaceOutputs::DepthAndNormals);
+        reconstruction_.appendAll(passes);
         passes.push_back(&lazyPass(pack_, sources_));
         for (PassTiming& timing : runner.run(passes, frame)) {
             timing.pass = "LightMap." + timing.pass;

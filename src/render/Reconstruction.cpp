@@ -18,26 +18,21 @@ void Reconstruction::appendRasterization(std::vector<RenderPass*>& passes) {
     passes.push_back(&lazyPass(rasterize_, sources_, capabilities_));
 }
 
-void Reconstruction::appendSurface(std::vector<RenderPass*>& passes, LevelZero levelZero,
-                                   SurfaceOutputs outputs) {
+void Reconstruction::appendSurface(std::vector<RenderPass*>& passes, LevelZero levelZero) {
     passes.push_back(&lazyPass(minDepthPyramid_, sources_));
     passes.push_back(&lazyPass(hiddenPointRemoval_, sources_));
     PullPushPass& pullPush = lazyPass(pullPush_, sources_);
     FillRemovalPass& fillRemoval = lazyPass(fillRemoval_, sources_);
+    NormalsPass& normals = lazyPass(normals_, sources_);
     pullPush.setLevelZero(levelZero);
     fillRemoval.setLevelZero(levelZero);
-    passes.insert(passes.end(), {&pullPush, &fillRemoval});
-    if (levelZero == LevelZero::Fused || outputs == SurfaceOutputs::DepthAndNormals) {
-        // Fused frames need the normal pyramid above level 0 for FinishSurface's blend.
-        NormalsPass& normals = lazyPass(normals_, sources_);
-        normals.setLevelZero(levelZero);
-        passes.push_back(&normals);
-    }
+    normals.setLevelZero(levelZero);
+    passes.insert(passes.end(), {&pullPush, &fillRemoval, &normals});
 }
 
-void Reconstruction::appendAll(std::vector<RenderPass*>& passes, SurfaceOutputs outputs) {
+void Reconstruction::appendAll(std::vector<RenderPass*>& passes) {
     appendRasterization(passes);
-    appendSurface(passes, LevelZero::PerPass, outputs);
+    appendSurface(passes, LevelZero::PerPass);
 }
 
 }  // namespace subscan

@@ -16,10 +16,6 @@ class PullPushPass;
 class FillRemovalPass;
 class NormalsPass;
 
-/// What a reconstruction leaves at full resolution besides the pyramids: "surfaceDepth" (and
-/// "mask", "filledColor"), or those and "normals".
-enum class SurfaceOutputs { Depth, DepthAndNormals };
-
 /// The screen-space reconstruction (DESIGN.md §5 steps 1-5) as one unit for any view: the
 /// camera's (Renderer) or a directional light's orthographic one (LightMaps). Its passes keep
 /// nothing of a view between runs — every image lives in the view's FrameResources — so one
@@ -34,11 +30,10 @@ class Reconstruction {
     /// Step 1: the compute rasterizer's 1-pixel points ("depth", "color").
     void appendRasterization(std::vector<RenderPass*>& passes);
     /// Steps 2-5 on the rasterized points. With LevelZero::Fused the full-resolution level is
-    /// left to FinishSurfacePass (and `outputs` does not apply).
-    void appendSurface(std::vector<RenderPass*>& passes, LevelZero levelZero,
-                       SurfaceOutputs outputs = SurfaceOutputs::DepthAndNormals);
-    /// Both, for a view that needs only the surface (a light's).
-    void appendAll(std::vector<RenderPass*>& passes, SurfaceOutputs outputs);
+    /// left to FinishSurfacePass.
+    void appendSurface(std::vector<RenderPass*>& passes, LevelZero levelZero);
+    /// Both, every level, for a view that needs only the surface (a light's).
+    void appendAll(std::vector<RenderPass*>& passes);
 
     /// The compute rasterizer, once a frame has used it (null before).
     const RasterizePointsPass* rasterizePass() const { return rasterize_.get(); }
