@@ -21,8 +21,8 @@ namespace subscan {
 
 /// A directional light's orthographic view of `bounds` (file coordinates), looking along
 /// -towardsLight: `resolution` texels span the longer side of the box's projection — 0 chooses
-/// one texel per point spacing h, within 64..2048 (a 2048² map costs about a 1080p frame to
-/// build, and it is built only when the light moves) — with kLightMapMargin empty texels on
+/// one texel per point spacing h, within 64..2048 (the cap bounds what turning a light costs:
+/// a build runs the reconstruction over every texel) — with kLightMapMargin empty texels on
 /// every side (the filter's reach). Near and far hug the box.
 Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int resolution,
                    double spacing);
