@@ -34,8 +34,10 @@ float litFraction(uint light, vec2 texel, float depth, vec2 slope) {
 
 /// The share of directional light `light` that reaches view-space `position` with surface
 /// normal `normal` past the cloud's own surface, seen from the light (its light map): 4
-/// bilinear percentage-closer tests a soft edge's width apart, each texel compared with the
-/// receiver's tangent plane at that texel (no acne on tilted surfaces) less the tolerance.
+/// bilinear percentage-closer tests, each texel compared with the receiver's tangent plane at
+/// that texel (no acne on tilted surfaces) less the tolerance. A bilinear test fades over one
+/// texel; the taps stand (width − 1 texel) apart, so that an edge fades over the soft edge's
+/// width (ShadeParams.shadow.y), or one texel at the least.
 float shadowing(uint light, vec3 position, vec3 normal) {
     vec4 map = shade.lightMap[light];
     vec3 at = lightMapPosition(shade.lightFromView[light], map, position);
@@ -44,7 +46,7 @@ float shadowing(uint light, vec3 position, vec3 normal) {
     const float kSteepest = 5.67;
     vec2 slope = clamp(vec2(normalInLight.x, -normalInLight.y) / max(normalInLight.z, 1e-3),
                        -kSteepest, kSteepest) / map.x;
-    float spread = 0.25 * shade.shadow.y * map.x;
+    float spread = 0.5 * max(shade.shadow.y * map.x - 1.0, 0.0);
     float lit = 0.0;
     for (int tap = 0; tap < 4; ++tap) {
         vec2 offset = spread * vec2(tap % 2 == 0 ? -1.0 : 1.0, tap < 2 ? -1.0 : 1.0);
@@ -57,23 +59,26 @@ float shadowing(uint light, vec3 position, vec3 normal) {
 /// cloud and diffused through it to view-space `position` (after Jimenez et al. 2010): the
 /// entry's irradiance c cos θ_entry times the profile integrated over a plane t deep,
 /// T(t) = Σ w_i e^(−t²/2v_i), t the distance to the entry's tangent plane (a plane-parallel
-/// slab's thickness, whatever the light's angle). It fades in over the shadow tolerance, so that
-/// the light's own first surface (t ≈ 0), which it lights directly, gets none.
+/// slab's thickness, whatever the light's angle). It fades in from one to three tolerances (the
+/// shadows', at least a texel), so that the light's own first surface (t ≈ 0), which it lights
+/// directly, gets none.
 vec3 transmittedIrradiance(uint light, vec3 position) {
     vec4 map = shade.lightMap[light];
     vec3 at = lightMapPosition(shade.lightFromView[light], map, position);
+    float tolerance = max(shade.shadow.x, 1.0 / map.x);
     vec3 entryNormal;
-    float entryDepth = lightMapSurface(light, map, at.xy, entryNormal);
+    float entryDepth =
+        lightMapSurface(light, map, at.xy, lightMapJump(map, tolerance), entryNormal);
     float cosEntry = max(entryNormal.z, 0.0);  // the light travels along -z in its view
     float thickness = (at.z - entryDepth) * cosEntry;
-    if (isinf(entryDepth) || !(thickness > shade.shadow.x)) {
+    if (isinf(entryDepth) || !(thickness > tolerance)) {
         return vec3(0.0);
     }
     vec3 through = vec3(0.0);
     for (uint i = 0u; i < shade.profileCount.x; ++i) {
         through += shade.profile[i].rgb * exp(-thickness * thickness / (2.0 * shade.profile[i].w));
     }
-    float fade = smoothstep(shade.shadow.x, 3.0 * shade.shadow.x, thickness);
+    float fade = smoothstep(tolerance, 3.0 * tolerance, thickness);
     return shade.lightColor[light].rgb * cosEntry * fade * through;
 }
 

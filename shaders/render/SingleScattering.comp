@@ -231,9 +231,8 @@ Entry localSlabEntry(float s, vec3 toLight, vec3 normal, float cosView) {
 
 #if LIGHT_MAP_ENTRIES
 /// Where directional light `light` entered on its way to `samplePoint`, from its light map:
-/// the first surface the light meets above the sample (depth interpolated bilinearly where the
-/// 4 nearest texels hold surface, else the nearest texel's), at the straight distance between
-/// them along the light, with that surface's normal. kInside (no light) where the sample lies
+/// the first surface the light meets above the sample (lightMapSurface), at the straight
+/// distance between them along the light, with that surface's normal. kInside (no light) where the sample lies
 /// in front of that surface by more than the tolerance `slack` — outside the medium as the light
 /// sees it, e.g. past the far face of a thin part —, kOffScreen where the map holds no surface.
 Entry lightMapEntry(uint light, vec3 samplePoint, float slack) {
@@ -241,7 +240,8 @@ Entry lightMapEntry(uint light, vec3 samplePoint, float slack) {
     vec4 map = lights.lightMap[light];
     vec3 at = lightMapPosition(lights.lightFromView[light], map, samplePoint);
     vec3 normal;
-    float surfaceDepth = lightMapSurface(light, map, at.xy, normal);
+    float surfaceDepth =
+        lightMapSurface(light, map, at.xy, lightMapJump(map, lights.shadow.x), normal);
     if (isinf(surfaceDepth)) {
         entry.state = kOffScreen;
         entry.distance = 0.0;

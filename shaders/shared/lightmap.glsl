@@ -48,9 +48,11 @@ void lightMapTexels(uint light, vec4 map, vec2 texel, out vec4 texels[4], out ve
 }
 
 /// The surface a light's map holds at continuous texel position `texel`: its depth along the
-/// light, interpolated bilinearly where the 4 nearest texels hold surface (else the nearest
-/// texel's; +inf where that holds none), and the nearest texel's normal (light view space).
-float lightMapSurface(uint light, vec4 map, vec2 texel, out vec3 normal) {
+/// light, interpolated bilinearly where the 4 nearest texels hold one surface (their depths
+/// within `jump` of each other), else the nearest texel's (+inf where that holds none), so that
+/// no depth between an occluder and what lies behind it is made up; and the nearest texel's
+/// normal (light view space).
+float lightMapSurface(uint light, vec4 map, vec2 texel, float jump, out vec3 normal) {
     vec4 texels[4];
     vec2 f;
     lightMapTexels(light, map, texel, texels, f);
@@ -61,5 +63,11 @@ float lightMapSurface(uint light, vec4 map, vec2 texel, out vec3 normal) {
         nearest = weights[k] > weights[nearest] ? k : nearest;
     }
     normal = texels[nearest].gba;
-    return any(isinf(depths)) ? depths[nearest] : dot(weights, depths);
+    float spread = max(max(depths.x, depths.y), max(depths.z, depths.w)) -
+                   min(min(depths.x, depths.y), min(depths.z, depths.w));
+    return spread <= jump ? dot(weights, depths) : depths[nearest];
 }
+
+/// The depth difference `lightMapSurface` still takes for one surface: the tolerance plus the
+/// spread of a surface tilted 76 degrees from the light over a texel (4 texel widths).
+float lightMapJump(vec4 map, float tolerance) { return tolerance + 4.0 / map.x; }

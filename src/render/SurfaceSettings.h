@@ -59,7 +59,7 @@ struct ShadingSettings {
     // reconstruction of the cloud: its light map (DESIGN.md §5.9, render/LightMaps.h).
     bool shadows = true;
     float shadowBias = 2.0f;      // x h: how far behind the light map's surface shadow begins
-    float shadowSoftness = 2.0f;  // x h: the width over which a shadow's edge fades
+    float shadowSoftness = 2.0f;  // x h: the width over which a shadow's edge fades (>= a texel)
     int lightMapResolution = 0;   // texels along a light map's longer side; 0: from h (LightMaps)
 };
 

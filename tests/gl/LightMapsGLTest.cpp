@@ -3,6 +3,7 @@
 // scattering through the maps: a slab lit from behind against its closed form. A light map's
 // depth against the plane it sees; maps rebuilt when, and only when, their light or the
 // settings that shape them change.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -176,6 +177,47 @@ TEST(LightMapsGLTest, FloatingPlateCastsItsAnalyticShadow) {
                          << " pixels are in the analytic shadow";
 }
 
+/// Pixels of the row through the floating plate's shadow, left of its middle, whose radiance
+/// lies strictly between a tenth and nine tenths of the lit value: the width of the shadow's
+/// left edge.
+int softEdgePixels(float softness) {
+    PointCloudBuilder builder({.color = true}, 170000);
+    addPlate(builder, 0.0, 2.0, {0.0, 0.0});
+    addPlate(builder, 0.6, 0.6, {0.35, 0.0});
+    Renderer renderer(test::glTestContext(), finish(builder), kSpacing);
+    const glm::dvec3 towardsLight = glm::normalize(glm::dvec3(1.0, 1.0, 0.0));
+    RenderSettings settings = lightOnly(towardsLight);
+    settings.shading.shadowSoftness = softness;
+    const Camera camera = lookingAt({0.0, 3.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, -1.0});
+    const Shaded shaded = renderShaded(renderer, camera, settings);
+    const double lit = towardsLight.y;
+    int partial = 0;
+    const int y = camera.height / 2;
+    for (int x = 0; x < camera.width; ++x) {
+        // The shadow spans x -0.55..0.05 on the lower plate; its left edge is alone out there.
+        if (hitPlane(pixelRay(camera, x, y), 0.0)->x > -0.25) {
+            continue;
+        }
+        const float value = shaded.radiance[4 * (static_cast<std::size_t>(y) * camera.width + x)];
+        partial += value > 0.1 * lit && value < 0.9 * lit ? 1 : 0;
+    }
+    return partial;
+}
+
+TEST(LightMapsGLTest, ShadowEdgesFadeOverTheSoftEdgesWidth) {
+    // Taps (w − 1) texels apart, each a one-texel bilinear ramp: the edge climbs from a tenth
+    // to nine tenths over w − 0.4 texels. A texel is h = 0.005 here, a pixel 0.00485 on the lower
+    // plate, and the light at 45° stretches the map across that plate by √2.
+    for (const float softness : {4.0f, 20.0f}) {
+        const double expected = (softness - 0.4) * std::sqrt(2.0) * 0.005 / 0.00485;
+        // Whole pixels at both ends of the ramp (1.5 pixels), and a tenth for the occluder's
+        // outline in the map, which has a fringe of its own. Measured: 5 pixels for 5.2 at 4 h,
+        // 29 for 28.6 at 20 h; taps half as far apart (the first version) gave 3 and 19.
+        EXPECT_NEAR(softEdgePixels(softness), expected, 1.5 + 0.1 * expected)
+            << "softness " << softness << " h";
+    }
+}
+
 TEST(LightMapsGLTest, LitFlatPlatesShowNoAcne) {
     const Camera camera = lookingAt({0.0, 1.6, 1.6}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
     for (const double noise : {0.0, 0.1 * kSpacing}) {
@@ -339,11 +381,13 @@ TEST(LightMapsGLTest, SlabLitFromBehindGetsNothingThroughTheScreenMarch) {
     EXPECT_GT(mapped.single[16 * 32 + 16][1], 0.0);
 }
 
-/// The diffuse light (before the blur) at the middle of a slab of skin between two plates of
+/// The diffuse light (before the blur) in the middle of a slab of skin between two plates of
 /// points 6 mm wide (millimetres), seen from the front, lit by one directional light.
 constexpr double kTransmissionSpacing = 0.05;  // mm: a tenth of the thinnest slab
 
-double transmittedDiffuse(double thickness, const glm::dvec3& towardsLight, bool transmission) {
+std::vector<float> transmittedDiffuse(double thickness, const glm::dvec3& towardsLight,
+                                      bool transmission,
+                                      float shadowBias = ShadingSettings{}.shadowBias) {
     constexpr double spacing = kTransmissionSpacing;
     PointCloudBuilder builder({.color = true}, 2 * 14400);
     addPlate(builder, 0.0, 6.0, {0.0, 0.0}, 0.0, Facing::Z, spacing);
@@ -354,6 +398,7 @@ double transmittedDiffuse(double thickness, const glm::dvec3& towardsLight, bool
     settings.scattering.material = "skin-deon";
     settings.scattering.unit = SceneUnit::Millimetre;
     settings.scattering.transmission = transmission;
+    settings.shading.shadowBias = shadowBias;
     Camera camera;
     camera.width = camera.height = 16;
     camera.fovyDegrees = 10.0;
@@ -361,7 +406,21 @@ double transmittedDiffuse(double thickness, const glm::dvec3& towardsLight, bool
     camera.nearPlane = 5.0;
     camera.farPlane = 30.0;
     renderer.render(camera, settings, FrameOutputs::Everything);
-    return renderer.resources().texture("diffuse").readFloats()[4 * (8 * 16 + 8) + 1];  // green
+    return renderer.resources().texture("diffuse").readFloats();
+}
+
+/// The green diffuse light at the middle pixel, and the brightest of the middle 8².
+float middlePixel(const std::vector<float>& diffuse) {
+    return diffuse[4 * (8 * 16 + 8) + 1];
+}
+float brightestInTheMiddle(const std::vector<float>& diffuse) {
+    float brightest = 0.0f;
+    for (int y = 4; y < 12; ++y) {
+        for (int x = 4; x < 12; ++x) {
+            brightest = std::max(brightest, diffuse[4 * (y * 16 + x) + 1]);
+        }
+    }
+    return brightest;
 }
 
 TEST(LightMapsGLTest, TransmissionThroughASlabFollowsTheProfile) {
@@ -382,14 +441,18 @@ TEST(LightMapsGLTest, TransmissionThroughASlabFollowsTheProfile) {
     const double tangent = std::sqrt(1.0 - behind.z * behind.z) / -behind.z;
     const double slack = 0.5 * kTransmissionSpacing * tangent;
     for (const double thickness : {0.5, 1.0, 2.0}) {
-        const double value = transmittedDiffuse(thickness, behind, true);
+        const double value = middlePixel(transmittedDiffuse(thickness, behind, true));
         EXPECT_GE(value, 0.99 * transmitted(thickness + slack)) << thickness << " mm";
         EXPECT_LE(value, 1.01 * transmitted(thickness)) << thickness << " mm";
-        EXPECT_EQ(transmittedDiffuse(thickness, behind, false), 0.0f) << thickness << " mm";
+        EXPECT_EQ(brightestInTheMiddle(transmittedDiffuse(thickness, behind, false)), 0.0f)
+            << thickness << " mm";
     }
     // Lit from the front, the front face is the light's own first surface: Lambert alone.
     const glm::dvec3 front = glm::normalize(glm::dvec3(0.3, 0.2, 1.0));
-    EXPECT_NEAR(transmittedDiffuse(0.5, front, true), front.z, 0.002);
+    // The diffuse light is a half float: 11 significant bits, 5e-4 of 0.95.
+    EXPECT_NEAR(brightestInTheMiddle(transmittedDiffuse(0.5, front, true)), front.z, 0.002);
+    // Also with no shadow bias at all: the fade keeps a texel's tolerance.
+    EXPECT_NEAR(brightestInTheMiddle(transmittedDiffuse(0.5, front, true, 0.0f)), front.z, 0.002);
 }
 
 TEST(LightMapsGLTest, LightMapHoldsTheDepthOfThePlaneItSees) {

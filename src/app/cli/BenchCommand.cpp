@@ -141,7 +141,11 @@ struct ModeRun {
         std::vector<double> totals;
         for (int build = 0; build < builds; ++build) {
             for (DirectionalLight& light : turned.shading.lights) {
-                light.direction = glm::normalize(light.direction) + glm::vec3(1e-3f, 0.0f, 0.0f);
+                // A thousandth of a radian about an axis across the light.
+                const glm::vec3 along = glm::normalize(light.direction);
+                const glm::vec3 other = std::abs(along.x) < 0.9f ? glm::vec3(1.0f, 0.0f, 0.0f)
+                                                                 : glm::vec3(0.0f, 1.0f, 0.0f);
+                light.direction = along + 1e-3f * glm::normalize(glm::cross(along, other));
             }
             double total = 0.0;
             for (const PassTiming& pass : renderer.render(camera, turned).passes) {

@@ -420,9 +420,12 @@ void ViewerPanel::drawShading(ShadingSettings& shading) {
     helpTooltip(
         "The directional lights cast shadows: each light reconstructs the scan from its own "
         "direction (its light map), again only when it turns. Hold L and drag to turn light 1.");
-    ImGui::BeginDisabled(!shading.shadows);
     ImGui::SliderFloat("shadow bias (h)", &shading.shadowBias, 0.0f, 20.0f, "%.2f", kClamp);
-    helpTooltip("How far behind the light's surface, in point spacings, a shadow begins.");
+    helpTooltip(
+        "How far behind the light's surface, in point spacings, a shadow begins; also how far "
+        "the camera's and the light's surfaces may differ for transmission and single "
+        "scattering's entries.");
+    ImGui::BeginDisabled(!shading.shadows);
     ImGui::SliderFloat("soft edge (h)", &shading.shadowSoftness, 0.0f, 20.0f, "%.2f", kClamp);
     helpTooltip("The width over which a shadow's edge fades, in point spacings.");
     ImGui::EndDisabled();
@@ -499,14 +502,14 @@ void ViewerPanel::drawScattering(ScatteringSettings& scattering) {
     ImGui::BeginDisabled(!single);
     choiceCombo<CoefficientSource>("coefficients", scattering.coefficients, kSources,
                                    [](CoefficientSource source) { return toString(source); });
+    helpTooltip(
+        "Where sigma_s' and sigma_a come from: the material's measurement, or per pixel from "
+        "the surface colour and the mean free path.");
     choiceCombo<LightPath>("light entry", scattering.lightPath, kLightPaths,
                            [](LightPath path) { return toString(path); });
     helpTooltip(
         "Where a directional light entered: light_map, the first surface the light meets (also "
         "the back of a thin part); screen, a march through what the camera sees.");
-    helpTooltip(
-        "Where sigma_s' and sigma_a come from: the material's measurement, or per pixel from "
-        "the surface colour and the mean free path.");
     ImGui::BeginDisabled(scattering.coefficients != CoefficientSource::Color);
     // The three values, a button, then the label where the other labels are.
     const ImGuiStyle& style = ImGui::GetStyle();
