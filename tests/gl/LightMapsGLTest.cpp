@@ -263,16 +263,22 @@ struct BackLitSlab {
     Camera camera;
 };
 
+/// The faces of a slab, z = 0 (towards the camera) and z = −thickness, `side` wide.
+PointCloud slab(double thickness, double side, double spacing) {
+    PointCloudBuilder builder({.color = true},
+                              2 * static_cast<std::size_t>(std::pow(side / spacing + 1.0, 2.0)));
+    addPlate(builder, 0.0, side, {0.0, 0.0}, 0.0, Facing::Z, spacing);
+    addPlate(builder, -thickness, side, {0.0, 0.0}, 0.0, Facing::Z, spacing);
+    return finish(builder);
+}
+
 constexpr double kSlabSpacing = 0.01;  // mm: a twentieth of the thinnest slab
 constexpr int kSlabSamples = 63;       // the most the pass takes but one (a multiple of 3)
 
 BackLitSlab renderBackLitSlab(double thickness, const glm::dvec3& towardsLight, LightPath path) {
     // 2 mm wide: the light reaches the middle through the back face, not the sides, for the
     // thickest slab (0.76 mm) at the test's angle.
-    PointCloudBuilder builder({.color = true}, 2 * 40000);
-    addPlate(builder, 0.0, 2.0, {0.0, 0.0}, 0.0, Facing::Z, kSlabSpacing);
-    addPlate(builder, -thickness, 2.0, {0.0, 0.0}, 0.0, Facing::Z, kSlabSpacing);
-    Renderer renderer(test::glTestContext(), finish(builder), kSlabSpacing);
+    Renderer renderer(test::glTestContext(), slab(thickness, 2.0, kSlabSpacing), kSlabSpacing);
     RenderSettings settings = lightOnly(towardsLight);
     settings.raster.mode = RenderMode::Sss;
     ScatteringSettings& scattering = settings.scattering;
@@ -388,11 +394,8 @@ constexpr double kTransmissionSpacing = 0.05;  // mm: a tenth of the thinnest sl
 std::vector<float> transmittedDiffuse(double thickness, const glm::dvec3& towardsLight,
                                       bool transmission,
                                       float shadowBias = ShadingSettings{}.shadowBias) {
-    constexpr double spacing = kTransmissionSpacing;
-    PointCloudBuilder builder({.color = true}, 2 * 14400);
-    addPlate(builder, 0.0, 6.0, {0.0, 0.0}, 0.0, Facing::Z, spacing);
-    addPlate(builder, -thickness, 6.0, {0.0, 0.0}, 0.0, Facing::Z, spacing);
-    Renderer renderer(test::glTestContext(), finish(builder), spacing);
+    Renderer renderer(test::glTestContext(), slab(thickness, 6.0, kTransmissionSpacing),
+                      kTransmissionSpacing);
     RenderSettings settings = lightOnly(towardsLight);
     settings.raster.mode = RenderMode::Sss;
     settings.scattering.material = "skin-deon";
