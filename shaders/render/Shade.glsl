@@ -19,7 +19,7 @@ float litFraction(uint light, vec2 texel, float depth, vec2 slope) {
     vec4 texels[4];
     vec2 f;
     lightMapTexels(light, shade.lightMap[light], texel, texels, f);
-    vec4 stored = vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
+    vec4 stored = depthsOf(texels);
     vec4 dx = vec4(0.0, 1.0, 0.0, 1.0) - f.x;
     vec4 dy = vec4(0.0, 0.0, 1.0, 1.0) - f.y;
     // A texel holds the depth of its nearest point, anywhere inside it, or where it holds
@@ -28,8 +28,7 @@ float litFraction(uint light, vec2 texel, float depth, vec2 slope) {
     float tolerance = shade.shadow.x + abs(slope.x) + abs(slope.y);
     vec4 receiver = depth + slope.x * dx + slope.y * dy - tolerance;
     vec4 lit = vec4(greaterThanEqual(stored, receiver));
-    vec4 weight = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    return dot(lit, weight);
+    return dot(lit, bilinearWeights(f));
 }
 
 /// The share of directional light `light` that reaches view-space `position` with surface

@@ -47,6 +47,15 @@ void lightMapTexels(uint light, vec4 map, vec2 texel, out vec4 texels[4], out ve
     }
 }
 
+/// The weights of texels (0, 0), (1, 0), (0, 1), (1, 1) from lightMapTexels' `base` at
+/// bilinear fraction `f`, and those texels' depths.
+vec4 bilinearWeights(vec2 f) {
+    return vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+}
+vec4 depthsOf(vec4 texels[4]) {
+    return vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
+}
+
 /// The surface a light's map holds at continuous texel position `texel`: its depth along the
 /// light, interpolated bilinearly where the 4 nearest texels hold one surface (their depths
 /// within `jump` of each other), else the nearest texel's (+inf where that holds none), so that
@@ -56,8 +65,8 @@ float lightMapSurface(uint light, vec4 map, vec2 texel, float jump, out vec3 nor
     vec4 texels[4];
     vec2 f;
     lightMapTexels(light, map, texel, texels, f);
-    vec4 weights = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
-    vec4 depths = vec4(texels[0].r, texels[1].r, texels[2].r, texels[3].r);
+    vec4 weights = bilinearWeights(f);
+    vec4 depths = depthsOf(texels);
     int nearest = 0;
     for (int k = 1; k < 4; ++k) {
         nearest = weights[k] > weights[nearest] ? k : nearest;

@@ -125,7 +125,7 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
         reconstruction_.appendAll(passes);
         passes.push_back(&lazyPass(pack_, sources_));
         for (PassTiming& timing : runner.run(passes, frame)) {
-            timing.pass = "LightMap." + timing.pass;
+            timing.pass = std::string(kLightMapPassPrefix) + timing.pass;
             timings.push_back(std::move(timing));
         }
 

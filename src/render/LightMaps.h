@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "core/Camera.h"
@@ -27,6 +28,8 @@ namespace subscan {
 Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int resolution,
                    double spacing);
 inline constexpr int kLightMapMargin = 4;
+/// What the names of a light map's passes begin with in a frame's timings.
+inline constexpr std::string_view kLightMapPassPrefix = "LightMap.";
 
 /// Whether a frame with these settings reads light maps: a final picture of the surface
 /// modes with directional lights that cast shadows, whose single scattering finds its entries

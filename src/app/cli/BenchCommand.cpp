@@ -59,7 +59,6 @@ constexpr std::string_view kReconstructionPasses[] = {"RasterizePoints",    "Min
                                                       "HiddenPointRemoval", "PullPush",
                                                       "FillRemoval",        "Normals"};
 constexpr std::string_view kSingleScatteringPass = "SingleScattering";
-constexpr std::string_view kLightMapPassPrefix = "LightMap.";
 constexpr std::string_view kNoShadows = "no-shadows";
 
 BenchMode parseMode(const std::string& name) {
