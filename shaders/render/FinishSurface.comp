@@ -8,14 +8,28 @@
 // half floats.
 //   STAGE_HEAD_LIGHT  the head light alone (no directional lights)
 //   STAGE_LIGHTS      the head light and the directional lights
-#define SHADE_DIRECTIONAL_LIGHTS STAGE_LIGHTS
+//   STAGE_*_RADIANCE  the same, writing linear radiance for the temporal filter (no encoding)
+#if defined(STAGE_LIGHTS) || defined(STAGE_LIGHTS_RADIANCE)
+#define SHADE_DIRECTIONAL_LIGHTS 1
+#else
+#define SHADE_DIRECTIONAL_LIGHTS 0
+#endif
+#if defined(STAGE_HEAD_LIGHT_RADIANCE) || defined(STAGE_LIGHTS_RADIANCE)
+#define WRITE_RADIANCE 1
+#else
+#define WRITE_RADIANCE 0
+#endif
 #include "render/FillRemoval.glsl"
 #include "render/Normals.glsl"
 #include "render/Shade.glsl"
 #include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
+#if WRITE_RADIANCE
+layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outRadiance;
+#else
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
+#endif
 layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceDepth;
 
 void main() {
@@ -33,6 +47,10 @@ void main() {
                    diffuse, specular);
         color = diffuse + specular;
     }
+#if WRITE_RADIANCE
+    imageStore(outRadiance, pixel, vec4(color, 1.0));
+#else
     imageStore(outImage, pixel, vec4(linearToSrgb(color), 1.0));
+#endif
     imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? filled.x : kInfinity));
 }

@@ -87,6 +87,7 @@ struct FrameParams {
     vec4 depthRange;     // near, far, focal length in pixels (orthographic: pixels per unit),
                          // w: 1 for an orthographic view (a light's), 0 for a pinhole camera
     vec4 background;     // linear RGB, alpha unused
+    vec4 jitter;         // xy: pixels the picture is shifted by (Camera::jitterPixels), zw unused
 };
 
 // RasterizePoints: which slice of the cloud this dispatch covers.
@@ -160,7 +161,23 @@ struct SingleScatterParams {
                         // y: 1 to write the term and the coefficients alone (exports)
 };
 
+// Temporal (DESIGN.md §5 step 10): the new frame blended into the previous result reprojected
+// to it.
+struct TemporalParams {
+    mat4 previousFromView;    // this frame's view space -> the previous frame's view space
+    mat4 previousProjection;  // the previous frame's projection without its jitter
+    vec4 blend;  // x: least weight of the new frame while the camera moves, y: clip sigma,
+                 // z: most frames a still camera averages, w: unused
+    vec4 depth;  // x: depth difference (scene units) beyond which the history saw another surface
+    uvec4 mode;  // x: SUBSCAN_TEMPORAL_RESTART, _STILL or _MOVING; y: 1 when the history was
+                 // reprojected last frame (a still camera then weighs it as one frame)
+};
+#define SUBSCAN_TEMPORAL_RESTART 0u  // no usable history: the frame alone
+#define SUBSCAN_TEMPORAL_STILL 1u    // the same camera: an even mean of the frames, no clipping
+#define SUBSCAN_TEMPORAL_MOVING 2u   // reprojection, disocclusion and clipping
+
 #ifdef __cplusplus
+static_assert(sizeof(TemporalParams) == 2 * 64 + 3 * 16);
 static_assert(sizeof(ScatterParams) == 48);
 static_assert(sizeof(SingleScatterParams) == 96);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
@@ -168,7 +185,7 @@ static_assert(sizeof(SurfaceParams) == 64);
 static_assert(sizeof(ShadeParams) == 3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 +
                                         SUBSCAN_MAX_LIGHTS * 64 + 16 +
                                         SUBSCAN_MAX_PROFILE_GAUSSIANS * 16 + 16);
-static_assert(sizeof(FrameParams) == 2 * 64 + 3 * 16);
+static_assert(sizeof(FrameParams) == 2 * 64 + 4 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);
 }  // namespace subscan::gpu

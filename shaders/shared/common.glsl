@@ -45,10 +45,12 @@ vec3 unpackColor(uint rgba8) { return srgbToLinear(unpackUnorm4x8(rgba8).rgb); }
 float projectiveDepth(float depth) { return frame.depthRange.w > 0.0 ? 1.0 : depth; }
 
 /// View-space position of a point seen at window position `window` (full-resolution pixels,
-/// row 0 at the top; a pixel's centre is its index + 0.5) at linear depth `depth`.
+/// row 0 at the top; a pixel's centre is its index + 0.5) at linear depth `depth`; the inverse
+/// of windowPosition(), jitter included.
 vec3 viewPositionAt(vec2 window, float depth) {
     float focal = frame.depthRange.z;
-    vec2 centred = vec2(window.x - 0.5 * frame.viewport.x, 0.5 * frame.viewport.y - window.y);
+    vec2 shifted = window - frame.jitter.xy;
+    vec2 centred = vec2(shifted.x - 0.5 * frame.viewport.x, 0.5 * frame.viewport.y - shifted.y);
     return vec3(centred * (projectiveDepth(depth) / focal), -depth);
 }
 

@@ -12,14 +12,24 @@
 namespace subscan {
 
 glm::dmat4 Camera::projection() const {
+    glm::dmat4 projection;
     if (orthographic()) {
         const double halfHeight = 0.5 * orthographicHeight;
         const double halfWidth = halfHeight * width / static_cast<double>(height);
-        return glm::ortho(-halfWidth, halfWidth, -halfHeight, halfHeight, nearPlane, farPlane);
+        projection =
+            glm::ortho(-halfWidth, halfWidth, -halfHeight, halfHeight, nearPlane, farPlane);
+    } else {
+        projection = glm::perspective(glm::radians(fovyDegrees),
+                                      static_cast<double>(width) / static_cast<double>(height),
+                                      nearPlane, farPlane);
     }
-    return glm::perspective(glm::radians(fovyDegrees),
-                            static_cast<double>(width) / static_cast<double>(height), nearPlane,
-                            farPlane);
+    if (jitterPixels == glm::dvec2(0.0)) {
+        return projection;
+    }
+    // A shift in normalized device coordinates (2 / size per pixel; window y runs down): as a
+    // translation of clip space it scales with w, so it moves every depth alike.
+    const glm::dvec3 shift(2.0 * jitterPixels.x / width, -2.0 * jitterPixels.y / height, 0.0);
+    return glm::translate(glm::dmat4(1.0), shift) * projection;
 }
 
 double Camera::focalLengthPixels() const {

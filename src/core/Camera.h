@@ -3,6 +3,7 @@
 #include <optional>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -23,6 +24,9 @@ struct Camera {
     /// > 0: an orthographic camera (a directional light's view) whose image is this many scene
     /// units tall; fovyDegrees is then unused. 0: a pinhole camera.
     double orthographicHeight = 0.0;
+    /// Sub-pixel shift of the picture, in pixels (x right, y down): the temporal filter's jitter
+    /// of the pipeline's camera. projection() and every back-projection include it.
+    glm::dvec2 jitterPixels{0.0};
 
     bool orthographic() const { return orthographicHeight > 0.0; }
     glm::dmat4 projection() const;

@@ -8,13 +8,16 @@
 
 namespace subscan {
 
-FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources) : sources_(sources) {}
+FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources, Output output)
+    : sources_(sources), output_(output) {}
 
 const ComputeStages& FinishSurfacePass::stagesFor(bool directionalLights) {
     std::optional<ComputeStages>& stages = directionalLights ? withLights_ : headLightOnly_;
     if (!stages) {
-        stages.emplace(sources_, "render/FinishSurface.comp",
-                       std::vector<std::string>{directionalLights ? "LIGHTS" : "HEAD_LIGHT"});
+        const std::string lights = directionalLights ? "LIGHTS" : "HEAD_LIGHT";
+        stages.emplace(
+            sources_, "render/FinishSurface.comp",
+            std::vector<std::string>{output_ == Output::Picture ? lights : lights + "_RADIANCE"});
     }
     return *stages;
 }
@@ -32,14 +35,20 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     const gpu::ShadeParams shade = ShadePass::parameters(frame);
     params_.set(shade);
     params_.bind(SUBSCAN_UBO_PASS);
-    Texture& image =
-        resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(), frame.height());
+    const bool picture = output_ == Output::Picture;
+    Texture& color = picture ? resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(),
+                                                       frame.height())
+                             : resources.ensureTexture("radiance", TextureFormat::RGBA16F,
+                                                       frame.width(), frame.height());
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
-    image.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        PresentPass::clearToBackground(image, frame.settings.raster);
+        // Radiance off the surface is never read: surfaceDepth marks it.
+        if (picture) {
+            PresentPass::clearToBackground(color, frame.settings.raster);
+        }
         surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
     }
     stagesFor(shade.lightCount.x > 0).runOverRegion(0, frame.region(0));

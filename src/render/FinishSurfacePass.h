@@ -13,16 +13,21 @@ namespace subscan {
 /// over the background, from the pyramids PullPushPass, FillRemovalPass and NormalsPass leave
 /// above level 0. Writes "image" and "surfaceDepth" (+inf off the surface) and nothing between:
 /// on llvmpipe the per-pass chain's six full-screen images cost more than their arithmetic.
-/// Equals the chain up to its half-float rounding of colour, normals and radiance.
+/// Equals the chain up to its half-float rounding of colour, normals and radiance. For the
+/// temporal filter it writes the linear "radiance" (+ "surfaceDepth") instead of the picture.
 class FinishSurfacePass final : public RenderPass {
   public:
-    explicit FinishSurfacePass(const ShaderSources& sources);
+    enum class Output { Picture, Radiance };
+
+    FinishSurfacePass(const ShaderSources& sources, Output output);
 
     std::string_view name() const override { return "FinishSurface"; }
     std::vector<std::string_view> inputs() const override {
         return {"pullValues", "pullWeights", "pushValues", "fillReach", "normalPyramid"};
     }
-    std::vector<std::string_view> outputs() const override { return {"image", "surfaceDepth"}; }
+    std::vector<std::string_view> outputs() const override {
+        return {output_ == Output::Picture ? "image" : "radiance", "surfaceDepth"};
+    }
     void execute(FrameContext& frame) override;
 
     /// Whether a frame can finish here: at full resolution (reduced frames scale up in
@@ -38,6 +43,7 @@ class FinishSurfacePass final : public RenderPass {
     const ComputeStages& stagesFor(bool directionalLights);
 
     const ShaderSources& sources_;
+    Output output_;
     std::optional<ComputeStages> headLightOnly_;
     std::optional<ComputeStages> withLights_;
     UniformBlock<gpu::ShadeParams> params_{"FinishSurface.shade"};

@@ -55,6 +55,10 @@ Buffer& FrameResources::ensureBuffer(std::string_view name, std::size_t bytes) {
     return found->second;
 }
 
+void FrameResources::swapTextures(std::string_view a, std::string_view b) {
+    std::swap(texture(a), texture(b));
+}
+
 Texture& FrameResources::texture(std::string_view name) {
     return const_cast<Texture&>(std::as_const(*this).texture(name));
 }

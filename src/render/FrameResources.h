@@ -24,6 +24,10 @@ class FrameResources {
     Buffer& buffer(std::string_view name);
     const Buffer& buffer(std::string_view name) const;
 
+    /// Exchanges the textures `a` and `b` (both must exist): ping-pong images, such as the
+    /// temporal filter's history, read from one while the frame writes the other.
+    void swapTextures(std::string_view a, std::string_view b);
+
     /// A texture or buffer of that name exists.
     bool has(std::string_view name) const;
     /// Bytes held by all textures and buffers, for the memory report.

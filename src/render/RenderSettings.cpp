@@ -78,6 +78,11 @@ bool isFinalImage(Stage stage) {
     return stage == Stage::Final || stage == Stage::Shaded;
 }
 
+bool filtersTemporally(const RenderSettings& settings) {
+    return settings.temporal.enabled && reconstructsSurface(settings.raster.mode) &&
+           settings.raster.stage == Stage::Final;
+}
+
 void to_json(nlohmann::json& json, const RasterSettings& settings) {
     json = {
         {"mode", toString(settings.mode)},
@@ -105,12 +110,30 @@ void from_json(const nlohmann::json& json, RasterSettings& settings) {
     readEnum(json, "resolution", settings.resolution, kResolutions, "resolution");
 }
 
+void to_json(nlohmann::json& json, const TemporalSettings& settings) {
+    json = {
+        {"enabled", settings.enabled},
+        {"new_frame_weight", settings.newFrameWeight},
+        {"clip_sigma", settings.clipSigma},
+        {"max_frames", settings.maxFrames},
+    };
+}
+
+void from_json(const nlohmann::json& json, TemporalSettings& settings) {
+    rejectUnknownKeys(json, "temporal",
+                      {"enabled", "new_frame_weight", "clip_sigma", "max_frames"});
+    readSetting(json, "enabled", settings.enabled);
+    readSetting(json, "new_frame_weight", settings.newFrameWeight, 0.01f, 1.0f);
+    readSetting(json, "clip_sigma", settings.clipSigma, 0.1f, 100.0f);
+    // The count rides in a half float, exact up to 2048.
+    readSetting(json, "max_frames", settings.maxFrames, 1, 2048);
+}
+
 void to_json(nlohmann::json& json, const RenderSettings& settings) {
     json = {
-        {"raster", settings.raster},
-        {"surface", settings.surface},
-        {"shading", settings.shading},
-        {"scattering", settings.scattering},
+        {"raster", settings.raster},     {"surface", settings.surface},
+        {"shading", settings.shading},   {"scattering", settings.scattering},
+        {"temporal", settings.temporal},
     };
 }
 
@@ -119,10 +142,11 @@ void from_json(const nlohmann::json& json, RenderSettings& settings) {
         throw Error("the settings must be a JSON object");
     }
     for (const auto& [key, value] : json.items()) {
-        if (key != "raster" && key != "surface" && key != "shading" && key != "scattering") {
+        if (key != "raster" && key != "surface" && key != "shading" && key != "scattering" &&
+            key != "temporal") {
             throw Error(
                 fmt::format("unknown settings section '{}' (expected raster, surface, "
-                            "shading, scattering)",
+                            "shading, scattering, temporal)",
                             key));
         }
     }
@@ -131,6 +155,7 @@ void from_json(const nlohmann::json& json, RenderSettings& settings) {
     settings.shading = json.value("shading", nlohmann::json::object()).get<ShadingSettings>();
     settings.scattering =
         json.value("scattering", nlohmann::json::object()).get<ScatteringSettings>();
+    settings.temporal = json.value("temporal", nlohmann::json::object()).get<TemporalSettings>();
 }
 
 RenderSettings readSettingsFile(const std::filesystem::path& path) {

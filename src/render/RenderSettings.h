@@ -48,16 +48,35 @@ struct RasterSettings {
     Stage stage = Stage::Final;
     int stageLevel = 3;  // the pyramid level the pyramid and pull stages show
     Resolution resolution = Resolution::Full;
+
+    bool operator==(const RasterSettings&) const = default;
+};
+
+/// The temporal filter of the surface and sss modes' pictures (DESIGN.md §5 step 10,
+/// render/TemporalPass.h): each frame's camera is jittered by a sub-pixel Halton offset and the
+/// frame is blended into the previous result reprojected to it, so a still camera converges to
+/// a supersampled picture and a moving one does not flicker.
+struct TemporalSettings {
+    bool enabled = false;         // off for one-frame stills; the viewer and turntable turn it on
+    float newFrameWeight = 0.1f;  // the least weight of the new frame while the camera moves
+    float clipSigma = 1.0f;       // the reprojected history is clipped to mean ± this many
+                                  // standard deviations of the new frame's 3x3 neighbourhood
+    int maxFrames = 256;          // a still camera averages this many frames evenly, then slides
+
+    bool operator==(const TemporalSettings&) const = default;
 };
 
 /// Every setting of a frame, one struct per concern; the JSON the CLI's --settings and the
 /// viewer read and write: {"raster": {...}, "surface": {...}, "shading": {...},
-/// "scattering": {...}}.
+/// "scattering": {...}, "temporal": {...}}.
 struct RenderSettings {
     RasterSettings raster;
     SurfaceSettings surface;
     ShadingSettings shading;
     ScatteringSettings scattering;
+    TemporalSettings temporal;
+
+    bool operator==(const RenderSettings&) const = default;
 };
 
 /// The settings file the CLI (--settings) and the viewer share; throws subscan::Error naming the
@@ -67,6 +86,8 @@ void writeSettingsFile(const std::filesystem::path& path, const RenderSettings& 
 
 void to_json(nlohmann::json& json, const RasterSettings& settings);
 void from_json(const nlohmann::json& json, RasterSettings& settings);
+void to_json(nlohmann::json& json, const TemporalSettings& settings);
+void from_json(const nlohmann::json& json, TemporalSettings& settings);
 void to_json(nlohmann::json& json, const RenderSettings& settings);
 void from_json(const nlohmann::json& json, RenderSettings& settings);
 
@@ -84,5 +105,8 @@ Resolution parseResolution(std::string_view text);
 bool reconstructsSurface(RenderMode mode);
 /// Whether `stage` is a finished picture rather than an intermediate image of the pipeline.
 bool isFinalImage(Stage stage);
+/// Whether a frame runs the temporal filter: enabled, in a mode that reconstructs, for its
+/// final picture.
+bool filtersTemporally(const RenderSettings& settings);
 
 }  // namespace subscan

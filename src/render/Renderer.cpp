@@ -15,6 +15,7 @@
 #include "render/SingleScatteringPass.h"
 #include "render/StageViewPass.h"
 #include "render/SubsurfaceScatteringPass.h"
+#include "render/TemporalPass.h"
 
 namespace subscan {
 
@@ -83,7 +84,28 @@ void Renderer::appendShading(bool split, std::vector<RenderPass*>& passes) {
                            : &lazyPass(shade_, sources_, ShadeOutputs::Radiance));
 }
 
-std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, LevelZero levelZero) {
+void Renderer::appendPresent(const RenderSettings& settings, int divisor, const std::string& color,
+                             std::vector<RenderPass*>& passes) {
+    if (!filtersTemporally(settings)) {
+        passes.push_back(&present(color, "surfaceDepth"));
+        return;
+    }
+    TemporalPass& temporal = lazyPass(temporal_, sources_);
+    temporal.setInput(color, divisor == 1);
+    passes.push_back(&temporal);
+    if (divisor != 1) {
+        passes.push_back(&present("history", ""));
+    }
+}
+
+void Renderer::restartTemporalFilter() {
+    if (temporal_) {
+        temporal_->restart();
+    }
+}
+
+std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, int divisor,
+                                             LevelZero levelZero) {
     const RasterSettings& raster = settings.raster;
     std::vector<RenderPass*> passes;
     appendPoints(raster.mode, passes);
@@ -93,7 +115,14 @@ std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, Lev
     if (surface) {
         reconstruction_.appendSurface(passes, levelZero);
         if (levelZero == LevelZero::Fused) {
-            passes.push_back(&lazyPass(finishSurface_, sources_));
+            if (!filtersTemporally(settings)) {
+                passes.push_back(
+                    &lazyPass(finishSurface_, sources_, FinishSurfacePass::Output::Picture));
+                return passes;
+            }
+            passes.push_back(
+                &lazyPass(finishSurfaceRadiance_, sources_, FinishSurfacePass::Output::Radiance));
+            appendPresent(settings, divisor, "radiance", passes);
             return passes;
         }
         appendShading(scatters, passes);
@@ -106,9 +135,9 @@ std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, Lev
         passes.push_back(&present("stage", ""));
     } else if (scatters) {
         appendScattering(settings.scattering.method, passes);
-        passes.push_back(&present("scatteredRadiance", "surfaceDepth"));
+        appendPresent(settings, divisor, "scatteredRadiance", passes);
     } else if (surface) {
-        passes.push_back(&present("radiance", "surfaceDepth"));
+        appendPresent(settings, divisor, "radiance", passes);
     } else {
         passes.push_back(&present("color", "depth"));
     }
@@ -143,6 +172,9 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
                                                          cloud_.origin(), spacing_)
                             : 1;
     pipelineCamera_ = divisor == 1 ? camera : reducedCamera(camera, divisor);
+    if (filtersTemporally(settings)) {
+        pipelineCamera_.jitterPixels += lazyPass(temporal_, sources_).nextJitter(settings.temporal);
+    }
     const gpu::PyramidLayout& layout =
         uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());
 
@@ -150,7 +182,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
         outputs == FrameOutputs::Picture && settings.raster.mode == RenderMode::Surface &&
         settings.raster.stage == Stage::Final && FinishSurfacePass::canFinish(divisor, layout);
     const std::vector<RenderPass*> passes =
-        passesFor(settings, fused ? LevelZero::Fused : LevelZero::PerPass);
+        passesFor(settings, divisor, fused ? LevelZero::Fused : LevelZero::PerPass);
     lastDivisor_ = divisor;
     FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
                          resourcesFor(divisor), layout, spacing_};

@@ -32,6 +32,7 @@ class StageViewPass;
 class SubsurfaceScatteringPass;
 class SingleScatteringPass;
 class PresentPass;
+class TemporalPass;
 
 struct FrameResult {
     std::vector<PassTiming> passes;
@@ -73,17 +74,24 @@ class Renderer {
     const RasterizePointsPass* rasterizePass() const { return reconstruction_.rasterizePass(); }
     /// The directional lights' maps (shadows), as the last frame that cast shadows left them.
     const LightMaps& lightMaps() const { return lightMaps_; }
+    /// The temporal filter's next frame starts afresh instead of blending into the last (a cut).
+    void restartTemporalFilter();
 
   private:
     /// The frame as named sub-pipelines: points -> reconstruction -> shading -> scattering ->
-    /// present (or a stage view).
-    std::vector<RenderPass*> passesFor(const RenderSettings& settings, LevelZero levelZero);
+    /// temporal -> present (or a stage view).
+    std::vector<RenderPass*> passesFor(const RenderSettings& settings, int divisor,
+                                       LevelZero levelZero);
     /// The points as the mode draws them: compute-rasterized, or GL_POINTS for the baselines.
     void appendPoints(RenderMode mode, std::vector<RenderPass*>& passes);
     /// Deferred shading of the reconstructed surface, split into its parts for scattering.
     void appendShading(bool split, std::vector<RenderPass*>& passes);
     /// The scattering passes of the sss mode's final picture, by ScatteringSettings::method.
     void appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes);
+    /// Present of the linear colour `color` (over the background where "surfaceDepth" is
+    /// +inf), through the temporal filter when the settings ask for it.
+    void appendPresent(const RenderSettings& settings, int divisor, const std::string& color,
+                       std::vector<RenderPass*>& passes);
     PresentPass& present(const std::string& color, const std::string& depth);
     FrameResources& resourcesFor(int divisor) {
         return divisor == 1 ? fullResources_ : reducedResources_;
@@ -109,6 +117,8 @@ class Renderer {
     LightMaps lightMaps_;
     std::unique_ptr<DrawPointsPass> drawPoints_;
     std::unique_ptr<FinishSurfacePass> finishSurface_;
+    std::unique_ptr<FinishSurfacePass> finishSurfaceRadiance_;  // for the temporal filter
+    std::unique_ptr<TemporalPass> temporal_;
     std::unique_ptr<ShadePass> shade_;
     std::unique_ptr<ShadePass> shadeSplit_;
     std::unique_ptr<SubsurfaceScatteringPass> subsurfaceScattering_;

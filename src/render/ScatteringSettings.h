@@ -56,6 +56,8 @@ struct ScatteringSettings {
     // Light of the directional lights through thin parts into the Gaussian blur: the light
     // map's thickness and the profile (Jimenez et al. 2010; DESIGN.md §5.9).
     bool transmission = true;
+
+    bool operator==(const ScatteringSettings&) const = default;
 };
 
 /// The relative index of refraction single scattering uses (ScatteringSettings::eta's rule).

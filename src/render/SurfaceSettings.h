@@ -38,6 +38,8 @@ struct DirectionalLight {
     glm::vec3 direction{0.0f, 1.0f, 0.0f};  // towards the light, in `space`
     glm::vec3 radiance{1.0f};
     LightSpace space = LightSpace::World;
+
+    bool operator==(const DirectionalLight&) const = default;
 };
 
 /// The unit direction towards `light` in the scene's coordinates for a camera whose
@@ -61,6 +63,8 @@ struct ShadingSettings {
     float shadowBias = 2.0f;      // x h: how far behind the light map's surface shadow begins
     float shadowSoftness = 2.0f;  // x h: the width over which a shadow's edge fades (>= a texel)
     int lightMapResolution = 0;   // texels along a light map's longer side; 0: from h (LightMaps)
+
+    bool operator==(const ShadingSettings&) const = default;
 };
 
 void to_json(nlohmann::json& json, const SurfaceSettings& settings);

@@ -37,6 +37,11 @@ FrameContext PassHarness::context() {
             resources_, layout_, spacing_};
 }
 
+void PassHarness::setCamera(const Camera& camera) {
+    camera_ = camera;
+    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_.origin());
+}
+
 glm::dvec3 PassHarness::viewPosition(double wx, double wy, double depth) const {
     const double f = focal();
     return {(wx - 0.5 * camera_.width) * depth / f, (0.5 * camera_.height - wy) * depth / f,

@@ -21,6 +21,8 @@ class PassHarness {
                 double fovyDegrees = 50.0);
 
     FrameContext context();
+    /// Another camera (its size must stay) for the passes run after this; uniforms updated.
+    void setCamera(const Camera& camera);
     FrameResources& resources() { return resources_; }
     const Camera& camera() const { return camera_; }
     const RenderSettings& settings() const { return settings_; }

@@ -43,6 +43,7 @@ struct RenderOptions {
     ScatteringOptions scattering;
     std::string settingsFile;
     std::string saveSettingsFile;
+    int samples = 1;
     bool timings = false;
     bool verbose = false;
     bool software = false;
@@ -188,6 +189,16 @@ int runRender(const RenderOptions& options) {
         raster.backgroundSrgb = parseBackground(options.background);
     }
     options.scattering.apply(settings.scattering);
+    if (options.samples > 1) {
+        if (!reconstructsSurface(raster.mode) || raster.stage != Stage::Final) {
+            throw Error(
+                "--samples needs the final picture of the surface or sss mode (the temporal "
+                "filter anti-aliases reconstructed surfaces)");
+        }
+        // A still camera's frames are averaged evenly up to max_frames of them.
+        settings.temporal.enabled = true;
+        settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, options.samples);
+    }
     if (!options.saveSettingsFile.empty()) {
         writeSettingsFile(options.saveSettingsFile, settings);
     }
@@ -221,8 +232,9 @@ int runRender(const RenderOptions& options) {
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
     if (options.timings) {
-        const std::vector<PassTiming> timings =
-            medianTimings(renderer, camera, settings, outputs, 3);
+        // With --samples the frames timed are the ones averaged, so the picture stays theirs.
+        const std::vector<PassTiming> timings = medianTimings(
+            renderer, camera, settings, outputs, options.samples > 1 ? options.samples - 1 : 3);
         double total = 0.0;
         for (const PassTiming& timing : timings) {
             fmt::print("{:<20} {:9.3f} ms\n", timing.pass, timing.milliseconds);
@@ -230,7 +242,9 @@ int runRender(const RenderOptions& options) {
         }
         fmt::print("{:<20} {:9.3f} ms\n", "total", total);
     } else {
-        renderer.render(camera, settings, outputs);
+        for (int frame = 0; frame < options.samples; ++frame) {
+            renderer.render(camera, settings, outputs);
+        }
     }
 
     if (!options.exportDirectory.empty()) {
@@ -292,6 +306,11 @@ Command addRenderCommand(CLI::App& parent) {
         ->check(CLI::ExistingFile);
     render->add_option("--save-settings", options->saveSettingsFile,
                        "Write the effective settings as JSON");
+    render
+        ->add_option("--samples", options->samples,
+                     "Anti-alias the surface: the mean of this many frames through sub-pixel "
+                     "jittered cameras (the temporal filter, still camera)")
+        ->check(CLI::Range(1, 2048));
     render->add_flag("--timings", options->timings, "Print per-pass milliseconds");
     render->add_flag("-v,--verbose", options->verbose, "Print the OpenGL renderer");
     render->add_flag("--software", options->software,

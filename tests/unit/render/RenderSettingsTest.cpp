@@ -33,6 +33,21 @@ TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
     EXPECT_EQ(partial.mode, RasterSettings{}.mode);
 }
 
+TEST(RenderSettingsTest, TemporalSettingsRoundTripAndRefuseImpossibleValues) {
+    RenderSettings settings;
+    settings.temporal = {true, 0.2f, 1.5f, 64};
+    const RenderSettings back = nlohmann::json(settings).get<RenderSettings>();
+    EXPECT_EQ(back.temporal, settings.temporal);
+    EXPECT_EQ(back, settings);
+    auto read = [](const nlohmann::json& temporal) {
+        return nlohmann::json{{"temporal", temporal}}.get<RenderSettings>();
+    };
+    EXPECT_THROW(read({{"new_frame_weight", 0.0}}), Error);  // the new frame would never count
+    EXPECT_THROW(read({{"max_frames", 4096}}), Error);       // beyond a half float's integers
+    EXPECT_THROW(read({{"clip", 1.0}}), Error);              // unknown key
+    EXPECT_FALSE(read(nlohmann::json::object()).temporal.enabled);
+}
+
 TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
     RenderSettings settings;
     settings.raster.mode = RenderMode::Surface;

@@ -1,0 +1,132 @@
+#include "render/TemporalPass.h"
+
+#include <limits>
+
+#include <glm/matrix.hpp>
+
+#include "core/Srgb.h"
+#include "render/PresentPass.h"
+
+namespace subscan {
+
+namespace {
+
+/// The history saw another surface where the depth it kept differs from the reprojected one by
+/// more than this many point spacings (plus the depth range of the pixel's neighbourhood, for
+/// surfaces seen at a grazing angle): a point of the same surface lands within about h of
+/// where the previous frame's reconstruction put it.
+constexpr double kDisocclusionSpacings = 4.0;
+
+double radicalInverse(unsigned index, unsigned base) {
+    double result = 0.0;
+    double digitWeight = 1.0 / base;
+    for (; index > 0; index /= base) {
+        result += (index % base) * digitWeight;
+        digitWeight /= base;
+    }
+    return result;
+}
+
+/// Same image, same lens, same pose: the previous result lines up with this frame's pixels.
+bool sameView(const Camera& a, const Camera& b) {
+    return a.width == b.width && a.height == b.height && a.fovyDegrees == b.fovyDegrees &&
+           a.nearPlane == b.nearPlane && a.farPlane == b.farPlane && a.view == b.view &&
+           a.orthographicHeight == b.orthographicHeight;
+}
+
+Camera withoutJitter(const Camera& camera) {
+    Camera plain = camera;
+    plain.jitterPixels = glm::dvec2(0.0);
+    return plain;
+}
+
+}  // namespace
+
+glm::dvec2 haltonJitter(unsigned index) {
+    return {radicalInverse(index, 2) - 0.5, radicalInverse(index, 3) - 0.5};
+}
+
+TemporalPass::TemporalPass(const ShaderSources& sources)
+    : stages_(sources, "render/Temporal.comp", {"FILTER", "PICTURE"}) {}
+
+std::vector<std::string_view> TemporalPass::outputs() const {
+    if (writesPicture_) {
+        return {"history", "historyState", "image"};
+    }
+    return {"history", "historyState"};
+}
+
+glm::dvec2 TemporalPass::nextJitter(const TemporalSettings& settings) {
+    if (!previous_) {
+        frameIndex_ = 0;
+    }
+    const unsigned index = frameIndex_ % static_cast<unsigned>(settings.maxFrames) + 1;
+    ++frameIndex_;
+    return haltonJitter(index);
+}
+
+void TemporalPass::execute(FrameContext& frame) {
+    FrameResources& resources = frame.resources;
+    const int width = frame.width(), height = frame.height();
+    const Camera camera = withoutJitter(frame.camera);
+    for (const char* name : {"history", "previousHistory"}) {
+        resources.ensureTexture(name, TextureFormat::RGBA16F, width, height);
+    }
+    for (const char* name : {"historyState", "previousHistoryState"}) {
+        resources.ensureTexture(name, TextureFormat::RG32F, width, height);
+    }
+    resources.swapTextures("history", "previousHistory");
+    resources.swapTextures("historyState", "previousHistoryState");
+
+    const bool continues = previous_ && previous_->settings == frame.settings &&
+                           previous_->divisor == frame.divisor &&
+                           previous_->camera.width == width && previous_->camera.height == height;
+    gpu::TemporalParams params{};
+    params.mode.x = !continues                            ? SUBSCAN_TEMPORAL_RESTART
+                    : sameView(previous_->camera, camera) ? SUBSCAN_TEMPORAL_STILL
+                                                          : SUBSCAN_TEMPORAL_MOVING;
+    params.mode.y = previous_ && previous_->moved ? 1u : 0u;
+    if (continues) {
+        params.previousFromView = glm::mat4(previous_->camera.view * glm::inverse(camera.view));
+        params.previousProjection = glm::mat4(previous_->camera.projection());
+    }
+    const TemporalSettings& settings = frame.settings.temporal;
+    params.blend = {settings.newFrameWeight, settings.clipSigma,
+                    static_cast<float>(settings.maxFrames), 0.0f};
+    params.depth = {static_cast<float>(kDisocclusionSpacings * frame.spacing), 0.0f, 0.0f, 0.0f};
+    params_.set(params);
+    params_.bind(SUBSCAN_UBO_PASS);
+
+    Texture& history = resources.texture("history");
+    Texture& state = resources.texture("historyState");
+    Texture* image = writesPicture_
+                         ? &resources.ensureTexture("image", TextureFormat::RGBA8, width, height)
+                         : nullptr;
+    const TexelRegion region = frame.region(0);
+    if (region.size != glm::ivec2(width, height)) {
+        // Off the region this frame shows the background (surfaceDepth is +inf there).
+        const glm::vec3& background = frame.settings.raster.backgroundSrgb;
+        history.clear(glm::vec4(srgbToLinear(background.r), srgbToLinear(background.g),
+                                srgbToLinear(background.b), 0.0f));
+        state.clear(glm::vec4(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f));
+        if (image) {
+            PresentPass::clearToBackground(*image, frame.settings.raster);
+        }
+    }
+    if (image) {
+        image->bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    }
+    resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+    resources.texture("previousHistory").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
+    resources.texture("previousHistoryState").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
+    history.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    state.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    stages_.runOverRegion(writesPicture_ ? 1 : 0, region);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    previous_ = PreviousFrame{camera, frame.settings, frame.divisor,
+                              params.mode.x == SUBSCAN_TEMPORAL_MOVING};
+}
+
+}  // namespace subscan

@@ -1,0 +1,441 @@
+// TemporalPass: the previous result reprojected by depth and both cameras (against a CPU
+// reference of the same formula), disocclusion, the even mean of a still camera, and end to end
+// through the Renderer: jittered frames converge to the supersampled coverage of an edge, and a
+// fast move leaves no ghost once the camera stops.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+#include "core/PointCloud.h"
+#include "core/Srgb.h"
+#include "render/Renderer.h"
+#include "render/TemporalPass.h"
+#include "scan/SyntheticScenes.h"
+#include "support/GlTestSupport.h"
+#include "support/PassHarness.h"
+
+namespace subscan {
+namespace {
+
+constexpr int kWidth = 48;
+constexpr int kHeight = 40;
+
+/// A tilted plane in front of the harness's first camera.
+struct Plane {
+    glm::dvec3 point{0.0, 0.0, -5.0};
+    glm::dvec3 normal = glm::normalize(glm::dvec3(0.15, 0.1, 1.0));
+
+    /// Where the ray from the eye of `camera` through window position `window` meets the plane,
+    /// in world (= the harness's cloud) coordinates; the ray built from the camera's lens and
+    /// jitter as the definition of a pinhole, independent of the shaders' helpers.
+    glm::dvec3 hit(const Camera& camera, glm::dvec2 window) const {
+        const double f = camera.focalLengthPixels();
+        const glm::dvec2 shifted = window - camera.jitterPixels;
+        const glm::dvec3 direction((shifted.x - 0.5 * camera.width) / f,
+                                   (0.5 * camera.height - shifted.y) / f, -1.0);
+        const glm::dmat4 toWorld = glm::inverse(camera.view);
+        const glm::dvec3 eye(toWorld * glm::dvec4(0, 0, 0, 1));
+        const glm::dvec3 ray(toWorld * glm::dvec4(direction, 0.0));
+        const double t = glm::dot(point - eye, normal) / glm::dot(ray, normal);
+        return eye + t * ray;
+    }
+};
+
+double linearDepth(const Camera& camera, const glm::dvec3& world) {
+    return -(camera.view * glm::dvec4(world, 1.0)).z;
+}
+
+/// The un-jittered window position of a world point.
+glm::dvec2 windowOf(const Camera& camera, const glm::dvec3& world) {
+    Camera plain = camera;
+    plain.jitterPixels = glm::dvec2(0.0);
+    const glm::dvec4 clip = plain.projection() * camera.view * glm::dvec4(world, 1.0);
+    return {(clip.x / clip.w + 1.0) * 0.5 * camera.width,
+            (1.0 - clip.y / clip.w) * 0.5 * camera.height};
+}
+
+/// A colour anchored to the plane, so that reprojection errors change it.
+glm::vec3 pattern(const glm::dvec3& world) {
+    return glm::vec3(0.5 + 0.4 * std::sin(3.0 * world.x), 0.5 + 0.4 * std::cos(2.0 * world.y),
+                     0.3 + 0.1 * world.x);
+}
+
+struct Inputs {
+    std::vector<float> radiance;  // RGBA
+    std::vector<float> depth;
+};
+
+/// The plane seen through `camera`: colour from `colorOf(world, x, y)`, +inf where `hole`.
+template <class Color, class Hole>
+Inputs planeInputs(const Camera& camera, const Plane& plane, Color colorOf, Hole hole) {
+    Inputs inputs;
+    for (int y = 0; y < camera.height; ++y) {
+        for (int x = 0; x < camera.width; ++x) {
+            const glm::dvec3 world = plane.hit(camera, {x + 0.5, y + 0.5});
+            const glm::vec3 color = colorOf(world, x, y);
+            inputs.radiance.insert(inputs.radiance.end(), {color.r, color.g, color.b, 1.0f});
+            inputs.depth.push_back(hole(x, y) ? INFINITY
+                                              : static_cast<float>(linearDepth(camera, world)));
+        }
+    }
+    return inputs;
+}
+
+class TemporalHarness {
+  public:
+    explicit TemporalHarness(const RenderSettings& settings, double spacing = 0.05)
+        : harness_(kWidth, kHeight, settings, spacing), pass_(harness_.sources()) {
+        pass_.setInput("radiance", false);
+    }
+
+    const Camera& camera() const { return harness_.camera(); }
+
+    /// One frame of the filter; returns "history" (RGBA) and "historyState" (depth, count).
+    std::pair<std::vector<float>, std::vector<float>> run(const Camera& camera,
+                                                          const Inputs& inputs) {
+        harness_.setCamera(camera);
+        FrameResources& resources = harness_.resources();
+        resources.ensureTexture("radiance", TextureFormat::RGBA16F, kWidth, kHeight)
+            .uploadFloats(inputs.radiance);
+        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, kWidth, kHeight)
+            .uploadFloats(inputs.depth);
+        FrameContext frame = harness_.context();
+        pass_.execute(frame);
+        return {resources.texture("history").readFloats(),
+                resources.texture("historyState").readFloats()};
+    }
+
+  private:
+    test::PassHarness harness_;
+    TemporalPass pass_;
+};
+
+/// Four colours by the parities of x and y: a neighbourhood whose luma and both chromas spread
+/// over most of 0..1, so that clipping to it (with a wide sigma) keeps any history of 0..1.
+glm::vec3 checker(glm::dvec3, int x, int y) {
+    return glm::vec3(float((x + y) % 2), float(x % 2), float(y % 2));
+}
+
+/// A second camera turned and moved against the harness's, both jittered differently.
+Camera movedCamera(const Camera& first) {
+    Camera moved = first;
+    moved.view = glm::translate(
+        glm::rotate(glm::dmat4(1.0), glm::radians(2.0), glm::normalize(glm::dvec3(0.3, 1.0, 0.1))),
+        glm::dvec3(-0.12, 0.05, 0.1));
+    moved.jitterPixels = {0.25, -0.3};
+    return moved;
+}
+
+TEST(TemporalGLTest, ReprojectsTheHistoryLikeTheCpuReference) {
+    RenderSettings settings;
+    settings.temporal.enabled = true;
+    settings.temporal.newFrameWeight = 0.01f;
+    // Clipping far outside the new frame's spread: this test is about where the history comes
+    // from, not about how it is clipped.
+    settings.temporal.clipSigma = 100.0f;
+    TemporalHarness harness(settings);
+    const Plane plane;
+    Camera first = harness.camera();
+    first.jitterPixels = {-0.2, 0.35};
+    const Camera second = movedCamera(first);
+    auto none = [](int, int) { return false; };
+
+    const auto [history1, state1] = harness.run(
+        first, planeInputs(
+                   first, plane, [](glm::dvec3 w, int, int) { return pattern(w); }, none));
+    const Inputs secondInputs = planeInputs(second, plane, checker, none);
+    const auto [history2, state2] = harness.run(second, secondInputs);
+
+    int compared = 0, reprojected = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            // The neighbour with the nearest depth stands for the pixel's motion (first of
+            // equals in row order, borders clamped), as in the shader.
+            glm::ivec2 nearest(x, y);
+            float nearestDepth = INFINITY;
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const glm::ivec2 t = glm::clamp(glm::ivec2(x + dx, y + dy), glm::ivec2(0),
+                                                    glm::ivec2(kWidth - 1, kHeight - 1));
+                    const float d = secondInputs.depth[t.y * kWidth + t.x];
+                    if (d < nearestDepth) {
+                        nearestDepth = d;
+                        nearest = t;
+                    }
+                }
+            }
+            const glm::dvec3 world = plane.hit(second, glm::dvec2(nearest) + 0.5);
+            const glm::dvec2 velocity =
+                windowOf(first, world) - (glm::dvec2(nearest) + 0.5 - second.jitterPixels);
+            const glm::dvec2 source = glm::dvec2(x, y) + velocity;
+            const glm::ivec2 base(glm::floor(source));
+            const glm::dvec2 t = source - glm::dvec2(base);
+            glm::dvec4 sum(0.0);
+            double weights = 0.0;
+            for (int tap = 0; tap < 4; ++tap) {
+                const glm::ivec2 texel = base + glm::ivec2(tap & 1, tap >> 1);
+                if (texel.x < 0 || texel.y < 0 || texel.x >= kWidth || texel.y >= kHeight) {
+                    continue;
+                }
+                const double w = ((tap & 1) ? t.x : 1.0 - t.x) * ((tap >> 1) ? t.y : 1.0 - t.y);
+                const std::size_t i = 4 * static_cast<std::size_t>(texel.y * kWidth + texel.x);
+                sum +=
+                    w * glm::dvec4(history1[i], history1[i + 1], history1[i + 2], history1[i + 3]);
+                weights += w;
+            }
+            const std::size_t i = 4 * static_cast<std::size_t>(y * kWidth + x);
+            const glm::dvec4 current(secondInputs.radiance[i], secondInputs.radiance[i + 1],
+                                     secondInputs.radiance[i + 2], 1.0);
+            // Each history holds one frame: the new one weighs 1/2.
+            const glm::dvec4 expected =
+                weights > 0.1 ? 0.5 * (sum / weights) + 0.5 * current : current;
+            reprojected += weights > 0.1 ? 1 : 0;
+            for (int c = 0; c < 4; ++c) {
+                // Half-float storage of the result: 2^-11 relative, and the pattern is <= 1.
+                EXPECT_NEAR(history2[i + c], expected[c], 2e-3)
+                    << "pixel " << x << "," << y << " channel " << c;
+            }
+            ++compared;
+        }
+    }
+    EXPECT_EQ(compared, kWidth * kHeight);
+    EXPECT_GT(reprojected, compared * 3 / 4) << "the move should keep most of the view";
+    EXPECT_LT(reprojected, compared) << "the move should uncover a border";
+}
+
+TEST(TemporalGLTest, DropsHistoryThatSawAnotherSurface) {
+    RenderSettings settings;
+    settings.temporal.enabled = true;
+    settings.temporal.clipSigma = 100.0f;  // as above: only disocclusion may drop the history
+    TemporalHarness harness(settings);
+    const Plane plane;
+    const Camera first = harness.camera();
+    const Camera second = movedCamera(first);
+    // The first frame has an object in front (1 m nearer) over the left half; the second sees
+    // the plane everywhere, so the left half's history belongs to another surface.
+    Inputs occluded = planeInputs(
+        first, plane, [](glm::dvec3, int, int) { return glm::vec3(1.0f, 0.0f, 0.0f); },
+        [](int, int) { return false; });
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth / 2; ++x) {
+            occluded.depth[y * kWidth + x] -= 1.0f;
+        }
+    }
+    harness.run(first, occluded);
+    const Inputs plain = planeInputs(second, plane, checker, [](int, int) { return false; });
+    const auto [history, state] = harness.run(second, plain);
+    int blended = 0;
+    for (int y = 4; y < kHeight - 4; ++y) {
+        for (int x = 4; x < kWidth - 4; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y * kWidth + x);
+            const float red = plain.radiance[4 * i];
+            if (x < kWidth / 2 - 8) {
+                // Well inside the left half (the move shifts it by a few pixels): the frame
+                // alone, none of the occluder's red.
+                EXPECT_EQ(history[4 * i], red) << "at " << x << "," << y;
+                EXPECT_EQ(state[2 * i + 1], 1.0f) << "frames at " << x << "," << y;
+            } else if (x > kWidth / 2 + 8) {
+                // The same surface: the occluder-free history (red 1) blended in at 1/2.
+                EXPECT_NEAR(history[4 * i], 0.5f * (1.0f + red), 1e-3)  // half floats
+                    << "at " << x << "," << y;
+                ++blended;
+            }
+        }
+    }
+    EXPECT_GT(blended, 0);
+}
+
+TEST(TemporalGLTest, ClipsTheHistoryToTheNewFramesNeighbourhood) {
+    // A moving camera whose history (red) falls outside everything the new frame shows
+    // nearby (blue, no spread): clipping moves it onto the new frame's colour, as it would a
+    // ghost of a surface that has left.
+    RenderSettings settings;
+    settings.temporal.enabled = true;
+    TemporalHarness harness(settings);
+    const Plane plane;
+    const Camera first = harness.camera();
+    auto none = [](int, int) { return false; };
+    harness.run(first,
+                planeInputs(
+                    first, plane, [](glm::dvec3, int, int) { return glm::vec3(1, 0, 0); }, none));
+    const auto [history, state] = harness.run(
+        movedCamera(first), planeInputs(
+                                movedCamera(first), plane,
+                                [](glm::dvec3, int, int) { return glm::vec3(0, 0, 1); }, none));
+    for (std::size_t i = 0; i < history.size(); i += 4) {
+        EXPECT_NEAR(history[i], 0.0f, 1e-3) << "texel " << i / 4;  // half-float rounding
+        EXPECT_NEAR(history[i + 2], 1.0f, 1e-3) << "texel " << i / 4;
+    }
+}
+
+TEST(TemporalGLTest, StillCameraAveragesEvenlyAndBackgroundCountsAsUncovered) {
+    RenderSettings settings;
+    settings.temporal.enabled = true;
+    settings.temporal.maxFrames = 4;
+    TemporalHarness harness(settings);
+    const Plane plane;
+    const Camera camera = harness.camera();
+    // Frames 1..6 show 0.1 k; the left column is background in odd frames. With a still
+    // camera the mean is even over the last frames up to 4, then slides by 1/4.
+    std::vector<float> history;
+    double expected = 0.0, coverage = 0.0, left = 0.0;
+    const double background = srgbToLinear(settings.raster.backgroundSrgb.r);
+    for (int k = 1; k <= 6; ++k) {
+        Camera jittered = camera;
+        jittered.jitterPixels = haltonJitter(static_cast<unsigned>(k));
+        const float value = 0.1f * static_cast<float>(k);
+        const bool hole = k % 2 == 1;
+        history = harness
+                      .run(jittered, planeInputs(
+                                         jittered, plane,
+                                         [&](glm::dvec3, int, int) { return glm::vec3(value); },
+                                         [&](int x, int) { return hole && x == 0; }))
+                      .first;
+        const double weight = 1.0 / std::min(k, 4);
+        expected += weight * (value - expected);
+        left += weight * ((hole ? background : value) - left);
+        coverage += weight * ((hole ? 0.0 : 1.0) - coverage);
+        const std::size_t middle = 4 * static_cast<std::size_t>(kHeight / 2 * kWidth + kWidth / 2);
+        const std::size_t edge = 4 * static_cast<std::size_t>(kHeight / 2 * kWidth);
+        // Half floats: 2^-11 relative on values below 1.
+        EXPECT_NEAR(history[middle], expected, 1e-3) << "frame " << k;
+        EXPECT_NEAR(history[edge], left, 1e-3) << "frame " << k;
+        EXPECT_NEAR(history[edge + 3], coverage, 1e-3) << "frame " << k;
+    }
+}
+
+// ---- end to end, through the Renderer ----
+
+/// A dense square of points, 2 x 2 units in the plane z = 0, `perSide` points per side.
+PointCloud square(int perSide) {
+    PointCloudBuilder builder({}, static_cast<std::size_t>(perSide * perSide));
+    for (int j = 0; j < perSide; ++j) {
+        for (int i = 0; i < perSide; ++i) {
+            builder.add(
+                {glm::dvec3(-1.0 + 2.0 * i / (perSide - 1), -1.0 + 2.0 * j / (perSide - 1), 0.0)});
+        }
+    }
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
+TEST(TemporalGLTest, JitteredFramesConvergeToTheSupersampledCoverageOfAnEdge) {
+    // The square seen face on, 32 pixels wide, its left and right edges 1/64 pixel past pixel
+    // boundaries (8 and 40; exact boundaries would leave the outermost points to rounding).
+    // A pixel holding any point is surface, so the reconstruction's silhouette lies half a
+    // pixel outside the points: pixels 7 and 40 are covered when the jitter moves the edge
+    // into them, half of the offsets; one frame shows them covered or not (error 0.5), and
+    // the mean over 16 Halton offsets, whose x are 16 evenly spread values, gives 8/16.
+    constexpr int kSize = 48;
+    Camera camera;
+    camera.width = kSize;
+    camera.height = kSize;
+    camera.fovyDegrees = 30.0;
+    const double distance = 2.0 / (32.0 / camera.focalLengthPixels());  // 2 units = 32 px
+    camera.nearPlane = 0.1;
+    camera.farPlane = 10.0;
+    const double offset = distance / camera.focalLengthPixels() / 64.0;
+    camera.view = glm::translate(glm::dmat4(1.0), glm::dvec3(offset, 0.0, -distance));
+
+    const PointCloud cloud = square(257);  // 8 points per pixel: the edge is sharp to 1/8 px
+    Renderer renderer(test::glTestContext(), cloud);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Surface;
+    settings.temporal.enabled = true;
+    auto edgeError = [&](const std::vector<float>& coverage) {
+        double error = 0.0;
+        int pixels = 0;
+        for (int y = 10; y < 38; ++y) {  // along the edges, away from the corners
+            for (const glm::ivec2 pixel : {glm::ivec2(7, y), glm::ivec2(40, y)}) {
+                error += std::abs(coverage[pixel.y * kSize + pixel.x] - 0.5);
+                ++pixels;
+            }
+        }
+        return error / pixels;
+    };
+    auto alphaOf = [&] {
+        const std::vector<float> history = renderer.resources().texture("history").readFloats();
+        std::vector<float> alpha;
+        for (std::size_t i = 3; i < history.size(); i += 4) {
+            alpha.push_back(history[i]);
+        }
+        return alpha;
+    };
+    renderer.render(camera, settings);
+    const double oneFrame = edgeError(alphaOf());
+    for (int frame = 1; frame < 16; ++frame) {
+        renderer.render(camera, settings);
+    }
+    const double sixteenFrames = edgeError(alphaOf());
+    EXPECT_GT(oneFrame, 0.45) << "one frame decides each edge pixel whole";
+    // 8 of 16 exactly, up to the half-float result; points 1/8 pixel apart leave no room
+    // for a miss.
+    EXPECT_LT(sixteenFrames, 0.01) << "after one frame: " << oneFrame;
+}
+
+TEST(TemporalGLTest, AFastMoveLeavesNoGhostOnceTheCameraStops) {
+    const PointCloud cloud = makeSyntheticScene("sphere");
+    Renderer renderer(test::glTestContext(), cloud);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Surface;
+    settings.temporal.enabled = true;
+    constexpr int kSize = 64;
+    auto poseAt = [&](double yaw, double panFraction) {
+        OrbitView orbit;
+        orbit.yawDegrees = yaw;
+        orbit.pitchDegrees = 10.0;
+        Camera camera = orbitCamera(cloud.bounds, orbit, kSize, kSize, 45.0);
+        // Panning sweeps the silhouette across the picture.
+        camera.view = glm::translate(glm::dmat4(1.0),
+                                     glm::dvec3(panFraction * cloud.bounds.extent().x, 0, 0)) *
+                      camera.view;
+        return camera;
+    };
+    auto picture = [&] { return renderer.readImage(); };
+    auto meanDifference = [](const std::vector<std::uint8_t>& a,
+                             const std::vector<std::uint8_t>& b) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            sum += std::abs(int(a[i]) - int(b[i]));
+        }
+        return sum / static_cast<double>(a.size());
+    };
+
+    const Camera start = poseAt(0.0, -0.6), end = poseAt(40.0, 0.6);
+    // The converged picture at the final pose, from a fresh history.
+    renderer.restartTemporalFilter();
+    for (int frame = 0; frame < 32; ++frame) {
+        renderer.render(end, settings);
+    }
+    const std::vector<std::uint8_t> converged = picture();
+
+    renderer.restartTemporalFilter();
+    for (int frame = 0; frame < 16; ++frame) {
+        renderer.render(start, settings);
+    }
+    const std::vector<std::uint8_t> before = picture();
+    // Five frames from one pose to the other: the silhouette jumps ~ 15 pixels a frame.
+    for (int step = 1; step <= 5; ++step) {
+        renderer.render(poseAt(8.0 * step, -0.6 + 0.24 * step), settings);
+    }
+    const double justArrived = meanDifference(picture(), converged);
+    for (int frame = 0; frame < 8; ++frame) {
+        renderer.render(end, settings);
+    }
+    const double settled = meanDifference(picture(), converged);
+    const double poses = meanDifference(before, converged);
+    EXPECT_GT(poses, 10.0) << "the two poses should look different";
+    // The moving frames' clipping already removes most of the old pose...
+    EXPECT_LT(justArrived, 0.1 * poses) << "before the stop: " << poses;
+    // ...and 8 still frames leave 1/9 of what the motion left, plus the difference between
+    // 8 and 32 jitter offsets at the silhouette: within 1 level of 255 on average.
+    EXPECT_LT(settled, 1.0) << "just arrived: " << justArrived;
+}
+
+}  // namespace
+}  // namespace subscan
