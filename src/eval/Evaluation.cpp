@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <tuple>
 #include <vector>
 
 #include <fmt/format.h>
@@ -116,6 +117,25 @@ std::vector<glm::vec3> towardsEye(const Camera& camera) {
     return normals;
 }
 
+/// A baseline's frame: the rasterized points (`mode`, `pointSize`), flat shaded by `shader`.
+struct BaselineFrame {
+    std::vector<std::uint8_t> image;
+    ReconstructionImages images;
+};
+
+BaselineFrame renderBaseline(Renderer& renderer, ImageShader& shader, const Camera& camera,
+                             const RenderSettings& render, RenderMode mode, float pointSize) {
+    RenderSettings settings = render;
+    settings.raster.mode = mode;
+    settings.raster.stage = Stage::Final;
+    settings.raster.pointSize = pointSize;
+    renderer.render(camera, settings);
+    ReconstructionImages images{renderer.resources().texture("depth").readFloats(), {}};
+    const std::vector<glm::vec3> albedo = rgbOf(renderer.resources().texture("color").readFloats());
+    return {shader.shade(camera, render, images.depth, towardsEye(camera), albedo),
+            std::move(images)};
+}
+
 /// The per-view pictures of EvaluationSettings::exportDirectory.
 void exportView(const std::filesystem::path& directory, int view, const Camera& camera,
                 double spacing, const GroundTruthImages& truth, const ReconstructionImages& surface,
@@ -178,21 +198,12 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         const GroundTruthImages groundTruth = renderGroundTruth(truth, camera);
         const std::vector<std::uint8_t> truthImage = shader.shade(
             camera, render, groundTruth.depth, groundTruth.normals, groundTruth.albedo);
-        const std::vector<glm::vec3> flatNormals = towardsEye(camera);
-
         // The baselines: rasterized points, flat shaded.
         auto baseline = [&](RenderMode mode, float pointSize) {
-            RenderSettings baselineSettings = render;
-            baselineSettings.raster.mode = mode;
-            baselineSettings.raster.stage = Stage::Final;
-            baselineSettings.raster.pointSize = pointSize;
-            renderer.render(camera, baselineSettings);
-            ReconstructionImages images{renderer.resources().texture("depth").readFloats(), {}};
-            QualityMetrics metrics = compareToGroundTruth(images, groundTruth, h);
-            const std::vector<glm::vec3> albedo =
-                rgbOf(renderer.resources().texture("color").readFloats());
-            metrics.psnrDb =
-                psnr(shader.shade(camera, render, images.depth, flatNormals, albedo), truthImage);
+            const BaselineFrame frame =
+                renderBaseline(renderer, shader, camera, render, mode, pointSize);
+            QualityMetrics metrics = compareToGroundTruth(frame.images, groundTruth, h);
+            metrics.psnrDb = psnr(frame.image, truthImage);
             return metrics;
         };
         pointViews.push_back(baseline(RenderMode::Points, 1.0f));
@@ -237,6 +248,152 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         }
     }
     return report;
+}
+
+namespace {
+
+/// 1 where `depth` is finite.
+std::vector<std::uint8_t> maskOf(const std::vector<float>& depth) {
+    std::vector<std::uint8_t> mask(depth.size());
+    std::transform(depth.begin(), depth.end(), mask.begin(),
+                   [](float d) { return std::isfinite(d) ? 1 : 0; });
+    return mask;
+}
+
+/// The truth seen through `camera` with `factor` x `factor` rays per pixel, shaded like the
+/// methods: the picture averaged in linear light, covered where most of a pixel's rays hit.
+SequenceFrame supersampledTruth(const Scene& truth, ImageShader& shader, const Camera& camera,
+                                const RenderSettings& render, int factor) {
+    Camera fine = camera;
+    fine.width = camera.width * factor;
+    fine.height = camera.height * factor;
+    const GroundTruthImages images = renderGroundTruth(truth, fine);
+    const std::vector<std::uint8_t> picture =
+        shader.shade(fine, render, images.depth, images.normals, images.albedo);
+    SequenceFrame frame{
+        downsampleSrgb(picture, camera.width, camera.height, factor),
+        std::vector<std::uint8_t>(static_cast<std::size_t>(camera.width * camera.height), 0)};
+    for (int y = 0; y < camera.height; ++y) {
+        for (int x = 0; x < camera.width; ++x) {
+            int hits = 0;
+            for (int sy = 0; sy < factor; ++sy) {
+                for (int sx = 0; sx < factor; ++sx) {
+                    hits += std::isfinite(
+                        images.depth[(y * factor + sy) * fine.width + x * factor + sx]);
+                }
+            }
+            frame.mask[y * camera.width + x] = 2 * hits >= factor * factor ? 1 : 0;
+        }
+    }
+    return frame;
+}
+
+}  // namespace
+
+TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const PointCloud& points,
+                                const EvaluationSettings& settings,
+                                const TemporalEvaluationSettings& temporal,
+                                const RenderSettings& render) {
+    Renderer renderer(context, points);
+    // Its own renderer, so the filter's history runs on undisturbed by the other methods.
+    Renderer filtered(context, points);
+    ImageShader shader(context, renderer.gpuCloud());
+    RenderSettings surfaceSettings = render;
+    surfaceSettings.raster.mode = RenderMode::Surface;
+    surfaceSettings.raster.stage = Stage::Final;
+    surfaceSettings.temporal.enabled = false;
+    RenderSettings filteredSettings = surfaceSettings;
+    filteredSettings.temporal.enabled = true;
+
+    TemporalReport report;
+    std::vector<SequenceFrame> truthFrames, pointFrames, splatFrames, surfaceFrames, filteredFrames;
+    for (int t = 0; t < temporal.frames; ++t) {
+        OrbitView orbit;
+        orbit.yawDegrees = 20.0 + t * temporal.stepDegrees;
+        orbit.pitchDegrees = 25.0;
+        orbit.distance = settings.distance;
+        const Camera camera = orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
+                                          settings.fovyDegrees);
+        truthFrames.push_back(
+            supersampledTruth(truth, shader, camera, render, temporal.supersampling));
+
+        for (const auto& [mode, size, frames] :
+             {std::tuple{RenderMode::Points, 1.0f, &pointFrames},
+              std::tuple{RenderMode::Splats, render.raster.pointSize, &splatFrames}}) {
+            BaselineFrame frame = renderBaseline(renderer, shader, camera, render, mode, size);
+            frames->push_back({std::move(frame.image), maskOf(frame.images.depth)});
+        }
+
+        // A pipeline image at the output's pixels (a reduced frame's texel per pixel).
+        auto atOutput = [&](const Renderer& source, const std::vector<float>& values, int channels,
+                            int divisor) {
+            return atOutputPixels(values, channels, camera, source.pipelineCamera(), divisor);
+        };
+        const int divisor =
+            renderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
+        surfaceFrames.push_back(
+            {renderer.readImage(),
+             maskOf(atOutput(renderer, renderer.resources().texture("surfaceDepth").readFloats(), 1,
+                             divisor))});
+
+        // The filtered sequence starts converged at the first pose, then follows the orbit.
+        int filteredDivisor = 1;
+        for (int still = 0; still < (t == 0 ? temporal.stillSamples : 1); ++still) {
+            filteredDivisor = filtered.render(camera, filteredSettings).divisor;
+        }
+        const std::vector<float> coverage = atOutput(
+            filtered, filtered.resources().texture("history").readFloats(), 4, filteredDivisor);
+        SequenceFrame frame{filtered.readImage(), {}};
+        for (std::size_t i = 3; i < coverage.size(); i += 4) {
+            frame.mask.push_back(coverage[i] >= 0.5f ? 1 : 0);
+        }
+        filteredFrames.push_back(std::move(frame));
+        if (t == 0) {
+            report.stillPsnrSurfaceDb = psnr(surfaceFrames[0].image, truthFrames[0].image);
+            report.stillPsnrTemporalDb = psnr(filteredFrames[0].image, truthFrames[0].image);
+        }
+    }
+    report.frames = temporal.frames;
+    report.stepDegrees = temporal.stepDegrees;
+    report.width = settings.width;
+    report.height = settings.height;
+    report.supersampling = temporal.supersampling;
+    report.points = points.size();
+    report.spacing = renderer.spacing();
+    report.splatSize = render.raster.pointSize;
+    report.points1px = compareSequences(pointFrames, truthFrames);
+    report.splats = compareSequences(splatFrames, truthFrames);
+    report.surface = compareSequences(surfaceFrames, truthFrames);
+    report.surfaceTemporal = compareSequences(filteredFrames, truthFrames);
+    return report;
+}
+
+nlohmann::json toJson(const TemporalReport& report) {
+    auto method = [](const TemporalMetrics& m) {
+        return nlohmann::json{{"temporal_error", m.temporalError},
+                              {"mask_flicker", m.maskFlicker},
+                              {"psnr_db", m.psnrDb}};
+    };
+    nlohmann::json splats = method(report.splats);
+    splats["point_size"] = report.splatSize;
+    nlohmann::json surface = method(report.surface);
+    surface["still_psnr_db"] = report.stillPsnrSurfaceDb;
+    nlohmann::json filtered = method(report.surfaceTemporal);
+    filtered["still_psnr_db"] = report.stillPsnrTemporalDb;
+    return {
+        {"frames", report.frames},
+        {"step_degrees", report.stepDegrees},
+        {"width", report.width},
+        {"height", report.height},
+        {"supersampling", report.supersampling},
+        {"points", report.points},
+        {"spacing", report.spacing},
+        {"methods",
+         {{"points", method(report.points1px)},
+          {"splats", splats},
+          {"surface", surface},
+          {"surface_temporal", filtered}}},
+    };
 }
 
 nlohmann::json toJson(const EvaluationReport& report) {

@@ -53,6 +53,43 @@ struct EvaluationReport {
 EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointCloud& points,
                           const EvaluationSettings& settings, const RenderSettings& render);
 
+/// How `subscan eval --temporal` moves: `frames` cameras on a slow orbit (yaw from 20° in steps
+/// of `stepDegrees`, pitch 25°), of EvaluationSettings' size, lens and distance.
+struct TemporalEvaluationSettings {
+    int frames = 24;
+    double stepDegrees = 1.0;
+    int supersampling = 4;  // ground-truth rays per pixel and side
+    int stillSamples = 16;  // frames the filtered sequence converges over at its first pose
+};
+
+/// DESIGN.md §7's temporal measures per method, against the supersampled truth.
+struct TemporalReport {
+    int frames = 0;
+    double stepDegrees = 0.0;
+    int width = 0;
+    int height = 0;
+    int supersampling = 0;
+    std::size_t points = 0;
+    double spacing = 0.0;
+    TemporalMetrics points1px;
+    TemporalMetrics splats;
+    float splatSize = 0.0f;  // RasterSettings::pointSize
+    TemporalMetrics surface;
+    TemporalMetrics surfaceTemporal;  // one continuous sequence through the temporal filter
+    // The first pose as a still: one frame of the surface, and the filter's converged picture.
+    double stillPsnrSurfaceDb = 0.0;
+    double stillPsnrTemporalDb = 0.0;
+};
+
+/// Renders the orbit with each method (the temporal filter's sequence starting converged) and
+/// compares the sequences with the truth's, supersampled.
+TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const PointCloud& points,
+                                const EvaluationSettings& settings,
+                                const TemporalEvaluationSettings& temporal,
+                                const RenderSettings& render);
+
+nlohmann::json toJson(const TemporalReport& report);
+
 /// {"views", "width", "height", "points", "spacing", "methods": {"points", "splats",
 /// "surface"}} with the keys of each method named in the issue (snake case).
 nlohmann::json toJson(const EvaluationReport& report);

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
+
+#include "core/Srgb.h"
 
 namespace subscan {
 
@@ -113,6 +116,75 @@ QualityMetrics average(const std::vector<QualityMetrics>& views) {
         mean.normalErrorP95Deg = normalP95;
     }
     return mean;
+}
+
+TemporalMetrics compareSequences(const std::vector<SequenceFrame>& frames,
+                                 const std::vector<SequenceFrame>& truth) {
+    if (frames.size() != truth.size()) {
+        throw std::invalid_argument("the sequences differ in length");
+    }
+    TemporalMetrics metrics;
+    if (frames.empty()) {
+        return metrics;
+    }
+    for (std::size_t t = 0; t < frames.size(); ++t) {
+        if (frames[t].image.size() != truth[t].image.size() ||
+            frames[t].mask.size() != truth[t].mask.size() ||
+            frames[t].image.size() != 4 * frames[t].mask.size()) {
+            throw std::invalid_argument("the sequences' frames differ in size");
+        }
+        metrics.psnrDb += psnr(frames[t].image, truth[t].image) / frames.size();
+    }
+    if (frames.size() < 2) {
+        return metrics;
+    }
+    const double steps = static_cast<double>(frames.size() - 1);
+    for (std::size_t t = 1; t < frames.size(); ++t) {
+        const SequenceFrame &now = frames[t], &before = frames[t - 1];
+        const SequenceFrame &truthNow = truth[t], &truthBefore = truth[t - 1];
+        double error = 0.0;
+        std::size_t flicker = 0;
+        for (std::size_t i = 0; i < now.mask.size(); ++i) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                const std::size_t k = 4 * i + c;
+                const int change = int(now.image[k]) - int(before.image[k]);
+                const int truthChange = int(truthNow.image[k]) - int(truthBefore.image[k]);
+                error += std::abs(change - truthChange) / 255.0;
+            }
+            const bool flipped = now.mask[i] != before.mask[i];
+            const bool truthFlipped = truthNow.mask[i] != truthBefore.mask[i];
+            flicker += flipped != truthFlipped ? 1 : 0;
+        }
+        const double pixels = static_cast<double>(now.mask.size());
+        metrics.temporalError += error / (3.0 * pixels) / steps;
+        metrics.maskFlicker += static_cast<double>(flicker) / pixels / steps;
+    }
+    return metrics;
+}
+
+std::vector<std::uint8_t> downsampleSrgb(const std::vector<std::uint8_t>& image, int width,
+                                         int height, int factor) {
+    const int fineWidth = width * factor;
+    std::vector<std::uint8_t> result(static_cast<std::size_t>(width * height * 4), 255);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                double sum = 0.0;
+                for (int sy = 0; sy < factor; ++sy) {
+                    for (int sx = 0; sx < factor; ++sx) {
+                        const std::size_t k =
+                            4 * static_cast<std::size_t>((y * factor + sy) * fineWidth +
+                                                         x * factor + sx) +
+                            static_cast<std::size_t>(c);
+                        sum += srgbToLinear(image[k] / 255.0f);
+                    }
+                }
+                result[4 * static_cast<std::size_t>(y * width + x) + static_cast<std::size_t>(c)] =
+                    srgb8Channel(static_cast<float>(sum / (factor * factor)));
+            }
+        }
+    }
+    return result;
 }
 
 }  // namespace subscan

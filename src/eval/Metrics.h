@@ -39,4 +39,31 @@ double psnr(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>&
 /// The mean of per-view metrics (optional ones averaged where present).
 QualityMetrics average(const std::vector<QualityMetrics>& views);
 
+/// One frame of a sequence: the picture (RGBA8, sRGB) and what it covers (1 per pixel where the
+/// method shows the object, else 0).
+struct SequenceFrame {
+    std::vector<std::uint8_t> image;
+    std::vector<std::uint8_t> mask;
+};
+
+/// DESIGN.md §7's measures of stability along a camera path, against the truth's sequence.
+struct TemporalMetrics {
+    /// E_t: mean over frames t >= 1, pixels and RGB of |(I_t - I_t-1) - (G_t - G_t-1)|, on the
+    /// sRGB values scaled to 0..1: change the truth does not make.
+    double temporalError = 0.0;
+    /// The share of pixels whose covered state changes when the truth's does not, or the other
+    /// way round, averaged over frames t >= 1.
+    double maskFlicker = 0.0;
+    double psnrDb = 0.0;  // mean over frames of each frame's PSNR against the truth's
+};
+
+/// Throws std::invalid_argument when the sequences differ in length or frame sizes.
+TemporalMetrics compareSequences(const std::vector<SequenceFrame>& frames,
+                                 const std::vector<SequenceFrame>& truth);
+
+/// An RGBA8 sRGB image of (factor W) x (factor H) averaged over factor x factor blocks in linear
+/// light and encoded again: a supersampled picture at W x H.
+std::vector<std::uint8_t> downsampleSrgb(const std::vector<std::uint8_t>& image, int width,
+                                         int height, int factor);
+
 }  // namespace subscan

@@ -48,6 +48,43 @@ TEST(EvaluationGLTest, EvalCommandJsonHasTheDocumentedShape) {
     EXPECT_TRUE(json["methods"]["surface"]["normal_error_mean_deg"].is_number());
 }
 
+TEST(EvaluationGLTest, TemporalEvaluationSeesMotionAndStillness) {
+    // Not a sphere: turning about its centre, a sphere looks the same from every yaw.
+    const auto truth = makeBuiltInScene("box-with-hole");
+    const PointCloud points = makeSyntheticScene("box-with-hole?points=20000");
+    EvaluationSettings settings;
+    settings.width = 48;
+    settings.height = 48;
+    TemporalEvaluationSettings temporal;
+    temporal.frames = 3;
+    temporal.stillSamples = 8;
+    // A camera that does not move: the truth and every unfiltered method repeat their
+    // frames exactly, so no change is counted.
+    temporal.stepDegrees = 0.0;
+    const TemporalReport still = evaluateTemporal(test::glTestContext(), *truth, points, settings,
+                                                  temporal, RenderSettings{});
+    EXPECT_EQ(still.surface.temporalError, 0.0);
+    EXPECT_EQ(still.surface.maskFlicker, 0.0);
+    EXPECT_EQ(still.points1px.temporalError, 0.0);
+    // The filter keeps averaging more offsets: its frames change, by under a level of 255.
+    EXPECT_LT(still.surfaceTemporal.temporalError, 1.0 / 255.0);
+    // Moving, the points' and the surface's pictures change as the truth's does not quite.
+    temporal.stepDegrees = 5.0;
+    const TemporalReport moving = evaluateTemporal(test::glTestContext(), *truth, points, settings,
+                                                   temporal, RenderSettings{});
+    EXPECT_GT(moving.points1px.temporalError, 0.0);
+    EXPECT_GT(moving.surface.temporalError, 0.0);
+    EXPECT_GT(moving.surface.psnrDb, 15.0) << "the box should be recognisable";
+
+    const nlohmann::json json = toJson(moving);
+    for (const char* method : {"points", "splats", "surface", "surface_temporal"}) {
+        for (const char* key : {"temporal_error", "mask_flicker", "psnr_db"}) {
+            EXPECT_TRUE(json["methods"][method].contains(key)) << method << "." << key;
+        }
+    }
+    EXPECT_TRUE(json["methods"]["surface_temporal"].contains("still_psnr_db"));
+}
+
 TEST(EvaluationGLTest, EvalReconstructsAScanFileAgainstTheMesh) {
     const test::TempDir dir;
     const auto mesh = dir.write("mesh.ply",

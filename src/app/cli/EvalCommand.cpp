@@ -21,6 +21,8 @@ namespace {
 struct EvalOptions {
     std::string source;
     EvaluationSettings evaluation;
+    bool temporal = false;
+    TemporalEvaluationSettings temporalEvaluation;
     std::string points = "vertices";
     std::string settingsFile;
     bool json = false;
@@ -74,6 +76,31 @@ int runEval(const EvalOptions& options) {
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
+    if (options.temporal) {
+        const TemporalReport report = evaluateTemporal(*context, *truth, points, options.evaluation,
+                                                       options.temporalEvaluation, render);
+        if (options.json) {
+            fmt::print("{}\n", toJson(report).dump(2));
+            return 0;
+        }
+        fmt::print(
+            "{}: {} points (h = {:.4g}), {} frames of {}x{}, {}° apart, truth {}x{} rays "
+            "per pixel\n",
+            options.source, report.points, report.spacing, report.frames, report.width,
+            report.height, report.stepDegrees, report.supersampling, report.supersampling);
+        fmt::print("{:<18} {:>10} {:>12} {:>8} {:>12}\n", "method", "E_t", "mask flicker", "PSNR",
+                   "still PSNR");
+        auto row = [](const std::string& name, const TemporalMetrics& m, std::string still) {
+            fmt::print("{:<18} {:>10.5f} {:>12.5f} {:>8.2f} {:>12}\n", name, m.temporalError,
+                       m.maskFlicker, m.psnrDb, still);
+        };
+        row("points", report.points1px, "-");
+        row(fmt::format("splats ({}px)", report.splatSize), report.splats, "-");
+        row("surface", report.surface, fmt::format("{:.2f}", report.stillPsnrSurfaceDb));
+        row("surface+temporal", report.surfaceTemporal,
+            fmt::format("{:.2f}", report.stillPsnrTemporalDb));
+        return 0;
+    }
     const EvaluationReport report = evaluate(*context, *truth, points, options.evaluation, render);
     if (options.json) {
         fmt::print("{}\n", toJson(report).dump(2));
@@ -125,6 +152,14 @@ Command addEvalCommand(CLI::App& parent) {
         ->check(CLI::ExistingFile);
     eval->add_option("--export-views", options->evaluation.exportDirectory,
                      "Directory for per-view pictures: truth, surface, coverage, normal error");
+    eval->add_flag("--temporal", options->temporal,
+                   "Stability along a slow orbit instead: E_t, mask flicker and PSNR per frame "
+                   "against a 4x4-supersampled truth, with and without the temporal filter");
+    eval->add_option("--frames", options->temporalEvaluation.frames, "Frames of --temporal")
+        ->check(CLI::Range(2, 10000));
+    eval->add_option("--step", options->temporalEvaluation.stepDegrees,
+                     "Degrees of yaw between frames of --temporal")
+        ->check(CLI::Range(0.0, 90.0));
     eval->add_flag("--json", options->json, "Machine-readable output");
     eval->add_flag("--software", options->software,
                    "Use Mesa's software rasterizer even when a GPU exists");

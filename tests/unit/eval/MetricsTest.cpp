@@ -79,5 +79,34 @@ TEST(MetricsTest, AverageOverViews) {
     EXPECT_DOUBLE_EQ(*mean.normalErrorP95Deg, 9.0);
 }
 
+TEST(MetricsTest, TemporalErrorCountsOnlyChangeTheTruthDoesNotMake) {
+    // Two pixels, three frames. Pixel 0 brightens by 51 a frame in both sequences (no error);
+    // pixel 1 stays dark in the truth but the method's blinks 0 -> 255 -> 0 and its mask with
+    // it: E_t = (255 + 255) / 255 over 3 channels x 2 pixels, per step of two.
+    auto frame = [](std::uint8_t a, std::uint8_t b, std::uint8_t maskB) {
+        return SequenceFrame{{a, a, a, 255, b, b, b, 255}, {1, maskB}};
+    };
+    const std::vector<SequenceFrame> truth = {frame(0, 0, 0), frame(51, 0, 0), frame(102, 0, 0)};
+    const std::vector<SequenceFrame> method = {frame(0, 0, 0), frame(51, 255, 1), frame(102, 0, 0)};
+    const TemporalMetrics same = compareSequences(truth, truth);
+    EXPECT_EQ(same.temporalError, 0.0);
+    EXPECT_EQ(same.maskFlicker, 0.0);
+    EXPECT_EQ(same.psnrDb, 100.0);
+    const TemporalMetrics blinking = compareSequences(method, truth);
+    EXPECT_NEAR(blinking.temporalError, 3.0 / 6.0, 1e-12);  // each step: 3 channels of 1.0
+    EXPECT_NEAR(blinking.maskFlicker, 0.5, 1e-12);          // one of two pixels each step
+    EXPECT_THROW(compareSequences(method, {truth[0]}), std::invalid_argument);
+}
+
+TEST(MetricsTest, DownsamplingAveragesInLinearLight) {
+    // A 2x2 block of black and white halves to linear 0.5: sRGB 188 (0.7354 x 255 rounded).
+    const std::vector<std::uint8_t> fine = {0,   0,   0,   255, 255, 255, 255, 255,
+                                            255, 255, 255, 255, 0,   0,   0,   255};
+    const std::vector<std::uint8_t> coarse = downsampleSrgb(fine, 1, 1, 2);
+    ASSERT_EQ(coarse.size(), 4u);
+    EXPECT_EQ(coarse[0], 188);
+    EXPECT_EQ(coarse[3], 255);
+}
+
 }  // namespace
 }  // namespace subscan
