@@ -348,6 +348,15 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
             frame.mask.push_back(coverage[i] >= 0.5f ? 1 : 0);
         }
         filteredFrames.push_back(std::move(frame));
+        if (!settings.exportDirectory.empty()) {
+            std::filesystem::create_directories(settings.exportDirectory);
+            for (const auto& [name, frames] :
+                 {std::pair{"truth", &truthFrames}, std::pair{"points", &pointFrames},
+                  std::pair{"surface", &surfaceFrames}, std::pair{"temporal", &filteredFrames}}) {
+                writePng(settings.exportDirectory / fmt::format("frame{:04}_{}.png", t, name),
+                         {camera.width, camera.height, 4, frames->back().image});
+            }
+        }
         if (t == 0) {
             report.stillPsnrSurfaceDb = psnr(surfaceFrames[0].image, truthFrames[0].image);
             report.stillPsnrTemporalDb = psnr(filteredFrames[0].image, truthFrames[0].image);

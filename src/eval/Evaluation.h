@@ -26,9 +26,9 @@ struct EvaluationSettings {
     int smallestSplat = 2;  // the splats baseline reports the best size in this range
     int largestSplat = 8;
     /// When set, each view's pictures go here: truth.png and surface.png (shaded), coverage.png
-    /// (grey: both, red: missed, blue: leaked,
-    /// yellow: a surface behind the true one shows through) and normal_error.png (black 0° to white
-    /// 45°).
+    /// (grey: both, red: missed, blue: leaked, yellow: a surface behind the true one shows
+    /// through) and normal_error.png (black 0° to white 45°). With --temporal, each frame's
+    /// frameNNNN_{truth,points,surface,temporal}.png (the truth supersampled).
     std::filesystem::path exportDirectory;
 };
 

@@ -173,7 +173,8 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
                             : 1;
     pipelineCamera_ = divisor == 1 ? camera : reducedCamera(camera, divisor);
     if (filtersTemporally(settings)) {
-        pipelineCamera_.jitterPixels += lazyPass(temporal_, sources_).nextJitter(settings.temporal);
+        pipelineCamera_.jitterPixels +=
+            lazyPass(temporal_, sources_).nextJitter(pipelineCamera_, settings.temporal);
     }
     const gpu::PyramidLayout& layout =
         uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());

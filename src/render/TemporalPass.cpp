@@ -56,9 +56,12 @@ std::vector<std::string_view> TemporalPass::outputs() const {
     return {"history", "historyState"};
 }
 
-glm::dvec2 TemporalPass::nextJitter(const TemporalSettings& settings) {
-    if (!previous_) {
+glm::dvec2 TemporalPass::nextJitter(const Camera& camera, const TemporalSettings& settings) {
+    if (!previous_ || !sameView(previous_->camera, camera)) {
         frameIndex_ = 0;
+        if (previous_) {
+            return glm::dvec2(0.0);
+        }
     }
     const unsigned index = frameIndex_ % static_cast<unsigned>(settings.maxFrames) + 1;
     ++frameIndex_;

@@ -41,9 +41,12 @@ class TemporalPass final : public RenderPass {
         colorInput_ = std::move(colorInput);
         writesPicture_ = writesPicture;
     }
-    /// The jitter of the next frame, pipeline pixels (Halton (2, 3), cycling through
-    /// TemporalSettings::maxFrames points so a still camera's mean covers the whole pattern).
-    glm::dvec2 nextJitter(const TemporalSettings& settings);
+    /// The jitter of the next frame through `camera` (without jitter), pipeline pixels: Halton
+    /// (2, 3), cycling through TemporalSettings::maxFrames points so a still camera's mean
+    /// covers the whole pattern; none while the camera moves, where the jitter's own change
+    /// from frame to frame costs more steadiness than its anti-aliasing gains (README,
+    /// "Temporal filter").
+    glm::dvec2 nextJitter(const Camera& camera, const TemporalSettings& settings);
     /// Forget the history: the next frame starts afresh (a cut in an animation).
     void restart() { previous_.reset(); }
 
