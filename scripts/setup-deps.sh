@@ -17,6 +17,8 @@ packages=(
     liblzf-dev libnanoflann-dev libeigen3-dev
     # tests and benchmarks
     libgtest-dev libgmock-dev libbenchmark-dev
+    # run time: `subscan turntable -o OUT.mp4` encodes with ffmpeg (folders of PNGs need nothing)
+    ffmpeg
 )
 
 # One dpkg-query for all packages; those it does not report as installed are missing.

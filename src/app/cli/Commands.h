@@ -20,6 +20,7 @@ Command addInfoCommand(CLI::App& parent);
 Command addMaterialsCommand(CLI::App& parent);
 Command addRenderCommand(CLI::App& parent);
 Command addScanCommand(CLI::App& parent);
+Command addTurntableCommand(CLI::App& parent);
 Command addViewCommand(CLI::App& parent);
 
 /// Parses the command line and runs the chosen subcommand. Exit codes: 0 success, 1 an error

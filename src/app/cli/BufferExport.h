@@ -1,0 +1,21 @@
+#pragma once
+
+#include <filesystem>
+
+#include "render/RenderSettings.h"
+#include "render/Renderer.h"
+
+namespace subscan::cli {
+
+/// camera.json, depth.pfm and color.png always; in the surface and sss modes also normals.pfm,
+/// mask.png and radiance.pfm (after scattering in sss mode), with depth.pfm holding the
+/// reconstructed depth (+inf outside the mask); with single scattering also single.pfm (that
+/// term alone, linear RGB like radiance.pfm), sigma_s.pfm and sigma_a.pfm (σs′ and σa in mm⁻¹).
+/// The camera and the buffers are the pipeline's last frame's: at reduced resolution smaller
+/// than the picture; with the temporal filter that frame's, jittered by under half a pixel,
+/// while camera.json holds the camera without the jitter. Needs a frame rendered with
+/// FrameOutputs::Everything.
+void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
+                   const RenderSettings& settings);
+
+}  // namespace subscan::cli

@@ -1,0 +1,162 @@
+#include "app/cli/FrameOptions.h"
+
+#include <system_error>
+
+#include <fmt/format.h>
+#include <glm/vector_relational.hpp>
+
+#include "core/Error.h"
+#include "io/CameraJson.h"
+
+namespace subscan::cli {
+
+namespace {
+
+/// "R,G,B" with sRGB components in 0..1, or "#rrggbb".
+glm::vec3 parseBackground(const std::string& text) {
+    if (text.size() == 7 && text[0] == '#' &&
+        text.find_first_not_of("0123456789abcdefABCDEF", 1) == std::string::npos) {
+        const unsigned long value = std::stoul(text.substr(1), nullptr, 16);
+        return glm::vec3((value >> 16) & 255, (value >> 8) & 255, value & 255) / 255.0f;
+    }
+    const std::optional<glm::vec3> color = parseCommaSeparatedRgb(text);
+    if (!color || glm::any(glm::lessThan(*color, glm::vec3(0.0f))) ||
+        glm::any(glm::greaterThan(*color, glm::vec3(1.0f)))) {
+        throw Error(
+            fmt::format("--background '{}' is not R,G,B with values in 0..1 or #rrggbb", text));
+    }
+    return *color;
+}
+
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ignored;
+    return std::filesystem::equivalent(a, b, ignored);
+}
+
+}  // namespace
+
+void FrameOptions::add(CLI::App& command) {
+    command.add_option("scan", source, "Scan file, or synthetic:NAME")->required();
+    command.add_option("--width", width, "Image width in pixels")->check(CLI::Range(1, 65536));
+    command.add_option("--height", height, "Image height in pixels")->check(CLI::Range(1, 65536));
+    command
+        .add_option("--mode", mode,
+                    "points (default) | points-gl | splats | surface | sss (surface with "
+                    "subsurface scattering)")
+        ->check(CLI::IsMember({"points", "points-gl", "splats", "surface", "sss"}));
+    command
+        .add_option("--stage", stage,
+                    "Show an intermediate: depth | pyramid | visibility | pull | push | fill | "
+                    "normals | shaded (surface and sss modes; depth in any)")
+        ->check(CLI::IsMember({"final", "depth", "pyramid", "visibility", "pull", "push", "fill",
+                               "normals", "shaded"}));
+    scattering.add(command);
+    command.add_option("--point-size", pointSize, "Splat size in pixels (splats mode)")
+        ->check(CLI::Range(1.0f, 64.0f));
+    command.add_option("--yaw", yaw, "Orbit angle around the up axis, degrees");
+    command.add_option("--pitch", pitch, "Orbit elevation, degrees")
+        ->check(CLI::Range(-90.0, 90.0));
+    command
+        .add_option("--distance", distance,
+                    "Eye distance from the centre (scene units); default frames the bounds")
+        ->check(CLI::PositiveNumber);
+    command.add_option("--up", up, "Up axis: auto (z for LAS, else y) | y | z")
+        ->check(CLI::IsMember({"auto", "y", "z"}));
+    command.add_option("--fovy", fovy, "Vertical field of view, degrees")
+        ->check(CLI::Range(1.0, 170.0));
+    command.add_option("--camera", cameraFile, "camera.json to render from")
+        ->check(CLI::ExistingFile);
+    command.add_option("--background", background, "R,G,B (sRGB 0..1) or #rrggbb");
+    command.add_option("--raster", raster, "Compute rasterizer: auto | int64 | two-pass")
+        ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
+    addResolutionOption(command, resolution);
+    command
+        .add_option("--settings", settingsFile,
+                    "Settings JSON ({\"raster\", \"surface\", \"shading\", \"scattering\", "
+                    "\"temporal\"}); options given here override it")
+        ->check(CLI::ExistingFile);
+    command.add_option("--save-settings", saveSettingsFile, "Write the effective settings as JSON");
+    command.add_flag("-v,--verbose", verbose, "Print the OpenGL renderer");
+    command.add_flag("--software", software,
+                     "Use Mesa's software rasterizer even when a GPU exists");
+}
+
+RenderSettings FrameOptions::settings() const {
+    RenderSettings settings;
+    if (!settingsFile.empty()) {
+        settings = readSettingsFile(settingsFile);
+    }
+    RasterSettings& rasterSettings = settings.raster;
+    if (!mode.empty()) {
+        rasterSettings.mode = parseRenderMode(mode);
+    }
+    if (pointSize) {
+        rasterSettings.pointSize = *pointSize;
+    }
+    if (!raster.empty()) {
+        rasterSettings.path = parseRasterPath(raster);
+    }
+    if (!resolution.empty()) {
+        rasterSettings.resolution = parseResolution(resolution);
+    }
+    if (!stage.empty()) {
+        rasterSettings.stage = parseStage(stage);
+    }
+    if (!background.empty()) {
+        rasterSettings.backgroundSrgb = parseBackground(background);
+    }
+    scattering.apply(settings.scattering);
+    return settings;
+}
+
+UpAxis FrameOptions::upAxis(const LoadedScan& scan) const {
+    return up == "z" || (up == "auto" && scan.format == "las") ? UpAxis::Z : UpAxis::Y;
+}
+
+Camera FrameOptions::camera(const LoadedScan& scan) const {
+    if (!cameraFile.empty()) {
+        return readCameraFile(cameraFile);
+    }
+    OrbitView orbit;
+    orbit.yawDegrees = yaw;
+    orbit.pitchDegrees = pitch;
+    orbit.distance = distance;
+    orbit.up = upAxis(scan);
+    return orbitCamera(scan.cloud.bounds, orbit, width, height, fovy);
+}
+
+std::unique_ptr<GlContext> FrameOptions::context() const {
+    HeadlessContextOptions options;
+    options.preferHardware = !software;
+#ifndef NDEBUG
+    options.debugOutput = true;  // debug builds turn GL errors into errors
+#endif
+    std::unique_ptr<GlContext> context = createHeadlessContext(options);
+    if (verbose) {
+        const GlCapabilities& caps = context->capabilities();
+        fmt::print(stderr, "subscan: OpenGL {} | {} | {}\n", caps.version, caps.vendor,
+                   caps.renderer);
+    }
+    return context;
+}
+
+void FrameOptions::refuseToOverwriteInputs(const std::filesystem::path& output,
+                                           std::string_view what) const {
+    for (const auto& [input, kind] :
+         {std::pair{&source, "scan"}, std::pair{&settingsFile, "settings file"},
+          std::pair{&cameraFile, "camera file"}}) {
+        if (!input->empty() && !input->starts_with("synthetic:") && sameFile(output, *input)) {
+            throw Error(fmt::format("{}: refusing to write {} over the input {}", output.string(),
+                                    what, kind));
+        }
+    }
+}
+
+void FrameOptions::saveSettings(const RenderSettings& settings) const {
+    if (!saveSettingsFile.empty()) {
+        refuseToOverwriteInputs(saveSettingsFile, "the settings");
+        writeSettingsFile(saveSettingsFile, settings);
+    }
+}
+
+}  // namespace subscan::cli

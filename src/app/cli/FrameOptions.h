@@ -1,0 +1,60 @@
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "app/cli/CommandSupport.h"
+#include "core/Camera.h"
+#include "gpu/GlContext.h"
+#include "io/ScanLoader.h"
+#include "render/RenderSettings.h"
+
+namespace subscan::cli {
+
+/// What render and turntable share: the picture's size, camera, mode, stage and settings, the
+/// GL context, and the guard against writing over the input.
+struct FrameOptions {
+    std::string source;  // the scan file, or synthetic:NAME
+    int width = 1280;
+    int height = 720;
+    std::string mode;
+    std::string stage;
+    std::optional<float> pointSize;
+    double yaw = 30.0;
+    double pitch = 20.0;
+    std::optional<double> distance;
+    std::string up = "auto";
+    double fovy = 45.0;
+    std::string cameraFile;
+    std::string background;
+    std::string raster;
+    std::string resolution;
+    ScatteringOptions scattering;
+    std::string settingsFile;
+    std::string saveSettingsFile;
+    bool verbose = false;
+    bool software = false;
+
+    void add(CLI::App& command);
+    /// The settings file's settings (or the defaults) with the given options written over them;
+    /// throws subscan::Error naming a bad value.
+    RenderSettings settings() const;
+    /// The camera of --camera, or the orbit of --yaw, --pitch, --distance, --up and --fovy
+    /// around the scan's bounds.
+    Camera camera(const LoadedScan& scan) const;
+    /// The up axis --up names for `scan` (auto: Z for LAS, else Y).
+    UpAxis upAxis(const LoadedScan& scan) const;
+    /// A headless context (hardware unless --software), its renderer printed with --verbose.
+    std::unique_ptr<GlContext> context() const;
+    /// Throws subscan::Error when `output` is the input scan or the settings file: nothing is
+    /// ever written over an input. `what` names the output ("the image", "the settings").
+    void refuseToOverwriteInputs(const std::filesystem::path& output, std::string_view what) const;
+    /// Writes --save-settings, if given (after the inputs are read).
+    void saveSettings(const RenderSettings& settings) const;
+};
+
+}  // namespace subscan::cli

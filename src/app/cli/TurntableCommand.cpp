@@ -1,0 +1,222 @@
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+#include <glm/ext/matrix_transform.hpp>
+
+#include "app/ProgressBar.h"
+#include "app/cli/BufferExport.h"
+#include "app/cli/CommandSupport.h"
+#include "app/cli/Commands.h"
+#include "app/cli/FrameOptions.h"
+#include "core/Error.h"
+#include "io/Image.h"
+#include "render/Renderer.h"
+
+extern char** environ;
+
+namespace subscan::cli {
+
+namespace {
+
+struct TurntableOptions {
+    FrameOptions frame;
+    std::string output;  // OUT.mp4, or a folder of PNGs
+    int frames = 120;
+    double degrees = 360.0;
+    int fps = 30;
+    int warmup = 16;  // still frames at the first pose before the first written one
+    std::string exportDirectory;
+};
+
+bool writesVideo(const std::filesystem::path& output) {
+    return output.extension() == ".mp4";
+}
+
+/// The ffmpeg on PATH, or nullopt.
+std::optional<std::filesystem::path> findFfmpeg() {
+    const char* path = std::getenv("PATH");
+    std::string_view directories = path ? path : "/usr/bin:/bin";
+    while (!directories.empty()) {
+        const std::size_t colon = directories.find(':');
+        const std::filesystem::path candidate =
+            std::filesystem::path(directories.substr(0, colon)) / "ffmpeg";
+        if (::access(candidate.c_str(), X_OK) == 0) {
+            return candidate;
+        }
+        directories = colon == std::string_view::npos ? "" : directories.substr(colon + 1);
+    }
+    return std::nullopt;
+}
+
+/// Runs ffmpeg on the numbered PNGs in `frames` into `video` (H.264, yuv420p, even sizes);
+/// throws subscan::Error with its exit status.
+void encodeVideo(const std::filesystem::path& ffmpeg, const std::filesystem::path& frames,
+                 const std::filesystem::path& video, int fps) {
+    const std::vector<std::string> arguments = {
+        ffmpeg.string(), "-y", "-loglevel", "error", "-framerate", std::to_string(fps), "-i",
+        (frames / "%04d.png").string(),
+        // yuv420p, which every player reads, needs even sizes: pad by a pixel when odd.
+        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p",
+        "-movflags", "+faststart", "-f", "mp4", video.string()};
+    std::vector<char*> argv;
+    for (const std::string& argument : arguments) {
+        argv.push_back(const_cast<char*>(argument.c_str()));
+    }
+    argv.push_back(nullptr);
+    pid_t child = 0;
+    if (posix_spawn(&child, argv[0], nullptr, nullptr, argv.data(), environ) != 0) {
+        throw Error(fmt::format("{}: cannot run {}", video.string(), ffmpeg.string()));
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        throw Error(fmt::format("{}: ffmpeg failed to encode the frames (exit status {})",
+                                video.string(), WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+    }
+}
+
+/// A temporary folder beside `output` for the frames of a video, removed when done.
+class FrameFolder {
+  public:
+    explicit FrameFolder(const std::filesystem::path& output)
+        : path_(output.parent_path() /
+                fmt::format(".{}.frames-{}", output.filename().string(), ::getpid())) {
+        std::filesystem::create_directories(path_);
+    }
+    ~FrameFolder() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path_, ignored);
+    }
+    FrameFolder(const FrameFolder&) = delete;
+    FrameFolder& operator=(const FrameFolder&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+
+  private:
+    std::filesystem::path path_;
+};
+
+void createFolder(const std::filesystem::path& folder, std::string_view what) {
+    std::error_code error;
+    std::filesystem::create_directories(folder, error);
+    if (error || !std::filesystem::is_directory(folder)) {
+        throw Error(fmt::format("{}: cannot create the {} folder{}", folder.string(), what,
+                                error ? ": " + error.message() : ""));
+    }
+}
+
+int runTurntable(const TurntableOptions& options) {
+    const FrameOptions& frame = options.frame;
+    const std::filesystem::path output = options.output;
+    frame.refuseToOverwriteInputs(output, "the turntable");
+    const bool video = writesVideo(output);
+    std::optional<std::filesystem::path> ffmpeg;
+    if (video) {
+        ffmpeg = findFfmpeg();
+        if (!ffmpeg) {
+            throw Error(fmt::format(
+                "{}: ffmpeg is not installed (Debian package ffmpeg); give -o a folder to get "
+                "numbered PNGs instead",
+                output.string()));
+        }
+    }
+    RenderSettings settings = frame.settings();
+    if (frame.mode.empty() && frame.settingsFile.empty()) {
+        settings.raster.mode = RenderMode::Surface;  // a turntable of the surface, unless asked
+    }
+    settings.temporal.enabled = true;
+    const bool filtered = filtersTemporally(settings);
+
+    const LoadedScan scan = loadScanForCommand(frame.source);
+    frame.saveSettings(settings);
+    const Camera first = frame.camera(scan);
+    // Each frame turns the scene about the up axis through the bounds' middle: the eye's yaw
+    // grows by degrees / frames, as --yaw would.
+    const glm::dvec3 centre = scan.cloud.bounds.center();
+    const glm::dvec3 axis =
+        frame.upAxis(scan) == UpAxis::Z ? glm::dvec3(0, 0, 1) : glm::dvec3(0, 1, 0);
+    auto cameraAt = [&](int index) {
+        const double angle = glm::radians(options.degrees * index / options.frames);
+        Camera camera = first;
+        camera.view = first.view * glm::translate(glm::dmat4(1.0), centre) *
+                      glm::rotate(glm::dmat4(1.0), -angle, axis) *
+                      glm::translate(glm::dmat4(1.0), -centre);
+        return camera;
+    };
+
+    const std::unique_ptr<GlContext> context = frame.context();
+    Renderer renderer(*context, scan.cloud);
+    std::optional<FrameFolder> temporary;
+    std::filesystem::path folder = output;
+    if (video) {
+        temporary.emplace(output);
+        folder = temporary->path();
+    } else {
+        createFolder(folder, "frames");
+    }
+    const FrameOutputs outputs =
+        options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
+    // The first written frame is already converged.
+    for (int still = 1; filtered && still < options.warmup; ++still) {
+        renderer.render(first, settings, outputs);
+    }
+    ProgressBar bar("turntable", options.frames > 1);
+    for (int index = 0; index < options.frames; ++index) {
+        const Camera camera = cameraAt(index);
+        renderer.render(camera, settings, outputs);
+        writePng(folder / fmt::format("{:04}.png", index),
+                 {camera.width, camera.height, 4, renderer.readImage()});
+        if (!options.exportDirectory.empty()) {
+            const std::filesystem::path buffers =
+                std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index);
+            createFolder(buffers, "buffers");
+            exportBuffers(buffers, renderer, settings);
+        }
+        bar.update((index + 1.0) / options.frames);
+    }
+    if (video) {
+        // Encoded beside the output and renamed over it once complete.
+        const std::filesystem::path partial =
+            output.parent_path() / fmt::format(".{}.partial", output.filename().string());
+        encodeVideo(*ffmpeg, folder, partial, options.fps);
+        std::filesystem::rename(partial, output);
+    }
+    return 0;
+}
+
+}  // namespace
+
+Command addTurntableCommand(CLI::App& parent) {
+    auto options = std::make_shared<TurntableOptions>();
+    CLI::App* turntable = parent.add_subcommand(
+        "turntable", "A turntable animation through the temporal filter (MP4 or numbered PNGs)");
+    options->frame.add(*turntable);
+    turntable
+        ->add_option("-o,--output", options->output,
+                     "OUT.mp4 (encoded by ffmpeg) or a folder for 0000.png, 0001.png, ...")
+        ->required();
+    turntable->add_option("--frames", options->frames, "Frames of the animation")
+        ->check(CLI::Range(1, 100000));
+    turntable->add_option("--degrees", options->degrees, "Degrees the scan turns in all")
+        ->check(CLI::Range(-36000.0, 36000.0));
+    turntable->add_option("--fps", options->fps, "Frames per second of the video")
+        ->check(CLI::Range(1, 240));
+    turntable
+        ->add_option("--warmup", options->warmup,
+                     "Still frames the temporal filter converges over before the first one")
+        ->check(CLI::Range(1, 2048));
+    turntable->add_option("--export-buffers", options->exportDirectory,
+                          "Directory for each frame's buffers: DIR/0000/, DIR/0001/, ... "
+                          "(camera.json, depth.pfm, ...)");
+    return {turntable, [options] { return runTurntable(*options); }};
+}
+
+}  // namespace subscan::cli

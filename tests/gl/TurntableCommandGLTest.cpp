@@ -1,0 +1,126 @@
+// `subscan turntable`: numbered PNGs or an MP4 through the temporal filter, the first frame
+// already converged, the yaw growing by degrees / frames, per-frame buffers, and refusals.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::runSubscan;
+using ::testing::HasSubstr;
+
+std::string fileBytes(const std::filesystem::path& path) {
+    std::ifstream stream(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(stream), {}};
+}
+
+const std::vector<std::string> kScene = {
+    "synthetic:sphere?points=4000", "--mode", "surface", "--width", "40", "--height", "32"};
+
+std::vector<std::string> with(std::vector<std::string> arguments,
+                              const std::vector<std::string>& more) {
+    arguments.insert(arguments.end(), more.begin(), more.end());
+    return arguments;
+}
+
+TEST(TurntableCommandGLTest, FramesStartConvergedAndTurnByDegreesOverFrames) {
+    const test::TempDir dir;
+    const auto turntable =
+        runSubscan(with(with({"turntable"}, kScene),
+                        {"-o", (dir / "frames").string(), "--frames", "3", "--degrees", "90",
+                         "--yaw", "10", "--export-buffers", (dir / "buffers").string()}));
+    ASSERT_EQ(turntable.exitCode, 0) << turntable.err;
+    for (const char* name : {"0000.png", "0001.png", "0002.png"}) {
+        EXPECT_TRUE(std::filesystem::is_regular_file(dir / "frames" / name)) << name;
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "frames" / "0003.png"));
+
+    // Frame 0 is the still the filter converges to over its 16 warm-up frames: the same
+    // picture, bit for bit, as `render --samples 16` from that camera (exporting too, so that
+    // both run the pass-by-pass chain, whose half floats round unlike FinishSurface).
+    const auto still =
+        runSubscan(with(with({"render"}, kScene),
+                        {"--yaw", "10", "--samples", "16", "-o", (dir / "still.png").string(),
+                         "--export-buffers", (dir / "still").string()}));
+    ASSERT_EQ(still.exitCode, 0) << still.err;
+    EXPECT_EQ(fileBytes(dir / "frames" / "0000.png"), fileBytes(dir / "still.png"));
+
+    // Frame 2's camera is render's at yaw 10 + 2 x 90 / 3, without jitter.
+    const auto render = runSubscan(
+        with(with({"render"}, kScene), {"--yaw", "70", "-o", (dir / "yaw70.png").string(),
+                                        "--export-buffers", (dir / "yaw70").string()}));
+    ASSERT_EQ(render.exitCode, 0) << render.err;
+    const nlohmann::json expected = nlohmann::json::parse(fileBytes(dir / "yaw70" / "camera.json"));
+    const nlohmann::json actual =
+        nlohmann::json::parse(fileBytes(dir / "buffers" / "0002" / "camera.json"));
+    for (const char* matrix : {"view", "projection"}) {
+        for (int r = 0; r < 4; ++r) {
+            for (int c = 0; c < 4; ++c) {
+                // Turning the scene about the centre instead of orbiting the eye: the same
+                // matrix up to double rounding.
+                EXPECT_NEAR(actual[matrix][r][c].get<double>(),
+                            expected[matrix][r][c].get<double>(), 1e-9)
+                    << matrix << "[" << r << "][" << c << "]";
+            }
+        }
+    }
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "buffers" / "0002" / "depth.pfm"));
+}
+
+TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
+    if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
+        GTEST_SKIP() << "ffmpeg is not installed (scripts/setup-deps.sh installs it)";
+    }
+    const test::TempDir dir;
+    const auto result = runSubscan(
+        with(with({"turntable"}, kScene), {"-o", (dir / "spin.mp4").string(), "--frames", "4"}));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const std::string video = fileBytes(dir / "spin.mp4");
+    ASSERT_GT(video.size(), 8u);
+    EXPECT_EQ(video.substr(4, 4), "ftyp");  // an ISO media file
+    // Nothing left beside it: the frames' folder and the partial file are gone.
+    int entries = 0;
+    for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+        ++entries;
+    }
+    EXPECT_EQ(entries, 1);
+}
+
+TEST(TurntableCommandGLTest, RefusesWhatItCannotDoWithOneSentence) {
+    const test::TempDir dir;
+    // No ffmpeg on PATH: an error naming the output and the package, no file.
+    const auto noFfmpeg = runSubscan(
+        with(with({"turntable"}, kScene), {"-o", (dir / "spin.mp4").string(), "--frames", "2"}),
+        {"PATH=" + dir.path().string()});
+    EXPECT_EQ(noFfmpeg.exitCode, 1);
+    EXPECT_THAT(noFfmpeg.err, HasSubstr("ffmpeg is not installed"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "spin.mp4"));
+
+    // Over its own input.
+    const std::filesystem::path scan = dir.write("scan.xyz", "0 0 0\n1 0 0\n0 1 0\n");
+    const auto overInput = runSubscan({"turntable", scan.string(), "-o", scan.string()});
+    EXPECT_EQ(overInput.exitCode, 1);
+    EXPECT_THAT(overInput.err, HasSubstr("refusing to write"));
+    EXPECT_EQ(fileBytes(scan), "0 0 0\n1 0 0\n0 1 0\n");
+
+    // --save-settings over the settings file it reads.
+    const std::filesystem::path settings = dir.write("settings.json", "{}");
+    const auto overSettings = runSubscan(
+        with(with({"render"}, kScene), {"-o", (dir / "x.png").string(), "--settings",
+                                        settings.string(), "--save-settings", settings.string()}));
+    EXPECT_EQ(overSettings.exitCode, 1);
+    EXPECT_THAT(overSettings.err, HasSubstr("refusing to write the settings"));
+    EXPECT_EQ(fileBytes(settings), "{}");
+}
+
+}  // namespace
+}  // namespace subscan
