@@ -150,21 +150,23 @@ void from_json(const nlohmann::json& json, RenderSettings& settings) {
                             key));
         }
     }
-    settings.raster = json.value("raster", nlohmann::json::object()).get<RasterSettings>();
-    settings.surface = json.value("surface", nlohmann::json::object()).get<SurfaceSettings>();
-    settings.shading = json.value("shading", nlohmann::json::object()).get<ShadingSettings>();
-    settings.scattering =
-        json.value("scattering", nlohmann::json::object()).get<ScatteringSettings>();
-    settings.temporal = json.value("temporal", nlohmann::json::object()).get<TemporalSettings>();
+    // Each section's absent keys keep what `settings` holds.
+    json.value("raster", nlohmann::json::object()).get_to(settings.raster);
+    json.value("surface", nlohmann::json::object()).get_to(settings.surface);
+    json.value("shading", nlohmann::json::object()).get_to(settings.shading);
+    json.value("scattering", nlohmann::json::object()).get_to(settings.scattering);
+    json.value("temporal", nlohmann::json::object()).get_to(settings.temporal);
 }
 
-RenderSettings readSettingsFile(const std::filesystem::path& path) {
+RenderSettings readSettingsFile(const std::filesystem::path& path, const RenderSettings& defaults) {
     std::ifstream stream(path);
     if (!stream) {
         throw Error(fmt::format("{}: cannot open the settings file", path.string()));
     }
     try {
-        return nlohmann::json::parse(stream).get<RenderSettings>();
+        RenderSettings settings = defaults;
+        nlohmann::json::parse(stream).get_to(settings);
+        return settings;
     } catch (const nlohmann::json::parse_error& error) {
         throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), error.byte));
     } catch (const Error& error) {

@@ -80,8 +80,9 @@ struct RenderSettings {
 };
 
 /// The settings file the CLI (--settings) and the viewer share; throws subscan::Error naming the
-/// file and the bad setting. Absent keys keep their defaults.
-RenderSettings readSettingsFile(const std::filesystem::path& path);
+/// file and the bad setting. Absent keys keep the values of `defaults`.
+RenderSettings readSettingsFile(const std::filesystem::path& path,
+                                const RenderSettings& defaults = {});
 void writeSettingsFile(const std::filesystem::path& path, const RenderSettings& settings);
 
 void to_json(nlohmann::json& json, const RasterSettings& settings);
@@ -108,5 +109,9 @@ bool isFinalImage(Stage stage);
 /// Whether a frame runs the temporal filter: enabled, in a mode that reconstructs, for its
 /// final picture.
 bool filtersTemporally(const RenderSettings& settings);
+/// Frames a camera at rest renders through the temporal filter before its picture counts as
+/// finished (the viewer then idles; `render` with the filter on averages this many): 32 jitter
+/// offsets put an edge pixel's coverage within 1/32 of its supersampled value.
+inline constexpr int kTemporalRestFrames = 32;
 
 }  // namespace subscan

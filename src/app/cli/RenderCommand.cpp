@@ -28,7 +28,7 @@ struct RenderOptions {
     FrameOptions frame;
     std::string output;
     std::string exportDirectory;
-    int samples = 1;
+    std::optional<int> samples;  // unset: 1, or kTemporalRestFrames with the filter on
     bool timings = false;
 };
 
@@ -64,7 +64,10 @@ int runRender(const RenderOptions& options) {
     }
     RenderSettings settings = frame.settings();
     const RasterSettings& raster = settings.raster;
-    if (options.samples > 1) {
+    // The filter on without --samples: its picture at rest, as the viewer shows it.
+    const int samples =
+        options.samples.value_or(filtersTemporally(settings) ? kTemporalRestFrames : 1);
+    if (samples > 1) {
         if (!reconstructsSurface(raster.mode) || raster.stage != Stage::Final) {
             throw Error(
                 "--samples needs the final picture of the surface or sss mode (the temporal "
@@ -72,7 +75,7 @@ int runRender(const RenderOptions& options) {
         }
         // A still camera's frames are averaged evenly up to max_frames of them.
         settings.temporal.enabled = true;
-        settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, options.samples);
+        settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, samples);
     }
     const LoadedScan scan = loadScanForCommand(frame.source);
     frame.saveSettings(settings);
@@ -83,8 +86,8 @@ int runRender(const RenderOptions& options) {
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
     if (options.timings) {
         // With --samples the frames timed are the ones averaged, so the picture stays theirs.
-        const std::vector<PassTiming> timings = medianTimings(
-            renderer, camera, settings, outputs, options.samples > 1 ? options.samples - 1 : 3);
+        const std::vector<PassTiming> timings =
+            medianTimings(renderer, camera, settings, outputs, samples > 1 ? samples - 1 : 3);
         double total = 0.0;
         for (const PassTiming& timing : timings) {
             fmt::print("{:<20} {:9.3f} ms\n", timing.pass, timing.milliseconds);
@@ -92,7 +95,7 @@ int runRender(const RenderOptions& options) {
         }
         fmt::print("{:<20} {:9.3f} ms\n", "total", total);
     } else {
-        for (int frame = 0; frame < options.samples; ++frame) {
+        for (int index = 0; index < samples; ++index) {
             renderer.render(camera, settings, outputs);
         }
     }
@@ -116,7 +119,8 @@ Command addRenderCommand(CLI::App& parent) {
     render
         ->add_option("--samples", options->samples,
                      "Anti-alias the surface: the mean of this many frames through sub-pixel "
-                     "jittered cameras (the temporal filter, still camera)")
+                     "jittered cameras (the temporal filter at rest; default 1, or 32 when the "
+                     "settings turn the filter on)")
         ->check(CLI::Range(1, 2048));
     render->add_flag("--timings", options->timings, "Print per-pass milliseconds");
     return {render, [options] { return runRender(*options); }};

@@ -52,7 +52,7 @@ viewer::ViewerOptions checkedOptions(const ViewCommandOptions& command) {
         options.up = command.up == "z" ? UpAxis::Z : UpAxis::Y;
     }
     if (!command.settingsFile.empty()) {
-        options.settings = readSettingsFile(command.settingsFile);
+        options.settings = readSettingsFile(command.settingsFile, viewer::viewerDefaultSettings());
     }
     if (!command.mode.empty()) {
         options.settings.raster.mode = parseRenderMode(command.mode);

@@ -73,6 +73,12 @@ WindowOptions windowOptions(const ViewerOptions& options) {
 
 }  // namespace
 
+RenderSettings viewerDefaultSettings() {
+    RenderSettings settings;
+    settings.temporal.enabled = true;
+    return settings;
+}
+
 Viewer::Viewer(ViewerOptions options)
     : options_(std::move(options)),
       unattended_(!options_.script.empty() || options_.exitAfterFrames.has_value()),
@@ -504,9 +510,12 @@ bool Viewer::frameIsStale() const {
     if (!renderer_ || size.x < 1 || size.y < 1) {
         return false;
     }
-    return redrawEveryFrame_ || !renderedCamera_ ||
-           !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
-           nlohmann::json(appliedSettings()).dump() != renderedSettings_;
+    const RenderSettings settings = appliedSettings();
+    const bool changed = !renderedCamera_ ||
+                         !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
+                         nlohmann::json(settings).dump() != renderedSettings_;
+    return redrawEveryFrame_ || changed ||
+           (filtersTemporally(settings) && framesAtRest_ + 1 < kTemporalRestFrames);
 }
 
 void Viewer::renderIfNeeded() {
@@ -517,9 +526,13 @@ void Viewer::renderIfNeeded() {
     const glm::ivec2 size = viewportSize();
     const Camera camera = camera_.camera(size.x, size.y);
     const RenderSettings settings = appliedSettings();
+    const std::string settingsJson = nlohmann::json(settings).dump();
+    const bool atRest = renderedCamera_ && sameCamera(*renderedCamera_, camera) &&
+                        settingsJson == renderedSettings_;
+    framesAtRest_ = atRest ? framesAtRest_ + 1 : 0;
     // Recorded before rendering: a frame that fails is not retried until something changes.
     renderedCamera_ = camera;
-    renderedSettings_ = nlohmann::json(settings).dump();
+    renderedSettings_ = settingsJson;
     renderedMode_ = settings.raster.mode;
     renderedImage_ = false;
     try {

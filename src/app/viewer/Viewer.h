@@ -25,11 +25,15 @@ class Renderer;
 
 namespace subscan::viewer {
 
+/// The viewer's defaults: RenderSettings' own with the temporal filter on, so orbiting is steady
+/// and a camera at rest refines to an anti-aliased picture.
+RenderSettings viewerDefaultSettings();
+
 struct ViewerOptions {
     std::string source;  // a scan file or synthetic:NAME
     int width = 1280;    // window size
     int height = 800;
-    RenderSettings settings;
+    RenderSettings settings = viewerDefaultSettings();
     std::optional<UpAxis> up;  // default: Z for LAS, Y otherwise
     std::vector<ScriptAction> script;
     std::filesystem::path screenshotAtExit;  // empty: none
@@ -40,7 +44,8 @@ struct ViewerOptions {
 /// `subscan view`: a window showing the frame pipeline's image of a scan, live, with a camera
 /// driven by mouse and keys (ViewerCamera), the ImGui panel (ViewerPanel) over it, scans loaded
 /// off the render thread (ScanLoadJob) and scripted input for unattended runs (ViewerScript).
-/// The pipeline renders only when the camera, the settings or the window size changed.
+/// The pipeline renders only when the camera, the settings or the window size changed, or while
+/// the temporal filter refines a camera at rest.
 class Viewer {
   public:
     /// Opens the window; throws subscan::Error when there is no display or no OpenGL 4.5.
@@ -147,6 +152,7 @@ class Viewer {
     // The last pipeline frame: what it showed (to skip identical frames) and whether it worked.
     std::optional<Camera> renderedCamera_;
     std::string renderedSettings_;
+    int framesAtRest_ = 0;  // frames rendered since the camera and the settings last changed
     RenderMode renderedMode_ = RenderMode::Points;
     bool renderedImage_ = false;
 

@@ -312,6 +312,16 @@ void ViewerPanel::drawView(RenderSettings& settings, Navigation& navigation,
             "Pixels the surface is reconstructed at before scaling to the window. half: "
             "about half the frame time, a pixel of the silhouette lost; auto: half while the "
             "points are 4 or more pixels apart (close-ups of sparse scans).");
+        TemporalSettings& temporal = settings.temporal;
+        ImGui::Checkbox("temporal filter", &temporal.enabled);
+        helpTooltip(
+            "Blend each frame into the last, reprojected: steadier while moving; at rest the "
+            "camera is jittered by sub-pixel offsets and the frames averaged into an "
+            "anti-aliased picture.");
+        if (temporal.enabled) {
+            ImGui::SliderFloat("new frame weight", &temporal.newFrameWeight, 0.01f, 1.0f, "%.2f");
+            helpTooltip("While moving: lower is steadier, higher follows changes sooner.");
+        }
     }
     if (raster.stage == Stage::Pyramid || raster.stage == Stage::Pull) {
         ImGui::SliderInt("stage level", &raster.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
