@@ -10,8 +10,13 @@
 //   moving   the history fetched where the pixel's surface was in the previous frame; taps that
 //            saw another surface there are dropped (disocclusion), and what is left is clipped
 //            to the new frame's neighbourhood (variance clipping in YCoCg) before the blend
-//   STAGE_FILTER   writes the result and its state
-//   STAGE_PICTURE  also the sRGB picture (Present's work, at full resolution)
+// Each of the three is its own variant (STAGE_RESTART, STAGE_STILL, STAGE_MOVING): llvmpipe
+// runs both sides of a branch, so one shader would make a still frame pay for the moving one's
+// neighbourhood. The *_PICTURE variants also write the sRGB picture (Present's work, at full
+// resolution).
+#define MODE_STILL (STAGE_STILL || STAGE_STILL_PICTURE)
+#define MODE_MOVING (STAGE_MOVING || STAGE_MOVING_PICTURE)
+#define WRITE_PICTURE (STAGE_RESTART_PICTURE || STAGE_STILL_PICTURE || STAGE_MOVING_PICTURE)
 #include "shared/common.glsl"
 #include "shared/region.glsl"
 
@@ -25,7 +30,7 @@ layout(binding = SUBSCAN_IMAGE_IN2, rgba16f) readonly uniform image2D inHistory;
 layout(binding = SUBSCAN_IMAGE_IN3, rg32f) readonly uniform image2D inHistoryState;
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outHistory;
 layout(binding = SUBSCAN_IMAGE_OUT1, rg32f) writeonly uniform image2D outHistoryState;
-#if STAGE_PICTURE
+#if WRITE_PICTURE
 layout(binding = SUBSCAN_IMAGE_OUT2, rgba8) writeonly uniform image2D outImage;
 #endif
 
@@ -36,9 +41,10 @@ vec3 toYCoCg(vec3 c) {
 
 vec3 fromYCoCg(vec3 c) { return vec3(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z); }
 
-/// This frame at `texel`: colour over the background and coverage (1 on the surface).
-vec4 frameSample(ivec2 texel) {
-    if (isinf(imageLoad(inDepth, texel).r)) {
+/// This frame at a texel of depth `depth`: colour over the background and coverage (1 on the
+/// surface).
+vec4 frameSample(ivec2 texel, float depth) {
+    if (isinf(depth)) {
         return vec4(frame.background.rgb, 0.0);
     }
     return vec4(imageLoad(inRadiance, texel).rgb, 1.0);
@@ -58,20 +64,23 @@ void main() {
     if (any(greaterThanEqual(pixel, size)) || !insideRegion(pixel)) {
         return;
     }
-    vec4 current = frameSample(pixel);
     float depth = imageLoad(inDepth, pixel).r;
+    vec4 current = frameSample(pixel, depth);
     vec4 result = current;
     float count = 1.0;
 
-    if (temporal.mode.x == SUBSCAN_TEMPORAL_STILL) {
+#if MODE_STILL
+    {
         // Nothing moved: the pixel's own history, an even mean over the jitter pattern. A
         // history built while moving (resampled, clipped) counts as one frame, so that what
         // the motion left fades as 1/n once the camera stops.
         vec4 history = imageLoad(inHistory, pixel);
-        float frames = temporal.mode.y == 1u ? 1.0 : imageLoad(inHistoryState, pixel).g;
+        float frames = temporal.flags.x == 1u ? 1.0 : imageLoad(inHistoryState, pixel).g;
         count = min(frames + 1.0, temporal.blend.z);
         result = history + (current - history) / count;
-    } else if (temporal.mode.x == SUBSCAN_TEMPORAL_MOVING) {
+    }
+#elif MODE_MOVING
+    {
         // The neighbourhood: its statistics in YCoCg + coverage, and its nearest surface,
         // whose motion stands for the pixel's (silhouettes move with the object in front).
         vec4 sum = vec4(0.0), squares = vec4(0.0);
@@ -80,11 +89,11 @@ void main() {
         for (int dy = -1; dy <= 1; ++dy) {
             for (int dx = -1; dx <= 1; ++dx) {
                 ivec2 texel = clamp(pixel + ivec2(dx, dy), ivec2(0), size - 1);
-                vec4 value = frameSample(texel);
+                float d = dx == 0 && dy == 0 ? depth : imageLoad(inDepth, texel).r;
+                vec4 value = dx == 0 && dy == 0 ? current : frameSample(texel, d);
                 value.rgb = toYCoCg(value.rgb);
                 sum += value;
                 squares += value * value;
-                float d = imageLoad(inDepth, texel).r;
                 if (d < nearest) {
                     nearest = d;
                     nearestTexel = texel;
@@ -141,9 +150,10 @@ void main() {
             result = mix(history, current, max(1.0 / count, temporal.blend.x));
         }
     }
+#endif
     imageStore(outHistory, pixel, result);
     imageStore(outHistoryState, pixel, vec4(depth, count, 0.0, 0.0));
-#if STAGE_PICTURE
+#if WRITE_PICTURE
     imageStore(outImage, pixel, vec4(linearToSrgb(result.rgb), 1.0));
 #endif
 }

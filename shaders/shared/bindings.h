@@ -169,12 +169,9 @@ struct TemporalParams {
     vec4 blend;  // x: least weight of the new frame while the camera moves, y: clip sigma,
                  // z: most frames a still camera averages, w: unused
     vec4 depth;  // x: depth difference (scene units) beyond which the history saw another surface
-    uvec4 mode;  // x: SUBSCAN_TEMPORAL_RESTART, _STILL or _MOVING; y: 1 when the history was
-                 // reprojected last frame (a still camera then weighs it as one frame)
+    uvec4 flags;  // x: 1 when the history was reprojected last frame (a still camera then
+                  // weighs it as one frame)
 };
-#define SUBSCAN_TEMPORAL_RESTART 0u  // no usable history: the frame alone
-#define SUBSCAN_TEMPORAL_STILL 1u    // the same camera: an even mean of the frames, no clipping
-#define SUBSCAN_TEMPORAL_MOVING 2u   // reprojection, disocclusion and clipping
 
 #ifdef __cplusplus
 static_assert(sizeof(TemporalParams) == 2 * 64 + 3 * 16);

@@ -47,7 +47,9 @@ glm::dvec2 haltonJitter(unsigned index) {
 }
 
 TemporalPass::TemporalPass(const ShaderSources& sources)
-    : stages_(sources, "render/Temporal.comp", {"FILTER", "PICTURE"}) {}
+    : stages_(
+          sources, "render/Temporal.comp",
+          {"RESTART", "STILL", "MOVING", "RESTART_PICTURE", "STILL_PICTURE", "MOVING_PICTURE"}) {}
 
 std::vector<std::string_view> TemporalPass::outputs() const {
     if (writesPicture_) {
@@ -85,10 +87,10 @@ void TemporalPass::execute(FrameContext& frame) {
                            previous_->divisor == frame.divisor &&
                            previous_->camera.width == width && previous_->camera.height == height;
     gpu::TemporalParams params{};
-    params.mode.x = !continues                            ? SUBSCAN_TEMPORAL_RESTART
-                    : sameView(previous_->camera, camera) ? SUBSCAN_TEMPORAL_STILL
-                                                          : SUBSCAN_TEMPORAL_MOVING;
-    params.mode.y = previous_ && previous_->moved ? 1u : 0u;
+    const Mode mode = !continues                            ? Mode::Restart
+                      : sameView(previous_->camera, camera) ? Mode::Still
+                                                            : Mode::Moving;
+    params.flags.x = previous_ && previous_->moved ? 1u : 0u;
     if (continues) {
         params.previousFromView = glm::mat4(previous_->camera.view * glm::inverse(camera.view));
         params.previousProjection = glm::mat4(previous_->camera.projection());
@@ -125,11 +127,10 @@ void TemporalPass::execute(FrameContext& frame) {
     resources.texture("previousHistoryState").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
     history.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     state.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    stages_.runOverRegion(writesPicture_ ? 1 : 0, region);
+    stages_.runOverRegion(static_cast<std::size_t>(mode) + (writesPicture_ ? 3 : 0), region);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
-    previous_ = PreviousFrame{camera, frame.settings, frame.divisor,
-                              params.mode.x == SUBSCAN_TEMPORAL_MOVING};
+    previous_ = PreviousFrame{camera, frame.settings, frame.divisor, mode == Mode::Moving};
 }
 
 }  // namespace subscan

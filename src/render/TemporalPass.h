@@ -61,7 +61,11 @@ class TemporalPass final : public RenderPass {
 
     std::string colorInput_ = "radiance";
     bool writesPicture_ = true;
-    ComputeStages stages_;  // FILTER: history alone; PICTURE: and the encoded picture
+    /// The frame alone, the even mean of a still camera, or the reprojected blend of a moving
+    /// one (Temporal.comp's variants in this order, then the same writing the picture).
+    enum class Mode { Restart, Still, Moving };
+
+    ComputeStages stages_;
     UniformBlock<gpu::TemporalParams> params_{"Temporal.params"};
     std::optional<PreviousFrame> previous_;
     unsigned frameIndex_ = 0;
