@@ -5,13 +5,17 @@
 //                  "depth" image (viewed as r32ui; cleared to +inf, whose bits are the largest)
 //   STAGE_INDEX    one thread per point: among points at the winning depth, atomicMin of index
 //   STAGE_INT64    one thread per point: one 64-bit atomicMin of depthBits << 32 | index
+//   STAGE_BLEND    one thread per point: a point within the relative depth raster.colorBlend
+//                  of its pixel's nearest adds its linear colour (fixed point) and 1 to the
+//                  pixel's sums (Schuetz et al. 2021's high-quality shading)
 //   STAGE_RESOLVE  one thread per pixel of the cloud's projected bounding box: the winner's
-//                  linear colour (and with USE_INT64 its depth) into images cleared before
+//                  linear colour, or with USE_BLEND the mean of the sums (and with USE_INT64
+//                  the winner's depth) into images cleared before
 // Positive IEEE floats order like their bit patterns, so depth bits compare as uints. Points
 // are read as buffer textures and the 32-bit path keeps its per-pixel words in images rather
 // than storage buffers: on llvmpipe a texel fetch or image load is a vector gather, a storage
 // buffer load one guarded scalar load per lane.
-#if STAGE_INT64 || (STAGE_RESOLVE && USE_INT64)
+#if STAGE_INT64 || ((STAGE_RESOLVE || STAGE_BLEND) && USE_INT64)
 #extension GL_ARB_gpu_shader_int64 : require
 #extension GL_NV_shader_atomic_int64 : require
 #endif
@@ -28,12 +32,19 @@ layout(binding = SUBSCAN_IMAGE_OUT0, r32ui) uniform uimage2D depthBits;
 #elif STAGE_INDEX
 layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D depthBits;
 layout(binding = SUBSCAN_IMAGE_OUT2, r32ui) uniform uimage2D pointIndex;
+#elif STAGE_BLEND && !USE_INT64
+layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D depthBits;
 #elif STAGE_RESOLVE && !USE_INT64
 layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D pointIndex;
 #endif
-#if STAGE_INT64 || (STAGE_RESOLVE && USE_INT64)
+#if STAGE_INT64 || ((STAGE_RESOLVE || STAGE_BLEND) && USE_INT64)
 layout(std430, binding = SUBSCAN_SSBO_DEPTH_INDEX) buffer DepthIndex {
     uint64_t depthIndex[];
+};
+#endif
+#if STAGE_BLEND || (STAGE_RESOLVE && USE_BLEND)
+layout(std430, binding = SUBSCAN_SSBO_COLOR_SUMS) buffer ColorSums {
+    uvec4 colorSums[];
 };
 #endif
 
@@ -62,8 +73,14 @@ void main() {
 #if USE_INT64
     imageStore(outDepth, pixel, vec4(uintBitsToFloat(uint(key >> 32))));
 #endif
-    imageStore(outColor, pixel,
-               vec4(unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r), 1.0));
+#if USE_BLEND
+    // The winner is among the points summed: the count is at least 1.
+    uvec4 sums = colorSums[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)];
+    vec3 color = vec3(sums.rgb) / (float(sums.a) * SUBSCAN_COLOR_SUM_SCALE);
+#else
+    vec3 color = unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r);
+#endif
+    imageStore(outColor, pixel, vec4(color, 1.0));
 }
 
 #else
@@ -99,6 +116,21 @@ void main() {
 #elif STAGE_INT64
     uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
     atomicMin(depthIndex[linear], (uint64_t(bits) << 32) | uint64_t(index));
+#elif STAGE_BLEND
+    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
+#if USE_INT64
+    float nearest = uintBitsToFloat(uint(depthIndex[linear] >> 32));
+#else
+    float nearest = uintBitsToFloat(imageLoad(depthBits, pixel).r);
+#endif
+    if (depth <= nearest * (1.0 + raster.colorBlend)) {
+        uvec3 fixedPoint =
+            uvec3(round(unpackColor(texelFetch(colors, int(local)).r) * SUBSCAN_COLOR_SUM_SCALE));
+        atomicAdd(colorSums[linear].r, fixedPoint.r);
+        atomicAdd(colorSums[linear].g, fixedPoint.g);
+        atomicAdd(colorSums[linear].b, fixedPoint.b);
+        atomicAdd(colorSums[linear].a, 1u);
+    }
 #endif
 }
 #endif

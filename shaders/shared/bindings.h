@@ -39,6 +39,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_NORMALS 9        // vec4 per texel, levels >= 1: view-space normal, w unused
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 #define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
+#define SUBSCAN_SSBO_COLOR_SUMS 12    // uvec4 per pixel: fixed-point linear RGB sums, point count
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
@@ -92,11 +93,14 @@ struct FrameParams {
 
 // RasterizePoints: which slice of the cloud this dispatch covers.
 struct RasterParams {
-    uint firstPoint;  // global index of the chunk's first point
-    uint pointCount;  // points in this chunk
-    uint pixelCount;  // width * height
-    uint unused0;
+    uint firstPoint;   // global index of the chunk's first point
+    uint pointCount;   // points in this chunk
+    uint pixelCount;   // width * height
+    float colorBlend;  // points within this relative depth of a pixel's nearest share its colour
 };
+// Fixed-point units per 1.0 of linear colour in SUBSCAN_SSBO_COLOR_SUMS: 2^32 / 1024 = 4 M
+// white points per pixel before a sum overflows.
+#define SUBSCAN_COLOR_SUM_SCALE 1024.0
 
 // DrawPoints (GL_POINTS baselines).
 struct DrawParams {

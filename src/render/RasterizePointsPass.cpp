@@ -10,31 +10,44 @@ namespace subscan {
 
 namespace {
 
-std::string stageDefines(bool depth, bool index, bool int64, bool resolve, bool useInt64) {
+enum class RasterStage { Depth, Index, Int64, Blend, Resolve };
+
+std::string stageDefines(RasterStage stage, bool useInt64, bool useBlend = false) {
     return fmt::format(
         "#define STAGE_DEPTH {}\n#define STAGE_INDEX {}\n#define STAGE_INT64 {}\n"
-        "#define STAGE_RESOLVE {}\n#define USE_INT64 {}\n",
-        int(depth), int(index), int(int64), int(resolve), int(useInt64));
+        "#define STAGE_BLEND {}\n#define STAGE_RESOLVE {}\n#define USE_INT64 {}\n"
+        "#define USE_BLEND {}\n",
+        int(stage == RasterStage::Depth), int(stage == RasterStage::Index),
+        int(stage == RasterStage::Int64), int(stage == RasterStage::Blend),
+        int(stage == RasterStage::Resolve), int(useInt64), int(useBlend));
 }
+
+constexpr std::string_view kShader = "render/RasterizePoints.comp";
 
 constexpr std::uint32_t kEmptyIndex = 0xFFFFFFFFu;
 
 }  // namespace
 
 RasterizePointsPass::RasterizePointsPass(const ShaderSources& sources,
-                                         const GlCapabilities& capabilities) {
-    constexpr std::string_view kShader = "render/RasterizePoints.comp";
-    depthStage_ =
-        Program::compute(sources, kShader, stageDefines(true, false, false, false, false));
-    indexStage_ =
-        Program::compute(sources, kShader, stageDefines(false, true, false, false, false));
-    resolve32_ = Program::compute(sources, kShader, stageDefines(false, false, false, true, false));
+                                         const GlCapabilities& capabilities)
+    : sources_(sources) {
+    depthStage_ = Program::compute(sources, kShader, stageDefines(RasterStage::Depth, false));
+    indexStage_ = Program::compute(sources, kShader, stageDefines(RasterStage::Index, false));
+    resolve32_ = Program::compute(sources, kShader, stageDefines(RasterStage::Resolve, false));
     if (capabilities.int64Atomics) {
-        int64Stage_ =
-            Program::compute(sources, kShader, stageDefines(false, false, true, false, true));
-        resolve64_ =
-            Program::compute(sources, kShader, stageDefines(false, false, false, true, true));
+        int64Stage_ = Program::compute(sources, kShader, stageDefines(RasterStage::Int64, true));
+        resolve64_ = Program::compute(sources, kShader, stageDefines(RasterStage::Resolve, true));
     }
+}
+
+const RasterizePointsPass::BlendPrograms& RasterizePointsPass::blendPrograms(bool int64) {
+    std::optional<BlendPrograms>& programs = int64 ? blend64_ : blend32_;
+    if (!programs) {
+        programs.emplace(BlendPrograms{
+            Program::compute(sources_, kShader, stageDefines(RasterStage::Blend, int64)),
+            Program::compute(sources_, kShader, stageDefines(RasterStage::Resolve, int64, true))});
+    }
+    return *programs;
 }
 
 RasterPath RasterizePointsPass::resolvePath(RasterPath requested,
@@ -60,7 +73,8 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
     const std::size_t pixels = static_cast<std::size_t>(frame.camera.width) *
                                static_cast<std::size_t>(frame.camera.height);
     for (const GpuPointCloud::Chunk& chunk : frame.cloud.chunks()) {
-        params_.set({chunk.firstPoint, chunk.pointCount, static_cast<std::uint32_t>(pixels), 0});
+        params_.set({chunk.firstPoint, chunk.pointCount, static_cast<std::uint32_t>(pixels),
+                     frame.settings.raster.colorBlend});
         params_.bind(SUBSCAN_UBO_PASS);
         chunk.positions.bindTexels(SUBSCAN_TEXELS_POSITIONS, TextureFormat::R32F);
         chunk.colors.bindTexels(SUBSCAN_TEXELS_COLORS, TextureFormat::R32UI);
@@ -121,8 +135,29 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         pointIndex.bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     }
+    const bool blend = frame.settings.raster.colorBlend > 0.0f;
+    if (blend) {
+        // Every point near its pixel's nearest adds to the pixel's sums; the resolve divides.
+        const std::size_t pixels =
+            static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+        Buffer& sums =
+            frame.resources.ensureBuffer("colorSums", pixels * 4 * sizeof(std::uint32_t));
+        sums.fill(0u);
+        sums.bindStorage(SUBSCAN_SSBO_COLOR_SUMS);
+        if (!int64) {
+            depth.bindImageBits(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+        }
+        runPerChunk(blendPrograms(int64).sums, frame, false);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        if (!int64) {
+            frame.resources.texture("pointIndex").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+        }
+    }
     color.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    runPerChunk(int64 ? resolve64_ : resolve32_, frame, true);
+    runPerChunk(blend   ? blendPrograms(int64).resolve
+                : int64 ? resolve64_
+                        : resolve32_,
+                frame, true);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

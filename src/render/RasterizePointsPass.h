@@ -1,5 +1,7 @@
 #pragma once
 
+#include <optional>
+
 #include "gpu/GlObjects.h"
 #include "gpu/ShaderSources.h"
 #include "render/RenderPass.h"
@@ -11,6 +13,8 @@ namespace subscan {
 /// ties to the smaller index. Writes "depth" (R32F linear depth, +inf where empty) and "color"
 /// (RGBA16F linear). One 64-bit atomicMin pass where the driver has 64-bit atomics, else two
 /// 32-bit passes (depth, then index among points at that depth); both give the same winner.
+/// With RasterSettings::colorBlend > 0 the colour is instead the mean of the points within that
+/// relative depth of the winner (Schuetz et al. 2021): a sum pass after the depth is known.
 /// Its per-pixel words live in the frame's resources ("depthIndex" or "pointIndex"), so one
 /// pass serves views of any size (the camera's, the lights').
 class RasterizePointsPass final : public RenderPass {
@@ -32,7 +36,18 @@ class RasterizePointsPass final : public RenderPass {
     std::vector<std::uint32_t> readWinners(const FrameResources& resources) const;
 
   private:
+    /// The colour-blending stages, compiled on first use.
+    struct BlendPrograms {
+        Program sums;
+        Program resolve;
+    };
+
     void runPerChunk(const Program& program, FrameContext& frame, bool perPixel);
+    const BlendPrograms& blendPrograms(bool int64);
+
+    const ShaderSources& sources_;
+    std::optional<BlendPrograms> blend32_;
+    std::optional<BlendPrograms> blend64_;
 
     Program depthStage_;
     Program indexStage_;

@@ -93,13 +93,14 @@ void to_json(nlohmann::json& json, const RasterSettings& settings) {
         {"stage", toString(settings.stage)},
         {"stage_level", settings.stageLevel},
         {"resolution", toString(settings.resolution)},
+        {"color_blend", settings.colorBlend},
     };
 }
 
 void from_json(const nlohmann::json& json, RasterSettings& settings) {
     rejectUnknownKeys(json, "raster",
                       {"mode", "raster_path", "point_size", "background_srgb", "timing", "stage",
-                       "stage_level", "resolution"});
+                       "stage_level", "resolution", "color_blend"});
     readEnum(json, "mode", settings.mode, kModes, "render mode");
     readEnum(json, "raster_path", settings.path, kPaths, "raster path");
     readSetting(json, "point_size", settings.pointSize, 1.0f, 64.0f);
@@ -108,6 +109,7 @@ void from_json(const nlohmann::json& json, RasterSettings& settings) {
     readEnum(json, "stage", settings.stage, kStages, "stage");
     readSetting(json, "stage_level", settings.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
     readEnum(json, "resolution", settings.resolution, kResolutions, "resolution");
+    readSetting(json, "color_blend", settings.colorBlend, 0.0f, 1.0f);
 }
 
 void to_json(nlohmann::json& json, const TemporalSettings& settings) {

@@ -48,6 +48,10 @@ struct RasterSettings {
     Stage stage = Stage::Final;
     int stageLevel = 3;  // the pyramid level the pyramid and pull stages show
     Resolution resolution = Resolution::Full;
+    // > 0: a pixel's colour is the mean of its points within this relative depth of the
+    // nearest (Schuetz et al. 2021), so it no longer depends on which of them wins; 0: the
+    // nearest point's colour.
+    float colorBlend = 0.0f;
 
     bool operator==(const RasterSettings&) const = default;
 };

@@ -121,7 +121,8 @@ PointCloud testCloud(const Camera& camera, std::uint32_t seed) {
 /// how many pixels hold a point.
 std::size_t expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
                                    const Reference& reference) {
-    const std::vector<std::uint32_t> winners = renderer.rasterizePass()->readWinners(renderer.resources());
+    const std::vector<std::uint32_t> winners =
+        renderer.rasterizePass()->readWinners(renderer.resources());
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
     const std::vector<float> color = renderer.resources().texture("color").readFloats();
     std::size_t covered = 0;
@@ -176,6 +177,60 @@ TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
                       reference.winner.size() / 2);
         }
     }
+}
+
+TEST(RasterizePointsGLTest, ColorBlendAveragesThePointsNearTheNearest) {
+    // Per pixel: the mean linear colour of the points whose depth is within 2 % of the
+    // nearest's (the test cloud's depths lie 1.5 mm apart from 1 m on, so several share a
+    // pixel's band and none sits within float rounding of its edge), the depth unchanged.
+    GlContext& context = test::glTestContext();
+    const Camera camera = smallCamera();
+    const PointCloud cloud = testCloud(camera, 2);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+    constexpr float kBlend = 0.02f;
+    const std::size_t pixels = reference.winner.size();
+    std::vector<glm::dvec3> sums(pixels, glm::dvec3(0.0));
+    std::vector<int> counts(pixels, 0);
+    const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
+    const glm::dmat4 projection = camera.projection();
+    for (std::uint32_t i = 0; i < cloud.size(); ++i) {
+        const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(cloud.positions[i]), 1.0);
+        const glm::dvec4 clip = projection * view;
+        const double x = std::floor((clip.x / clip.w + 1.0) * 0.5 * camera.width);
+        const double y = std::floor((1.0 - clip.y / clip.w) * 0.5 * camera.height);
+        if (-view.z < camera.nearPlane || -view.z > camera.farPlane || x < 0 || y < 0 ||
+            x >= camera.width || y >= camera.height) {
+            continue;
+        }
+        const std::size_t pixel =
+            static_cast<std::size_t>(y) * camera.width + static_cast<std::size_t>(x);
+        if (-view.z <= reference.depth[pixel] * (1.0 + kBlend)) {
+            sums[pixel] += glm::dvec3(linearColor(cloud.colors[i]));
+            ++counts[pixel];
+        }
+    }
+
+    Renderer renderer(context, cloud);
+    RenderSettings settings;
+    settings.raster.colorBlend = kBlend;
+    renderer.render(camera, settings);
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
+    int blended = 0;
+    for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+        if (counts[pixel] == 0) {
+            EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+            continue;
+        }
+        blended += counts[pixel] > 1 ? 1 : 0;
+        EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel]);
+        for (int c = 0; c < 3; ++c) {
+            // Fixed point of 1/1024 per point, then RGBA16F's 11 significant bits.
+            EXPECT_NEAR(color[4 * pixel + c], sums[pixel][c] / counts[pixel], 2e-3)
+                << "pixel " << pixel << " of " << counts[pixel] << " points";
+        }
+    }
+    EXPECT_GT(blended, 20) << "the test should blend pixels of several points";
 }
 
 TEST(RasterizePointsGLTest, AFarFrameAfterACloseOneKeepsNothingOfIt) {

@@ -330,6 +330,14 @@ void ViewerPanel::drawView(RenderSettings& settings, Navigation& navigation,
         ImGui::SliderFloat("point size (px)", &raster.pointSize, 1.0f, 32.0f, "%.1f");
     }
     if (raster.mode != RenderMode::PointsGl && raster.mode != RenderMode::Splats) {
+        float blendPercent = 100.0f * raster.colorBlend;
+        if (ImGui::SliderFloat("colour blend (depth %)", &blendPercent, 0.0f, 5.0f, "%.1f")) {
+            raster.colorBlend = blendPercent / 100.0f;
+        }
+        helpTooltip(
+            "0: a pixel shows its nearest point's colour. Above 0: the mean colour of its points "
+            "within that share of the nearest's depth, so colours stop flickering as points "
+            "trade places.");
         choiceCombo<RasterPath>("rasterizer", raster.path, kRasterPaths,
                                 [](RasterPath path) { return toString(path); });
         helpTooltip(status.int64Atomics

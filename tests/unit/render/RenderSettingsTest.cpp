@@ -20,7 +20,9 @@ TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
     settings.backgroundSrgb = {0.1f, 0.2f, 0.3f};
     settings.timing = TimingMode::FinishAndClock;
     settings.resolution = Resolution::Half;
+    settings.colorBlend = 0.01f;
     const RasterSettings back = nlohmann::json(settings).get<RasterSettings>();
+    EXPECT_EQ(back, settings);
     EXPECT_EQ(back.mode, settings.mode);
     EXPECT_EQ(back.path, settings.path);
     EXPECT_EQ(back.pointSize, settings.pointSize);
