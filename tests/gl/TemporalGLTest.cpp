@@ -432,9 +432,10 @@ TEST(TemporalGLTest, AFastMoveLeavesNoGhostOnceTheCameraStops) {
     EXPECT_GT(poses, 10.0) << "the two poses should look different";
     // The moving frames' clipping already removes most of the old pose...
     EXPECT_LT(justArrived, 0.1 * poses) << "before the stop: " << poses;
-    // ...and 8 still frames leave 1/9 of what the motion left, plus the difference between
-    // 8 and 32 jitter offsets at the silhouette: within 1 level of 255 on average.
-    EXPECT_LT(settled, 1.0) << "just arrived: " << justArrived;
+    // ...and 8 still frames leave 1/9 of what the motion left (~0.13 of a level here), plus
+    // the difference between 8 and 32 jitter offsets at the silhouette (~0.2): within half a
+    // level of 255 on average. Weighing the motion's history as all its frames leaves ~0.75.
+    EXPECT_LT(settled, 0.5) << "just arrived: " << justArrived;
 }
 
 }  // namespace
