@@ -5,27 +5,29 @@
 // from the pyramids those passes leave above level 0. Pass by pass, the same work writes and
 // reads back six full-screen images; here it writes the picture and "surfaceDepth". Each step
 // is the function its pass runs, so the two differ only where that chain rounds its images to
-// half floats.
-//   STAGE_HEAD_LIGHT  the head light alone (no directional lights)
-//   STAGE_LIGHTS      the head light and the directional lights
-//   STAGE_*_RADIANCE  the same, writing linear radiance for the temporal filter (no encoding)
-#if defined(STAGE_LIGHTS) || defined(STAGE_LIGHTS_RADIANCE)
-#define SHADE_DIRECTIONAL_LIGHTS 1
-#else
-#define SHADE_DIRECTIONAL_LIGHTS 0
-#endif
-#if defined(STAGE_HEAD_LIGHT_RADIANCE) || defined(STAGE_LIGHTS_RADIANCE)
-#define WRITE_RADIANCE 1
-#else
-#define WRITE_RADIANCE 0
-#endif
+// half floats. Defined by FinishSurfacePass:
+//   SHADE_DIRECTIONAL_LIGHTS  0: the head light alone; 1: and the directional lights
+//   FINISH_OUTPUT             FINISH_PICTURE: the picture; FINISH_RADIANCE: linear radiance
+//                             for a temporal filter pass after it (a moving camera, whose
+//                             blend needs the neighbourhood); FINISH_RESTART, FINISH_STILL: the
+//                             temporal filter's blend too (render/Temporal.glsl), saving its
+//                             pass (on llvmpipe a pass over the image costs ~5 ms before it
+//                             does anything)
+#define FINISH_PICTURE 0
+#define FINISH_RADIANCE 1
+#define FINISH_RESTART 2
+#define FINISH_STILL 3
+#define FINISH_TEMPORAL (FINISH_OUTPUT >= FINISH_RESTART)
 #include "render/FillRemoval.glsl"
 #include "render/Normals.glsl"
 #include "render/Shade.glsl"
 #include "shared/region.glsl"
+#if FINISH_TEMPORAL
+#include "render/Temporal.glsl"
+#endif
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
-#if WRITE_RADIANCE
+#if FINISH_OUTPUT == FINISH_RADIANCE
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outRadiance;
 #else
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
@@ -37,20 +39,30 @@ void main() {
     if (!insideLevel(0u, pixel) || !insideRegion(pixel)) {
         return;
     }
-    vec4 filled = pushedValue(0u, pixel);
-    bool surfacePixel = onSurface(pixel, filled.x);
     vec3 color = frame.background.rgb;
-    if (surfacePixel) {
+    float depth = kInfinity;
+    vec4 filled = pushedValue(0u, pixel);
+    if (onSurface(pixel, filled.x)) {
         vec3 diffuse;
         vec3 specular;
         shadePixel(pixel, filled.x, blendedNormal(pixel, filled.x), clamp(filled.yzw, 0.0, 1.0),
                    diffuse, specular);
         color = diffuse + specular;
+        depth = filled.x;
     }
-#if WRITE_RADIANCE
+    imageStore(outSurfaceDepth, pixel, vec4(depth));
+#if FINISH_OUTPUT == FINISH_RADIANCE
     imageStore(outRadiance, pixel, vec4(color, 1.0));
-#else
+#elif FINISH_OUTPUT == FINISH_PICTURE
     imageStore(outImage, pixel, vec4(linearToSrgb(color), 1.0));
+#else
+    vec4 current = frameSample(color, depth);
+    vec4 result = current;
+    float count = 1.0;
+#if FINISH_OUTPUT == FINISH_STILL
+    result = blendStill(pixel, current, count);
 #endif
-    imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? filled.x : kInfinity));
+    storeHistory(pixel, result, depth, count);
+    imageStore(outImage, pixel, vec4(linearToSrgb(result.rgb), 1.0));
+#endif
 }

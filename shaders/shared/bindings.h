@@ -23,6 +23,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UBO_PYRAMID 2
 #define SUBSCAN_UBO_SURFACE 3
 #define SUBSCAN_UBO_LIGHTS 4  // ShadeParams for a pass other than Shade that needs the lights
+#define SUBSCAN_UBO_TEMPORAL 5  // TemporalParams (Temporal, and FinishSurface's fused filter)
 
 // ---- plain uniforms ----
 #define SUBSCAN_UNIFORM_LEVEL 0    // uint: the pyramid level a per-level dispatch works on

@@ -2,24 +2,57 @@
 
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "core/Error.h"
+#include "render/ComputeStages.h"
 #include "render/PresentPass.h"
 #include "render/ShadePass.h"
+#include "render/TemporalPass.h"
 
 namespace subscan {
 
-FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources, Output output)
-    : sources_(sources), output_(output) {}
+namespace {
 
-const ComputeStages& FinishSurfacePass::stagesFor(bool directionalLights) {
-    std::optional<ComputeStages>& stages = directionalLights ? withLights_ : headLightOnly_;
-    if (!stages) {
-        const std::string lights = directionalLights ? "LIGHTS" : "HEAD_LIGHT";
-        stages.emplace(
-            sources_, "render/FinishSurface.comp",
-            std::vector<std::string>{output_ == Output::Picture ? lights : lights + "_RADIANCE"});
+// FINISH_OUTPUT in FinishSurface.comp.
+constexpr int kFinishPicture = 0;
+constexpr int kFinishRadiance = 1;
+constexpr int kFinishRestart = 2;  // then still: TemporalHistory::Mode in order
+
+}  // namespace
+
+FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources, Output output,
+                                     TemporalHistory* history)
+    : sources_(sources), output_(output), history_(history) {
+    if (output == Output::Temporal && !history) {
+        throw Error("FinishSurface's temporal filter needs the filter's history");
     }
-    return *stages;
+}
+
+std::vector<std::string_view> FinishSurfacePass::outputs() const {
+    switch (output_) {
+        case Output::Picture:
+            return {"image", "surfaceDepth"};
+        case Output::Radiance:
+            return {"radiance", "surfaceDepth"};
+        case Output::Temporal:
+            break;
+    }
+    return {"image", "surfaceDepth", "history", "historyState"};
+}
+
+const Program& FinishSurfacePass::program(bool directionalLights, int finishOutput) {
+    auto found = programs_.find({directionalLights, finishOutput});
+    if (found == programs_.end()) {
+        const std::string defines =
+            fmt::format("#define SHADE_DIRECTIONAL_LIGHTS {}\n#define FINISH_OUTPUT {}\n",
+                        directionalLights ? 1 : 0, finishOutput);
+        found = programs_
+                    .emplace(std::pair{directionalLights, finishOutput},
+                             Program::compute(sources_, "render/FinishSurface.comp", defines))
+                    .first;
+    }
+    return found->second;
 }
 
 void FinishSurfacePass::execute(FrameContext& frame) {
@@ -35,25 +68,46 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     const gpu::ShadeParams shade = ShadePass::parameters(frame);
     params_.set(shade);
     params_.bind(SUBSCAN_UBO_PASS);
-    const bool picture = output_ == Output::Picture;
-    Texture& color = picture ? resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(),
-                                                       frame.height())
-                             : resources.ensureTexture("radiance", TextureFormat::RGBA16F,
-                                                       frame.width(), frame.height());
+
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
-    color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        // Radiance off the surface is never read: surfaceDepth marks it.
-        if (picture) {
-            PresentPass::clearToBackground(color, frame.settings.raster);
-        }
         surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
     }
-    stagesFor(shade.lightCount.x > 0).runOverRegion(0, frame.region(0));
+    int finishOutput = kFinishPicture;
+    TemporalHistory::Mode mode = TemporalHistory::Mode::Restart;
+    if (output_ == Output::Temporal) {
+        // Binds the picture too, cleared to the background off the region.
+        mode = history_->begin(frame, true);
+        if (mode == TemporalHistory::Mode::Moving) {
+            throw Error("FinishSurface blends a moving camera's frame only in TemporalPass");
+        }
+        finishOutput = kFinishRestart + static_cast<int>(mode);
+    } else {
+        const bool picture = output_ == Output::Picture;
+        Texture& color = picture ? resources.ensureTexture("image", TextureFormat::RGBA8,
+                                                           frame.width(), frame.height())
+                                 : resources.ensureTexture("radiance", TextureFormat::RGBA16F,
+                                                           frame.width(), frame.height());
+        color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+        // Radiance off the surface is never read: surfaceDepth marks it.
+        if (picture && frame.restricted()) {
+            PresentPass::clearToBackground(color, frame.settings.raster);
+        }
+        finishOutput = picture ? kFinishPicture : kFinishRadiance;
+    }
+    const Program& shader = program(shade.lightCount.x > 0, finishOutput);
+    shader.use();
+    const TexelRegion region = frame.region(0);
+    ComputeStages::setRegionUniforms(shader, region);
+    Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
+                        SUBSCAN_IMAGE_GROUP_SIZE);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
+    if (output_ == Output::Temporal) {
+        history_->end(frame, mode);
+    }
 }
 
 }  // namespace subscan

@@ -1,33 +1,40 @@
 #pragma once
 
-#include <optional>
+#include <map>
+#include <utility>
 
-#include "render/ComputeStages.h"
+#include "gpu/GlObjects.h"
 #include "render/RenderPass.h"
 #include "shared/bindings.h"
 
 namespace subscan {
+
+class TemporalHistory;
 
 /// The full-resolution end of the surface mode in one dispatch (LevelZero::Fused): per pixel the
 /// push's level 0, the fill-removal mask, the blended normal, the shading and the sRGB encoding
 /// over the background, from the pyramids PullPushPass, FillRemovalPass and NormalsPass leave
 /// above level 0. Writes "image" and "surfaceDepth" (+inf off the surface) and nothing between:
 /// on llvmpipe the per-pass chain's six full-screen images cost more than their arithmetic.
-/// Equals the chain up to its half-float rounding of colour, normals and radiance. For the
-/// temporal filter it writes the linear "radiance" (+ "surfaceDepth") instead of the picture.
+/// Equals the chain up to its half-float rounding of colour, normals and radiance. With the
+/// temporal filter it also blends the frame into the history when the filter restarts or the
+/// camera rests (Output::Temporal: TemporalPass's work without its dispatch), or leaves the
+/// linear "radiance" for a TemporalPass after it (Output::Radiance: a moving camera's blend
+/// needs the neighbourhood, which here would take a work-group barrier that made the pass
+/// 14 ms slower on llvmpipe).
 class FinishSurfacePass final : public RenderPass {
   public:
-    enum class Output { Picture, Radiance };
+    enum class Output { Picture, Radiance, Temporal };
 
-    FinishSurfacePass(const ShaderSources& sources, Output output);
+    /// `history` is the filter's memory, for Output::Temporal.
+    FinishSurfacePass(const ShaderSources& sources, Output output,
+                      TemporalHistory* history = nullptr);
 
     std::string_view name() const override { return "FinishSurface"; }
     std::vector<std::string_view> inputs() const override {
         return {"pullValues", "pullWeights", "pushValues", "fillReach", "normalPyramid"};
     }
-    std::vector<std::string_view> outputs() const override {
-        return {output_ == Output::Picture ? "image" : "radiance", "surfaceDepth"};
-    }
+    std::vector<std::string_view> outputs() const override;
     void execute(FrameContext& frame) override;
 
     /// Whether a frame can finish here: at full resolution (reduced frames scale up in
@@ -37,15 +44,15 @@ class FinishSurfacePass final : public RenderPass {
     }
 
   private:
-    /// Built on first use, with or without the loop over directional lights: on llvmpipe that
-    /// loop costs a frame lit by the head light alone a sixth of this pass even when it runs
-    /// zero times.
-    const ComputeStages& stagesFor(bool directionalLights);
+    /// The shader for the lights and what it writes (FINISH_OUTPUT), built on first use: on
+    /// llvmpipe an unused loop over directional lights still costs a frame lit by the head
+    /// light alone a sixth of this pass.
+    const Program& program(bool directionalLights, int finishOutput);
 
     const ShaderSources& sources_;
     Output output_;
-    std::optional<ComputeStages> headLightOnly_;
-    std::optional<ComputeStages> withLights_;
+    TemporalHistory* history_;
+    std::map<std::pair<bool, int>, Program> programs_;
     UniformBlock<gpu::ShadeParams> params_{"FinishSurface.shade"};
 };
 

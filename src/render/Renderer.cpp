@@ -90,7 +90,7 @@ void Renderer::appendPresent(const RenderSettings& settings, int divisor, const 
         passes.push_back(&present(color, "surfaceDepth"));
         return;
     }
-    TemporalPass& temporal = lazyPass(temporal_, sources_);
+    TemporalPass& temporal = lazyPass(temporal_, sources_, temporalHistory_);
     temporal.setInput(color, divisor == 1);
     passes.push_back(&temporal);
     if (divisor != 1) {
@@ -99,9 +99,7 @@ void Renderer::appendPresent(const RenderSettings& settings, int divisor, const 
 }
 
 void Renderer::restartTemporalFilter() {
-    if (temporal_) {
-        temporal_->restart();
-    }
+    temporalHistory_.restart();
 }
 
 std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, int divisor,
@@ -120,9 +118,16 @@ std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, int
                     &lazyPass(finishSurface_, sources_, FinishSurfacePass::Output::Picture));
                 return passes;
             }
-            passes.push_back(
-                &lazyPass(finishSurfaceRadiance_, sources_, FinishSurfacePass::Output::Radiance));
-            appendPresent(settings, divisor, "radiance", passes);
+            // A moving camera's blend needs the neighbourhood: its own pass after this.
+            if (temporalHistory_.modeFor(pipelineCamera_, settings, divisor) ==
+                TemporalHistory::Mode::Moving) {
+                passes.push_back(&lazyPass(finishSurfaceRadiance_, sources_,
+                                           FinishSurfacePass::Output::Radiance));
+                appendPresent(settings, divisor, "radiance", passes);
+            } else {
+                passes.push_back(&lazyPass(finishSurfaceTemporal_, sources_,
+                                           FinishSurfacePass::Output::Temporal, &temporalHistory_));
+            }
             return passes;
         }
         appendShading(scatters, passes);
@@ -174,7 +179,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     pipelineCamera_ = divisor == 1 ? camera : reducedCamera(camera, divisor);
     if (filtersTemporally(settings)) {
         pipelineCamera_.jitterPixels +=
-            lazyPass(temporal_, sources_).nextJitter(pipelineCamera_, settings.temporal);
+            temporalHistory_.nextJitter(pipelineCamera_, settings.temporal);
     }
     const gpu::PyramidLayout& layout =
         uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());

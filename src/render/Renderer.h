@@ -20,6 +20,7 @@
 #include "render/Reconstruction.h"
 #include "render/ReducedResolution.h"
 #include "render/RenderSettings.h"
+#include "render/TemporalPass.h"
 #include "shared/bindings.h"
 
 namespace subscan {
@@ -32,7 +33,6 @@ class StageViewPass;
 class SubsurfaceScatteringPass;
 class SingleScatteringPass;
 class PresentPass;
-class TemporalPass;
 
 struct FrameResult {
     std::vector<PassTiming> passes;
@@ -117,7 +117,9 @@ class Renderer {
     LightMaps lightMaps_;
     std::unique_ptr<DrawPointsPass> drawPoints_;
     std::unique_ptr<FinishSurfacePass> finishSurface_;
-    std::unique_ptr<FinishSurfacePass> finishSurfaceRadiance_;  // for the temporal filter
+    std::unique_ptr<FinishSurfacePass> finishSurfaceRadiance_;  // before TemporalPass
+    std::unique_ptr<FinishSurfacePass> finishSurfaceTemporal_;  // with its blend at rest
+    TemporalHistory temporalHistory_;
     std::unique_ptr<TemporalPass> temporal_;
     std::unique_ptr<ShadePass> shade_;
     std::unique_ptr<ShadePass> shadeSplit_;

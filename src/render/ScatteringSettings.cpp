@@ -139,10 +139,10 @@ void checkScatteringSettings(const ScatteringSettings& settings) {
 }
 
 void from_json(const nlohmann::json& json, ScatteringSettings& settings) {
-    rejectUnknownKeys(json, "scattering",
-                      {"method", "material", "unit", "scale", "albedo", "max_taps", "coefficients",
-                       "mean_free_path_mm", "eta", "phase_g", "single_samples", "light_path",
-                       "transmission"});
+    rejectUnknownKeys(
+        json, "scattering",
+        {"method", "material", "unit", "scale", "albedo", "max_taps", "coefficients",
+         "mean_free_path_mm", "eta", "phase_g", "single_samples", "light_path", "transmission"});
     readEnum(json, "method", settings.method, kMethods, "scattering method");
     readEnum(json, "coefficients", settings.coefficients, kSources, "coefficient source");
     if (const auto found = json.find("material"); found != json.end()) {

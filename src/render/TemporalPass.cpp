@@ -46,19 +46,7 @@ glm::dvec2 haltonJitter(unsigned index) {
     return {radicalInverse(index, 2) - 0.5, radicalInverse(index, 3) - 0.5};
 }
 
-TemporalPass::TemporalPass(const ShaderSources& sources)
-    : stages_(
-          sources, "render/Temporal.comp",
-          {"RESTART", "STILL", "MOVING", "RESTART_PICTURE", "STILL_PICTURE", "MOVING_PICTURE"}) {}
-
-std::vector<std::string_view> TemporalPass::outputs() const {
-    if (writesPicture_) {
-        return {"history", "historyState", "image"};
-    }
-    return {"history", "historyState"};
-}
-
-glm::dvec2 TemporalPass::nextJitter(const Camera& camera, const TemporalSettings& settings) {
+glm::dvec2 TemporalHistory::nextJitter(const Camera& camera, const TemporalSettings& settings) {
     if (!previous_ || !sameView(previous_->camera, camera)) {
         frameIndex_ = 0;
         if (previous_) {
@@ -70,7 +58,18 @@ glm::dvec2 TemporalPass::nextJitter(const Camera& camera, const TemporalSettings
     return haltonJitter(index);
 }
 
-void TemporalPass::execute(FrameContext& frame) {
+TemporalHistory::Mode TemporalHistory::modeFor(const Camera& camera, const RenderSettings& settings,
+                                               int divisor) const {
+    const bool continues =
+        previous_ && previous_->settings == settings && previous_->divisor == divisor &&
+        previous_->camera.width == camera.width && previous_->camera.height == camera.height;
+    if (!continues) {
+        return Mode::Restart;
+    }
+    return sameView(previous_->camera, withoutJitter(camera)) ? Mode::Still : Mode::Moving;
+}
+
+TemporalHistory::Mode TemporalHistory::begin(FrameContext& frame, bool picture) {
     FrameResources& resources = frame.resources;
     const int width = frame.width(), height = frame.height();
     const Camera camera = withoutJitter(frame.camera);
@@ -83,15 +82,10 @@ void TemporalPass::execute(FrameContext& frame) {
     resources.swapTextures("history", "previousHistory");
     resources.swapTextures("historyState", "previousHistoryState");
 
-    const bool continues = previous_ && previous_->settings == frame.settings &&
-                           previous_->divisor == frame.divisor &&
-                           previous_->camera.width == width && previous_->camera.height == height;
+    const Mode mode = modeFor(frame.camera, frame.settings, frame.divisor);
     gpu::TemporalParams params{};
-    const Mode mode = !continues                            ? Mode::Restart
-                      : sameView(previous_->camera, camera) ? Mode::Still
-                                                            : Mode::Moving;
     params.flags.x = previous_ && previous_->moved ? 1u : 0u;
-    if (continues) {
+    if (mode != Mode::Restart) {
         params.previousFromView = glm::mat4(previous_->camera.view * glm::inverse(camera.view));
         params.previousProjection = glm::mat4(previous_->camera.projection());
     }
@@ -100,15 +94,13 @@ void TemporalPass::execute(FrameContext& frame) {
                     static_cast<float>(settings.maxFrames), 0.0f};
     params.depth = {static_cast<float>(kDisocclusionSpacings * frame.spacing), 0.0f, 0.0f, 0.0f};
     params_.set(params);
-    params_.bind(SUBSCAN_UBO_PASS);
+    params_.bind(SUBSCAN_UBO_TEMPORAL);
 
     Texture& history = resources.texture("history");
     Texture& state = resources.texture("historyState");
-    Texture* image = writesPicture_
-                         ? &resources.ensureTexture("image", TextureFormat::RGBA8, width, height)
-                         : nullptr;
-    const TexelRegion region = frame.region(0);
-    if (region.size != glm::ivec2(width, height)) {
+    Texture* image =
+        picture ? &resources.ensureTexture("image", TextureFormat::RGBA8, width, height) : nullptr;
+    if (frame.region(0).size != glm::ivec2(width, height)) {
         // Off the region this frame shows the background (surfaceDepth is +inf there).
         const glm::vec3& background = frame.settings.raster.backgroundSrgb;
         history.clear(glm::vec4(srgbToLinear(background.r), srgbToLinear(background.g),
@@ -119,18 +111,42 @@ void TemporalPass::execute(FrameContext& frame) {
         }
     }
     if (image) {
-        image->bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+        image->bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     }
-    resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     resources.texture("previousHistory").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
     resources.texture("previousHistoryState").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
-    history.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    state.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    stages_.runOverRegion(static_cast<std::size_t>(mode) + (writesPicture_ ? 3 : 0), region);
+    history.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    state.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
+    return mode;
+}
+
+void TemporalHistory::end(const FrameContext& frame, Mode mode) {
+    previous_ = PreviousFrame{withoutJitter(frame.camera), frame.settings, frame.divisor,
+                              mode == Mode::Moving};
+}
+
+TemporalPass::TemporalPass(const ShaderSources& sources, TemporalHistory& history)
+    : history_(history),
+      stages_(
+          sources, "render/Temporal.comp",
+          {"RESTART", "STILL", "MOVING", "RESTART_PICTURE", "STILL_PICTURE", "MOVING_PICTURE"}) {}
+
+std::vector<std::string_view> TemporalPass::outputs() const {
+    if (writesPicture_) {
+        return {"history", "historyState", "image"};
+    }
+    return {"history", "historyState"};
+}
+
+void TemporalPass::execute(FrameContext& frame) {
+    const TemporalHistory::Mode mode = history_.begin(frame, writesPicture_);
+    frame.resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    frame.resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+    stages_.runOverRegion(static_cast<std::size_t>(mode) + (writesPicture_ ? 3 : 0),
+                          frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
-    previous_ = PreviousFrame{camera, frame.settings, frame.divisor, mode == Mode::Moving};
+    history_.end(frame, mode);
 }
 
 }  // namespace subscan

@@ -17,18 +17,58 @@ namespace subscan {
 /// first 2^k x 3^k points fill a pixel evenly, so jittered frames average to a supersampled one.
 glm::dvec2 haltonJitter(unsigned index);
 
-/// The temporal filter (DESIGN.md §5 step 10): the frame's linear colour over the background,
-/// rendered through a camera jittered by jitterFor(), blended into the previous result
-/// reprojected to this frame. Writes "history" (RGBA16F: colour over the background, coverage
-/// of the surface in alpha) and "historyState" (RG32F: this frame's depth, frames in the pixel's
-/// history); the previous frame's pair waits under "previousHistory" and "previousHistoryState".
-/// At full resolution it also encodes the picture "image" (Present's work, saving a full-screen
-/// pass); a reduced frame leaves "history" to Present, which scales it up. The history restarts
-/// when the settings, the image or the resolution change; a still camera averages frames evenly
-/// (TemporalSettings::maxFrames).
+/// The temporal filter's memory across frames (DESIGN.md §5 step 10): the jitter sequence, the
+/// previous frame's camera and settings, and its result in the frame's resources: "history"
+/// (RGBA16F: colour over the background, coverage of the surface in alpha) and "historyState"
+/// (RG32F: that frame's depth, frames in the pixel's history), the one before waiting under
+/// "previousHistory" and "previousHistoryState". Shared by TemporalPass and the surface mode's
+/// fused end (FinishSurfacePass), which run render/Temporal.glsl. The history restarts when the
+/// settings, the image or the resolution change.
+class TemporalHistory {
+  public:
+    /// The frame alone, the even mean of a still camera, or the reprojected blend of a moving
+    /// one.
+    enum class Mode { Restart, Still, Moving };
+
+    /// The jitter of the next frame through `camera` (without jitter), pipeline pixels: Halton
+    /// (2, 3), cycling through TemporalSettings::maxFrames points so a still camera's mean
+    /// covers the whole pattern; none while the camera moves, where the jitter's own change
+    /// from frame to frame costs more steadiness than its anti-aliasing gains (README,
+    /// "Temporal filter and turntables").
+    glm::dvec2 nextJitter(const Camera& camera, const TemporalSettings& settings);
+    /// Forget the history: the next frame starts afresh (a cut in an animation).
+    void restart() { previous_.reset(); }
+
+    /// The mode of the next frame through the pipeline camera `camera` (with its jitter).
+    Mode modeFor(const Camera& camera, const RenderSettings& settings, int divisor) const;
+    /// Readies this frame's blend and returns its mode: swaps the history images, sets what
+    /// lies outside the frame's region to the background (with the picture "image", when
+    /// `picture`), and binds the parameters (SUBSCAN_UBO_TEMPORAL), the previous result
+    /// (IN2, IN3), the new one (OUT2, OUT3) and the picture (OUT0).
+    Mode begin(FrameContext& frame, bool picture);
+    /// After the dispatch: this frame becomes the one the next reprojects from.
+    void end(const FrameContext& frame, Mode mode);
+
+  private:
+    struct PreviousFrame {
+        Camera camera;  // without jitter
+        RenderSettings settings;
+        int divisor = 1;
+        bool moved = false;  // its history was reprojected
+    };
+
+    UniformBlock<gpu::TemporalParams> params_{"Temporal.params"};
+    std::optional<PreviousFrame> previous_;
+    unsigned frameIndex_ = 0;
+};
+
+/// The temporal filter as its own pass, after shading or scattering (the sss mode, reduced
+/// resolution, exports): blends the frame's linear colour into `history`. At full resolution
+/// it also encodes the picture "image" (Present's work, saving a full-screen pass); a reduced
+/// frame leaves "history" to Present, which scales it up.
 class TemporalPass final : public RenderPass {
   public:
-    explicit TemporalPass(const ShaderSources& sources);
+    TemporalPass(const ShaderSources& sources, TemporalHistory& history);
 
     std::string_view name() const override { return "Temporal"; }
     std::vector<std::string_view> inputs() const override { return {colorInput_, "surfaceDepth"}; }
@@ -41,34 +81,13 @@ class TemporalPass final : public RenderPass {
         colorInput_ = std::move(colorInput);
         writesPicture_ = writesPicture;
     }
-    /// The jitter of the next frame through `camera` (without jitter), pipeline pixels: Halton
-    /// (2, 3), cycling through TemporalSettings::maxFrames points so a still camera's mean
-    /// covers the whole pattern; none while the camera moves, where the jitter's own change
-    /// from frame to frame costs more steadiness than its anti-aliasing gains (README,
-    /// "Temporal filter").
-    glm::dvec2 nextJitter(const Camera& camera, const TemporalSettings& settings);
-    /// Forget the history: the next frame starts afresh (a cut in an animation).
-    void restart() { previous_.reset(); }
 
   private:
-    /// What the next frame's reprojection needs of this one.
-    struct PreviousFrame {
-        Camera camera;  // without jitter
-        RenderSettings settings;
-        int divisor = 1;
-        bool moved = false;  // its history was reprojected
-    };
-
+    TemporalHistory& history_;
     std::string colorInput_ = "radiance";
     bool writesPicture_ = true;
-    /// The frame alone, the even mean of a still camera, or the reprojected blend of a moving
-    /// one (Temporal.comp's variants in this order, then the same writing the picture).
-    enum class Mode { Restart, Still, Moving };
-
-    ComputeStages stages_;
-    UniformBlock<gpu::TemporalParams> params_{"Temporal.params"};
-    std::optional<PreviousFrame> previous_;
-    unsigned frameIndex_ = 0;
+    ComputeStages stages_;  // Temporal.comp's variants, by TemporalHistory::Mode, then the same
+                            // writing the picture
 };
 
 }  // namespace subscan

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
 
 #include "core/Camera.h"
 #include "render/Renderer.h"
@@ -90,6 +91,40 @@ TEST(FinishSurfaceGLTest, CloseUpLooksAsPassByPass) {
     RenderSettings settings;
     settings.raster.mode = RenderMode::Surface;
     expectSamePicture(cloud, orbitCamera(cloud.bounds, close, 120, 90, 45.0), settings);
+}
+
+TEST(FinishSurfaceGLTest, TemporalFilterAtRestBlendsAsItsOwnPassDoes) {
+    // A still camera's 8 jittered frames: FinishSurface blends them itself (pictures only),
+    // pass by pass TemporalPass does; moving, both leave the blend to TemporalPass.
+    const PointCloud cloud = makeSyntheticScene("sculpture?points=20000");
+    const Camera camera = orbitCamera(cloud.bounds, {30.0, 20.0}, 161, 97, 45.0);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Surface;
+    settings.temporal.enabled = true;
+    Renderer fused(test::glTestContext(), cloud);
+    Renderer perPass(test::glTestContext(), cloud);
+    for (int frame = 0; frame < 8; ++frame) {
+        const FrameResult result = fused.render(camera, settings);
+        EXPECT_TRUE(ranPass(result, "FinishSurface"));
+        EXPECT_FALSE(ranPass(result, "Temporal")) << "frame " << frame;
+        EXPECT_TRUE(
+            ranPass(perPass.render(camera, settings, FrameOutputs::Everything), "Temporal"));
+    }
+    const std::vector<std::uint8_t> a = fused.readImage(), b = perPass.readImage();
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differences = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const int difference = std::abs(int(a[i]) - int(b[i]));
+        // As above: the chain's half floats move a value near a rounding boundary by a step.
+        ASSERT_LE(difference, 1) << "byte " << i;
+        differences += difference == 0 ? 0 : 1;
+    }
+    EXPECT_LT(differences, a.size() / 20);
+    Camera moved = camera;
+    moved.view = glm::translate(camera.view, glm::dvec3(0.01, 0.0, 0.0));
+    const FrameResult moving = fused.render(moved, settings);
+    EXPECT_TRUE(ranPass(moving, "FinishSurface"));
+    EXPECT_TRUE(ranPass(moving, "Temporal"));
 }
 
 TEST(FinishSurfaceGLTest, OnlyTheSurfaceModesFinalFullResolutionPictureIsFused) {

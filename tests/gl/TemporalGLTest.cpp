@@ -89,7 +89,7 @@ Inputs planeInputs(const Camera& camera, const Plane& plane, Color colorOf, Hole
 class TemporalHarness {
   public:
     explicit TemporalHarness(const RenderSettings& settings, double spacing = 0.05)
-        : harness_(kWidth, kHeight, settings, spacing), pass_(harness_.sources()) {
+        : harness_(kWidth, kHeight, settings, spacing), pass_(harness_.sources(), history_) {
         pass_.setInput("radiance", false);
     }
 
@@ -112,6 +112,7 @@ class TemporalHarness {
 
   private:
     test::PassHarness harness_;
+    TemporalHistory history_;
     TemporalPass pass_;
 };
 
