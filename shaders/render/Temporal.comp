@@ -49,7 +49,7 @@ void main() {
             addSample(around, texel, centre ? current : frameSampleAt(texel, d), d);
         }
     }
-    result = blendMoving(pixel, current, around, count);
+    result = blendMoving(pixel, current, depth, around, count);
 #endif
     storeHistory(pixel, result, depth, count);
 #if WRITE_PICTURE

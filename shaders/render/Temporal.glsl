@@ -14,9 +14,11 @@
 layout(std140, binding = SUBSCAN_UBO_TEMPORAL) uniform TemporalBlock {
     TemporalParams temporal;
 };
-layout(binding = SUBSCAN_IMAGE_IN2, rgba16f) readonly uniform image2D inHistory;
+// 32-bit floats: an even mean of n frames moves by (new - mean) / n, which half floats would
+// round away once n reaches the hundreds.
+layout(binding = SUBSCAN_IMAGE_IN2, rgba32f) readonly uniform image2D inHistory;
 layout(binding = SUBSCAN_IMAGE_IN3, rg32f) readonly uniform image2D inHistoryState;
-layout(binding = SUBSCAN_IMAGE_OUT2, rgba16f) writeonly uniform image2D outHistory;
+layout(binding = SUBSCAN_IMAGE_OUT2, rgba32f) writeonly uniform image2D outHistory;
 layout(binding = SUBSCAN_IMAGE_OUT3, rg32f) writeonly uniform image2D outHistoryState;
 
 vec3 toYCoCg(vec3 c) {
@@ -79,8 +81,8 @@ void addSample(inout Neighbourhood around, ivec2 texel, vec4 value, float depth)
 }
 
 /// A moving camera: the previous result where the pixel's surface was, blended with
-/// `current`; `current` alone where none of it saw this surface.
-vec4 blendMoving(ivec2 pixel, vec4 current, Neighbourhood around, out float count) {
+/// `current` (of depth `depth`); `current` alone where none of it saw this surface.
+vec4 blendMoving(ivec2 pixel, vec4 current, float depth, Neighbourhood around, out float count) {
     ivec2 size = imageSizeOfFrame();
     count = 1.0;
     // Off the surface the motion of the far plane stands in: the background is one colour.
@@ -109,7 +111,10 @@ vec4 blendMoving(ivec2 pixel, vec4 current, Neighbourhood around, out float coun
             continue;
         }
         vec2 state = imageLoad(inHistoryState, texel).rg;
-        bool sameSurface = surface ? abs(state.r - expectedDepth) <= tolerance : true;
+        // Background where background was is kept too (a silhouette's outer ring); clipping
+        // then settles how much of the surface's edge it keeps.
+        bool sameSurface = !surface || abs(state.r - expectedDepth) <= tolerance ||
+                           (isinf(state.r) && isinf(depth));
         if (!sameSurface) {
             continue;
         }

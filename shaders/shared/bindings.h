@@ -99,9 +99,10 @@ struct RasterParams {
     uint pixelCount;   // width * height
     float colorBlend;  // points within this relative depth of a pixel's nearest share its colour
 };
-// Fixed-point units per 1.0 of linear colour in SUBSCAN_SSBO_COLOR_SUMS: 2^32 / 1024 = 4 M
-// white points per pixel before a sum overflows.
-#define SUBSCAN_COLOR_SUM_SCALE 1024.0
+// Fixed-point units per 1.0 of linear colour in SUBSCAN_SSBO_COLOR_SUMS: 2^14, so that the
+// darkest 8-bit sRGB step (3e-4) is 5 units, and 2^32 / 2^14 = 262144 white points per pixel
+// fit before a sum overflows.
+#define SUBSCAN_COLOR_SUM_SCALE 16384.0
 
 // DrawPoints (GL_POINTS baselines).
 struct DrawParams {

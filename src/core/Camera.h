@@ -25,7 +25,8 @@ struct Camera {
     /// units tall; fovyDegrees is then unused. 0: a pinhole camera.
     double orthographicHeight = 0.0;
     /// Sub-pixel shift of the picture, in pixels (x right, y down): the temporal filter's jitter
-    /// of the pipeline's camera. projection() and every back-projection include it.
+    /// of the pipeline's camera. projection() and the shaders' viewPositionAt() include it; the
+    /// viewer's picking ignores it (half a pixel at most).
     glm::dvec2 jitterPixels{0.0};
 
     bool orthographic() const { return orthographicHeight > 0.0; }

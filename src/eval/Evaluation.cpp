@@ -215,6 +215,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         RenderSettings surfaceSettings = render;
         surfaceSettings.raster.mode = RenderMode::Surface;
         surfaceSettings.raster.stage = Stage::Final;
+        surfaceSettings.temporal.enabled = false;  // one frame per view (eval --temporal has it)
         const int divisor =
             renderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
         report.surfaceReducedViews += divisor == 1 ? 0 : 1;

@@ -1,5 +1,7 @@
 #include "io/CameraJson.h"
 
+#include <array>
+
 #include <cmath>
 #include <fstream>
 
@@ -36,7 +38,7 @@ T required(const nlohmann::json& json, const char* key) {
 }  // namespace
 
 nlohmann::json cameraToJson(const Camera& camera) {
-    return {
+    nlohmann::json json = {
         {"width", camera.width},
         {"height", camera.height},
         {"fovy_deg", camera.fovyDegrees},
@@ -45,6 +47,10 @@ nlohmann::json cameraToJson(const Camera& camera) {
         {"view", rowMajor(camera.view)},
         {"projection", rowMajor(camera.projection())},
     };
+    if (camera.jitterPixels != glm::dvec2(0.0)) {
+        json["jitter_pixels"] = {camera.jitterPixels.x, camera.jitterPixels.y};
+    }
+    return json;
 }
 
 Camera cameraFromJson(const nlohmann::json& json) {
@@ -85,6 +91,18 @@ Camera cameraFromJson(const nlohmann::json& json) {
             }
             camera.view[column][row] = value;
         }
+    }
+    if (const auto jitter = json.find("jitter_pixels"); jitter != json.end()) {
+        std::array<double, 2> pixels{};
+        try {
+            pixels = jitter->get<std::array<double, 2>>();
+        } catch (const nlohmann::json::exception&) {
+            throw Error("the camera's 'jitter_pixels' needs 2 numbers");
+        }
+        if (!std::isfinite(pixels[0]) || !std::isfinite(pixels[1])) {
+            throw Error("the camera's 'jitter_pixels' holds a non-finite number");
+        }
+        camera.jitterPixels = {pixels[0], pixels[1]};
     }
     return camera;
 }

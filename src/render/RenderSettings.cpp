@@ -127,7 +127,7 @@ void from_json(const nlohmann::json& json, TemporalSettings& settings) {
     readSetting(json, "enabled", settings.enabled);
     readSetting(json, "new_frame_weight", settings.newFrameWeight, 0.01f, 1.0f);
     readSetting(json, "clip_sigma", settings.clipSigma, 0.1f, 100.0f);
-    // The count rides in a half float, exact up to 2048.
+    // More frames change nothing a picture shows: 1/2048 of a colour step.
     readSetting(json, "max_frames", settings.maxFrames, 1, 2048);
 }
 

@@ -177,7 +177,10 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
                                                          cloud_.origin(), spacing_)
                             : 1;
     pipelineCamera_ = divisor == 1 ? camera : reducedCamera(camera, divisor);
-    if (filtersTemporally(settings)) {
+    if (!filtersTemporally(settings)) {
+        // Frames without the filter move on without it: its history no longer lines up.
+        temporalHistory_.restart();
+    } else {
         pipelineCamera_.jitterPixels +=
             temporalHistory_.nextJitter(pipelineCamera_, settings.temporal);
     }

@@ -74,7 +74,7 @@ TemporalHistory::Mode TemporalHistory::begin(FrameContext& frame, bool picture) 
     const int width = frame.width(), height = frame.height();
     const Camera camera = withoutJitter(frame.camera);
     for (const char* name : {"history", "previousHistory"}) {
-        resources.ensureTexture(name, TextureFormat::RGBA16F, width, height);
+        resources.ensureTexture(name, TextureFormat::RGBA32F, width, height);
     }
     for (const char* name : {"historyState", "previousHistoryState"}) {
         resources.ensureTexture(name, TextureFormat::RG32F, width, height);

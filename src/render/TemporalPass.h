@@ -19,7 +19,7 @@ glm::dvec2 haltonJitter(unsigned index);
 
 /// The temporal filter's memory across frames (DESIGN.md §5 step 10): the jitter sequence, the
 /// previous frame's camera and settings, and its result in the frame's resources: "history"
-/// (RGBA16F: colour over the background, coverage of the surface in alpha) and "historyState"
+/// (RGBA32F: colour over the background, coverage of the surface in alpha) and "historyState"
 /// (RG32F: that frame's depth, frames in the pixel's history), the one before waiting under
 /// "previousHistory" and "previousHistoryState". Shared by TemporalPass and the surface mode's
 /// fused end (FinishSurfacePass), which run render/Temporal.glsl. The history restarts when the

@@ -33,9 +33,7 @@ ImageF channelsOf(const Texture& texture, int channels) {
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
                    const RenderSettings& settings) {
     const RenderMode mode = settings.raster.mode;
-    // The buffers' own camera, its sub-pixel jitter left out (the temporal filter's frames).
-    Camera camera = renderer.pipelineCamera();
-    camera.jitterPixels = glm::dvec2(0.0);
+    const Camera& camera = renderer.pipelineCamera();
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) {

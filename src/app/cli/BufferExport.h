@@ -12,9 +12,9 @@ namespace subscan::cli {
 /// reconstructed depth (+inf outside the mask); with single scattering also single.pfm (that
 /// term alone, linear RGB like radiance.pfm), sigma_s.pfm and sigma_a.pfm (σs′ and σa in mm⁻¹).
 /// The camera and the buffers are the pipeline's last frame's: at reduced resolution smaller
-/// than the picture; with the temporal filter that frame's, jittered by under half a pixel,
-/// while camera.json holds the camera without the jitter. Needs a frame rendered with
-/// FrameOutputs::Everything.
+/// than the picture; with the temporal filter at rest, that frame's jittered camera (its
+/// `jitter_pixels` in camera.json), the picture being the mean over many. Needs a frame
+/// rendered with FrameOutputs::Everything.
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
                    const RenderSettings& settings);
 

@@ -67,7 +67,9 @@ int runRender(const RenderOptions& options) {
     // The filter on without --samples: its picture at rest, as the viewer shows it.
     const int samples =
         options.samples.value_or(filtersTemporally(settings) ? kTemporalRestFrames : 1);
-    if (samples > 1) {
+    if (samples == 1) {
+        settings.temporal.enabled = false;  // one frame: no jitter, nothing to blend
+    } else {
         if (!reconstructsSurface(raster.mode) || raster.stage != Stage::Final) {
             throw Error(
                 "--samples needs the final picture of the surface or sss mode (the temporal "

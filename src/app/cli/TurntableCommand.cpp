@@ -2,6 +2,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -61,9 +62,10 @@ std::optional<std::filesystem::path> findFfmpeg() {
 /// throws subscan::Error with its exit status.
 void encodeVideo(const std::filesystem::path& ffmpeg, const std::filesystem::path& frames,
                  const std::filesystem::path& video, int fps) {
+    // -nostdin: ffmpeg would otherwise read (and, in the background, stop on) the terminal.
     const std::vector<std::string> arguments = {
-        ffmpeg.string(), "-y", "-loglevel", "error", "-framerate", std::to_string(fps), "-i",
-        (frames / "%04d.png").string(),
+        ffmpeg.string(), "-nostdin", "-y", "-loglevel", "error", "-framerate", std::to_string(fps),
+        "-i", (frames / "%04d.png").string(),
         // yuv420p, which every player reads, needs even sizes: pad by a pixel when odd.
         "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p",
         "-movflags", "+faststart", "-f", "mp4", video.string()};
@@ -77,10 +79,22 @@ void encodeVideo(const std::filesystem::path& ffmpeg, const std::filesystem::pat
         throw Error(fmt::format("{}: cannot run {}", video.string(), ffmpeg.string()));
     }
     int status = 0;
-    waitpid(child, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    pid_t waited = 0;
+    do {
+        waited = waitpid(child, &status, 0);
+    } while (waited == -1 && errno == EINTR);
+    if (waited != child || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         throw Error(fmt::format("{}: ffmpeg failed to encode the frames (exit status {})",
                                 video.string(), WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+    }
+}
+
+void createFolder(const std::filesystem::path& folder, std::string_view what) {
+    std::error_code error;
+    std::filesystem::create_directories(folder, error);
+    if (error || !std::filesystem::is_directory(folder)) {
+        throw Error(fmt::format("{}: cannot create the {} folder{}", folder.string(), what,
+                                error ? ": " + error.message() : ""));
     }
 }
 
@@ -90,7 +104,7 @@ class FrameFolder {
     explicit FrameFolder(const std::filesystem::path& output)
         : path_(output.parent_path() /
                 fmt::format(".{}.frames-{}", output.filename().string(), ::getpid())) {
-        std::filesystem::create_directories(path_);
+        createFolder(path_, "frames");
     }
     ~FrameFolder() {
         std::error_code ignored;
@@ -103,15 +117,6 @@ class FrameFolder {
   private:
     std::filesystem::path path_;
 };
-
-void createFolder(const std::filesystem::path& folder, std::string_view what) {
-    std::error_code error;
-    std::filesystem::create_directories(folder, error);
-    if (error || !std::filesystem::is_directory(folder)) {
-        throw Error(fmt::format("{}: cannot create the {} folder{}", folder.string(), what,
-                                error ? ": " + error.message() : ""));
-    }
-}
 
 int runTurntable(const TurntableOptions& options) {
     const FrameOptions& frame = options.frame;
@@ -164,7 +169,8 @@ int runTurntable(const TurntableOptions& options) {
     }
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
-    // The first written frame is already converged.
+    // The first written frame is already converged: the mean of `warmup` frames, itself
+    // included.
     for (int still = 1; filtered && still < options.warmup; ++still) {
         renderer.render(first, settings, outputs);
     }
@@ -177,17 +183,29 @@ int runTurntable(const TurntableOptions& options) {
         if (!options.exportDirectory.empty()) {
             const std::filesystem::path buffers =
                 std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index);
+            frame.refuseToOverwriteInputs(buffers / "camera.json", "the camera");
             createFolder(buffers, "buffers");
             exportBuffers(buffers, renderer, settings);
         }
         bar.update((index + 1.0) / options.frames);
     }
     if (video) {
-        // Encoded beside the output and renamed over it once complete.
+        // Encoded beside the output and renamed over it once complete; removed on failure.
         const std::filesystem::path partial =
             output.parent_path() / fmt::format(".{}.partial", output.filename().string());
-        encodeVideo(*ffmpeg, folder, partial, options.fps);
-        std::filesystem::rename(partial, output);
+        std::error_code error;
+        try {
+            encodeVideo(*ffmpeg, folder, partial, options.fps);
+            std::filesystem::rename(partial, output, error);
+        } catch (const Error&) {
+            std::filesystem::remove(partial, error);
+            throw;
+        }
+        if (error) {
+            std::filesystem::remove(partial, error);
+            throw Error(
+                fmt::format("{}: cannot write the video: {}", output.string(), error.message()));
+        }
     }
     return 0;
 }
@@ -211,7 +229,8 @@ Command addTurntableCommand(CLI::App& parent) {
         ->check(CLI::Range(1, 240));
     turntable
         ->add_option("--warmup", options->warmup,
-                     "Still frames the temporal filter converges over before the first one")
+                     "Frames the temporal filter averages at the first pose for the first "
+                     "frame (itself included)")
         ->check(CLI::Range(1, 2048));
     turntable->add_option("--export-buffers", options->exportDirectory,
                           "Directory for each frame's buffers: DIR/0000/, DIR/0001/, ... "

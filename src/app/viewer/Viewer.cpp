@@ -515,7 +515,8 @@ bool Viewer::frameIsStale() const {
                          !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
                          nlohmann::json(settings).dump() != renderedSettings_;
     return redrawEveryFrame_ || changed ||
-           (filtersTemporally(settings) && framesAtRest_ + 1 < kTemporalRestFrames);
+           (filtersTemporally(settings) && renderedImage_ &&
+            framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
 }
 
 void Viewer::renderIfNeeded() {
@@ -594,7 +595,7 @@ void Viewer::drawPanel() {
             notify("saved the settings to " + *requests.saveSettings);
         }
         if (requests.loadSettings) {
-            settings_ = readSettingsFile(*requests.loadSettings);
+            settings_ = readSettingsFile(*requests.loadSettings, viewerDefaultSettings());
             notify("loaded the settings from " + *requests.loadSettings);
         }
     } catch (const Error& error) {

@@ -2,6 +2,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -15,6 +16,29 @@ Bounds box(glm::dvec3 min, glm::dvec3 max) {
     bounds.add(min);
     bounds.add(max);
     return bounds;
+}
+
+TEST(CameraTest, JitterShiftsEveryPointByItsPixelsRightAndDown) {
+    // The temporal filter's jitter moves the picture by (x right, y down) pixels at every
+    // depth; the shaders' viewPositionAt() subtracts it (mutate-temporal.sh checks that side).
+    Camera camera;
+    camera.width = 64;
+    camera.height = 48;
+    camera.view = glm::lookAt(glm::dvec3(1, 2, 5), glm::dvec3(0), glm::dvec3(0, 1, 0));
+    Camera jittered = camera;
+    jittered.jitterPixels = {0.3, -0.2};
+    auto window = [](const Camera& c, glm::dvec3 point) {
+        const glm::dvec4 clip = c.projection() * c.view * glm::dvec4(point, 1.0);
+        return glm::dvec2((clip.x / clip.w + 1.0) * 0.5 * c.width,
+                          (1.0 - clip.y / clip.w) * 0.5 * c.height);
+    };
+    for (const glm::dvec3 point :
+         {glm::dvec3(0.0), glm::dvec3(0.5, -0.3, 1.0), glm::dvec3(-1.0, 0.4, -2.0)}) {
+        const glm::dvec2 shift = window(jittered, point) - window(camera, point);
+        EXPECT_NEAR(shift.x, 0.3, 1e-9);  // double rounding of the projection
+        EXPECT_NEAR(shift.y, -0.2, 1e-9);
+    }
+    EXPECT_EQ(jittered.focalLengthPixels(), camera.focalLengthPixels());
 }
 
 TEST(CameraTest, AutoFramingKeepsEveryCornerInsideTheImageAndDepthRange) {

@@ -33,7 +33,20 @@ TEST(CameraJsonTest, RoundTripsAndWritesRowMajorMatrices) {
     EXPECT_EQ(back.fovyDegrees, 37.5);
     EXPECT_EQ(back.nearPlane, 0.25);
     EXPECT_EQ(back.farPlane, 80);
-    EXPECT_EQ(back.view, camera.view);  // JSON numbers round-trip doubles exactly
+    EXPECT_EQ(back.view, camera.view);             // JSON numbers round-trip doubles exactly
+    EXPECT_FALSE(json.contains("jitter_pixels"));  // written only for a jittered camera
+
+    camera.jitterPixels = {0.25, -0.375};
+    const nlohmann::json jittered = cameraToJson(camera);
+    EXPECT_EQ(cameraFromJson(jittered).jitterPixels, camera.jitterPixels);
+    // The projection holds the shift: x by 2 * 0.25 / 320 in clip space per unit of w.
+    EXPECT_NEAR(jittered["projection"][0][3].get<double>() - json["projection"][0][3].get<double>(),
+                0.0, 1e-15);
+    EXPECT_NEAR(jittered["projection"][0][2].get<double>() - json["projection"][0][2].get<double>(),
+                -2.0 * 0.25 / 320, 1e-15);
+    nlohmann::json bad = jittered;
+    bad["jitter_pixels"] = {0.1};
+    EXPECT_THROW(cameraFromJson(bad), Error);
 }
 
 TEST(CameraJsonTest, InvalidFieldsAreNamed) {
