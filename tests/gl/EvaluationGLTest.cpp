@@ -68,12 +68,17 @@ TEST(EvaluationGLTest, TemporalEvaluationSeesMotionAndStillness) {
     EXPECT_EQ(still.points1px.temporalError, 0.0);
     // The filter keeps averaging more offsets: its frames change, by under a level of 255.
     EXPECT_LT(still.surfaceTemporal.temporalError, 1.0 / 255.0);
-    // Moving, the points' and the surface's pictures change as the truth's does not quite.
-    temporal.stepDegrees = 5.0;
+    // Moving, the filter's sequence changes less against the truth's than the plain surface's
+    // (measured on llvmpipe: E_t 0.0113 against 0.0125), and its first frame, converged, is
+    // closer to the supersampled truth (21.36 dB against 21.26).
+    settings.width = 64;
+    settings.height = 64;
+    temporal.frames = 6;
+    temporal.stepDegrees = 2.0;
     const TemporalReport moving = evaluateTemporal(test::glTestContext(), *truth, points, settings,
                                                    temporal, RenderSettings{});
-    EXPECT_GT(moving.points1px.temporalError, 0.0);
-    EXPECT_GT(moving.surface.temporalError, 0.0);
+    EXPECT_LT(moving.surfaceTemporal.temporalError, moving.surface.temporalError);
+    EXPECT_GT(moving.stillPsnrTemporalDb, moving.stillPsnrSurfaceDb);
     EXPECT_GT(moving.surface.psnrDb, 15.0) << "the box should be recognisable";
 
     const nlohmann::json json = toJson(moving);
