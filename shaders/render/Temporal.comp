@@ -21,7 +21,7 @@ layout(binding = SUBSCAN_IMAGE_IN1, r32f) readonly uniform image2D inDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
 #endif
 
-/// This frame at `texel` of depth `depth`.
+/// This frame at `texel` of depth `depth`, reading the radiance only on the surface.
 vec4 frameSampleAt(ivec2 texel, float depth) {
     return isinf(depth) ? vec4(frame.background.rgb, 0.0)
                         : frameSample(imageLoad(inRadiance, texel).rgb, depth);

@@ -80,10 +80,14 @@ std::vector<glm::vec3> rgbOf(const std::vector<float>& rgba) {
     return rgb;
 }
 
-/// A pipeline image of `channels` floats per texel at the output camera's pixels: each takes
-/// the texel its centre falls in (ReducedResolution.h), as the metrics compare pixel by pixel.
-std::vector<float> atOutputPixels(const std::vector<float>& values, int channels,
-                                  const Camera& output, const Camera& pipeline, int divisor) {
+/// The last frame's pipeline image `name` of `channels` floats per texel at the output camera's
+/// pixels: each takes the texel its centre falls in (ReducedResolution.h), as the metrics
+/// compare pixel by pixel.
+std::vector<float> atOutputPixels(const Renderer& renderer, const char* name, int channels,
+                                  const Camera& output) {
+    const std::vector<float> values = renderer.resources().texture(name).readFloats();
+    const Camera& pipeline = renderer.pipelineCamera();
+    const int divisor = renderer.pipelineDivisor();
     if (divisor == 1) {
         return values;
     }
@@ -219,11 +223,8 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         const int divisor =
             renderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
         report.surfaceReducedViews += divisor == 1 ? 0 : 1;
-        auto atPixels = [&](const char* name, int channels) {
-            return atOutputPixels(renderer.resources().texture(name).readFloats(), channels, camera,
-                                  renderer.pipelineCamera(), divisor);
-        };
-        ReconstructionImages images{atPixels("surfaceDepth", 1), rgbOf(atPixels("normals", 4))};
+        ReconstructionImages images{atOutputPixels(renderer, "surfaceDepth", 1, camera),
+                                    rgbOf(atOutputPixels(renderer, "normals", 4, camera))};
         QualityMetrics metrics = compareToGroundTruth(images, groundTruth, h);
         const std::vector<std::uint8_t> surfaceImage = renderer.readImage();
         metrics.psnrDb = psnr(surfaceImage, truthImage);
@@ -325,25 +326,15 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
             frames->push_back({std::move(frame.image), maskOf(frame.images.depth)});
         }
 
-        // A pipeline image at the output's pixels (a reduced frame's texel per pixel).
-        auto atOutput = [&](const Renderer& source, const std::vector<float>& values, int channels,
-                            int divisor) {
-            return atOutputPixels(values, channels, camera, source.pipelineCamera(), divisor);
-        };
-        const int divisor =
-            renderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
+        renderer.render(camera, surfaceSettings, FrameOutputs::Everything);
         surfaceFrames.push_back(
-            {renderer.readImage(),
-             maskOf(atOutput(renderer, renderer.resources().texture("surfaceDepth").readFloats(), 1,
-                             divisor))});
+            {renderer.readImage(), maskOf(atOutputPixels(renderer, "surfaceDepth", 1, camera))});
 
         // The filtered sequence starts converged at the first pose, then follows the orbit.
-        int filteredDivisor = 1;
         for (int still = 0; still < (t == 0 ? temporal.stillSamples : 1); ++still) {
-            filteredDivisor = filtered.render(camera, filteredSettings).divisor;
+            filtered.render(camera, filteredSettings);
         }
-        const std::vector<float> coverage = atOutput(
-            filtered, filtered.resources().texture("history").readFloats(), 4, filteredDivisor);
+        const std::vector<float> coverage = atOutputPixels(filtered, "history", 4, camera);
         SequenceFrame frame{filtered.readImage(), {}};
         for (std::size_t i = 3; i < coverage.size(); i += 4) {
             frame.mask.push_back(coverage[i] >= 0.5f ? 1 : 0);
