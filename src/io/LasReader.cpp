@@ -9,11 +9,14 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "core/Error.h"
 #include "io/ByteOrder.h"
+#include "io/laz/Copc.h"
+#include "io/laz/LazDecoder.h"
 
 namespace subscan {
 
@@ -52,6 +55,8 @@ constexpr std::size_t kVlrRecordIdOffset = 18;
 constexpr std::size_t kVlrLengthOffset = 20;
 constexpr std::string_view kLaszipUserId = "laszip encoded";
 constexpr std::uint16_t kLaszipRecordId = 22204;
+constexpr std::string_view kCopcUserId = "copc";
+constexpr std::uint16_t kCopcInfoRecordId = 1;
 
 constexpr std::size_t kIntensityOffset = 12;  // in every point format
 
@@ -87,6 +92,7 @@ struct LasHeader {
     glm::dvec3 scale{1.0};
     glm::dvec3 offset{0.0};
     Bounds declaredBounds;
+    std::optional<std::span<const std::byte>> laszipRecord;  // LAZ and COPC files
 };
 
 template <class T>
@@ -106,36 +112,31 @@ std::size_t requiredHeaderSize(int versionMinor) {
     return versionMinor == 3 ? kHeaderSize13 : kHeaderSize14;
 }
 
-[[noreturn]] void throwCompressed() {
-    throw Error(
-        "compressed LAS (LAZ) is not supported yet; decompress it first, e.g. with "
-        "'laszip -i in.laz -o out.las' or 'pdal translate in.laz out.las'");
-}
-
-/// Whether the VLRs (between the header and the point data) contain the laszip descriptor. A file
-/// whose format byte lost its compression bits still holds compressed points then. The VLR area
-/// belongs to other readers: a malformed one merely ends the search.
-bool hasLaszipRecord(std::span<const std::byte> file, const LasHeader& header) {
+/// The payload of the first VLR (between the header and the point data) with this user id and
+/// record id. The VLR area belongs to other readers too: a malformed one merely ends the search.
+std::optional<std::span<const std::byte>> findVlr(std::span<const std::byte> file,
+                                                  const LasHeader& header, std::string_view user,
+                                                  std::uint16_t recordId) {
     const std::uint32_t vlrCount = loadField<std::uint32_t>(file, header_field::kVlrCount);
     std::size_t position = header.headerSize;
     for (std::uint32_t i = 0; i < vlrCount; ++i) {
         if (header.pointDataOffset - position < kVlrHeaderSize) {
-            return false;
+            return std::nullopt;
         }
         const std::byte* record = file.data() + position;
         const std::string_view userId(reinterpret_cast<const char*>(record + kVlrUserIdOffset),
                                       kVlrUserIdSize);
-        if (userId.substr(0, userId.find('\0')) == kLaszipUserId &&
-            loadLittleEndian<std::uint16_t>(record + kVlrRecordIdOffset) == kLaszipRecordId) {
-            return true;
-        }
         const std::size_t payload = loadLittleEndian<std::uint16_t>(record + kVlrLengthOffset);
         if (header.pointDataOffset - position - kVlrHeaderSize < payload) {
-            return false;
+            return std::nullopt;
+        }
+        if (userId.substr(0, userId.find('\0')) == user &&
+            loadLittleEndian<std::uint16_t>(record + kVlrRecordIdOffset) == recordId) {
+            return file.subspan(position + kVlrHeaderSize, payload);
         }
         position += kVlrHeaderSize + payload;
     }
-    return false;
+    return std::nullopt;
 }
 
 void checkScaleAndOffset(const LasHeader& header) {
@@ -167,12 +168,7 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
                         "LAS header (file truncated?)",
                         file.size(), kHeaderSizeUpTo12));
     }
-    // Checked before anything else: whatever else a LAZ header says, the answer is the same.
     const auto formatByte = loadField<std::uint8_t>(file, header_field::kPointFormat);
-    if ((formatByte & kCompressionBits) != 0) {
-        throwCompressed();
-    }
-
     LasHeader header;
     const int major = loadField<std::uint8_t>(file, header_field::kVersionMajor);
     header.versionMinor = loadField<std::uint8_t>(file, header_field::kVersionMinor);
@@ -205,11 +201,14 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
                         "({} bytes; file truncated?)",
                         header.pointDataOffset, file.size()));
     }
-    if (hasLaszipRecord(file, header)) {
-        throwCompressed();
+    header.laszipRecord = findVlr(file, header, kLaszipUserId, kLaszipRecordId);
+    if ((formatByte & kCompressionBits) != 0 && !header.laszipRecord) {
+        throw Error(fmt::format(
+            "the LAS point format byte {} marks compressed (LAZ) points, but the file has no "
+            "laszip VLR describing them",
+            formatByte));
     }
-
-    header.pointFormat = formatByte;
+    header.pointFormat = formatByte & ~kCompressionBits;
     if (header.pointFormat >= static_cast<int>(kPointFormats.size())) {
         throw Error(fmt::format("the LAS point data format {} is unknown (supported: 0 to {})",
                                 header.pointFormat, kPointFormats.size() - 1));
@@ -342,15 +341,77 @@ void warnIfBoundsDisagree(const LasHeader& header, const Bounds& decoded, ReadCo
     }
 }
 
-}  // namespace
+/// LASzip compresses hardly below two bytes a point; a header that claims more than this many
+/// points per compressed byte is corrupt, and must not make us allocate its records.
+constexpr std::uint64_t kMaxLazPointsPerByte = 64;
 
-PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
-    const LasHeader header = parseHeader(file, context);
-    context.formatDetail =
-        fmt::format("LAS 1.{}, point format {}", header.versionMinor, header.pointFormat);
+/// The point records of a LAZ or COPC file, decompressed: the same bytes an uncompressed LAS
+/// file of the same points holds. COPC files are read node by node through their hierarchy.
+std::vector<std::byte> decompressLaz(std::span<const std::byte> file, const LasHeader& header,
+                                     ReadContext& context) {
+    const laz::LazLayout layout =
+        laz::parseLaszipRecord(*header.laszipRecord, header.pointFormat, header.recordLength);
+    const std::uint64_t compressedBytes = file.size() - header.pointDataOffset;
+    if (header.pointCount > kMaxLazPointsPerByte * compressedBytes) {
+        throw Error(fmt::format(
+            "the LAS header declares {} points, far more than {} bytes of LAZ data can hold "
+            "(file truncated, or the count is wrong)",
+            header.pointCount, compressedBytes));
+    }
+    std::vector<laz::Chunk> chunks;
+    const std::optional<std::span<const std::byte>> copcRecord =
+        findVlr(file, header, kCopcUserId, kCopcInfoRecordId);
+    if (copcRecord) {
+        const laz::CopcInfo info = laz::parseCopcInfo(*copcRecord);
+        const std::vector<laz::CopcNode> nodes = laz::readCopcHierarchy(file, info);
+        std::uint64_t points = 0;
+        for (const laz::CopcNode& node : nodes) {
+            chunks.push_back(node.chunk);
+            points += node.chunk.pointCount;
+        }
+        if (points != header.pointCount) {
+            throw Error(fmt::format(
+                "the COPC hierarchy's nodes hold {} points, but the LAS header declares {}", points,
+                header.pointCount));
+        }
+        context.formatDetail = fmt::format(
+            "COPC 1.0 (LAZ, LAS 1.{}, point format {}): octree of {} levels, {} nodes, root "
+            "spacing {:.6g}",
+            header.versionMinor, header.pointFormat, laz::copcLevels(nodes), nodes.size(),
+            info.rootSpacing);
+    } else {
+        chunks = laz::readChunkTable(file, header.pointDataOffset, layout, header.pointCount);
+        context.formatDetail = fmt::format(
+            "LAZ (LAS 1.{}, point format {}, {} chunks, {})", header.versionMinor,
+            header.pointFormat, chunks.size(),
+            layout.compressor == laz::kCompressorLayeredChunked ? "layered" : "pointwise");
+    }
+    std::vector<std::byte> records(static_cast<std::size_t>(header.pointCount) *
+                                   header.recordLength);
+    laz::decodeChunks(file, layout, chunks, records, context.decodeThreads,
+                      [&](std::uint64_t done) {
+                          // Decoding is most of the work; the record pass after it is quick.
+                          context.reportProgress(done, header.pointCount);
+                      });
+    return records;
+}
 
-    // One bounds check for the whole point block, before reserving anything: a lying count must
-    // neither read past the end nor allocate memory for points that are not there.
+/// The header and the point records, decompressed where the file is LAZ or COPC (then `storage`
+/// holds them); every record lies inside the returned span.
+std::span<const std::byte> pointRecords(std::span<const std::byte> file, const LasHeader& header,
+                                        ReadContext& context, std::vector<std::byte>& storage) {
+    if (header.pointCount > kMaxPoints) {
+        throw Error(
+            fmt::format("the LAS header declares {} points, more than the {} points "
+                        "subscan can hold",
+                        header.pointCount, kMaxPoints));
+    }
+    if (header.laszipRecord) {
+        storage = decompressLaz(file, header, context);
+        return storage;
+    }
+    // One bounds check for the whole point block, before reserving anything: a lying count
+    // must neither read past the end nor allocate memory for points that are not there.
     const std::size_t available = (file.size() - header.pointDataOffset) / header.recordLength;
     if (header.pointCount > available) {
         throw Error(
@@ -358,14 +419,33 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
                         "only {} (file truncated, or the count is wrong)",
                         header.pointCount, available));
     }
-    if (header.pointCount > kMaxPoints) {
-        throw Error(
-            fmt::format("the LAS header declares {} points, more than the {} points "
-                        "subscan can hold",
-                        header.pointCount, kMaxPoints));
+    return file.subspan(header.pointDataOffset,
+                        static_cast<std::size_t>(header.pointCount) * header.recordLength);
+}
+
+std::string describe(const LasHeader& header) {
+    return fmt::format("LAS 1.{}, point format {}", header.versionMinor, header.pointFormat);
+}
+
+}  // namespace
+
+LasRecords readLasRecords(std::span<const std::byte> file, ReadContext& context) {
+    const LasHeader header = parseHeader(file, context);
+    context.formatDetail = describe(header);
+    std::vector<std::byte> storage;
+    const std::span<const std::byte> records = pointRecords(file, header, context, storage);
+    if (storage.empty()) {
+        storage.assign(records.begin(), records.end());
     }
+    return {header.pointFormat, header.recordLength, std::move(storage)};
+}
+
+PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
+    const LasHeader header = parseHeader(file, context);
+    context.formatDetail = describe(header);
+    std::vector<std::byte> storage;
+    const std::byte* points = pointRecords(file, header, context, storage).data();
     const auto count = static_cast<std::size_t>(header.pointCount);
-    const std::byte* points = file.data() + header.pointDataOffset;
 
     const std::optional<std::size_t> colorOffset = kPointFormats[header.pointFormat].colorOffset;
     const ColorDepth depth =
@@ -375,17 +455,20 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
     attributes.color = colorOffset.has_value();
     attributes.intensity = true;
     PointCloudBuilder builder(attributes, count);
+    // Decompression already reported the progress of a LAZ file; the record pass is quick.
+    const ReadContext silent;
+    const ReadContext& recordContext = header.laszipRecord ? silent : context;
     switch (depth) {
         case ColorDepth::None:
-            decodePoints<ColorDepth::None>(points, count, header, 0, builder, context);
+            decodePoints<ColorDepth::None>(points, count, header, 0, builder, recordContext);
             break;
         case ColorDepth::EightBit:
             decodePoints<ColorDepth::EightBit>(points, count, header, *colorOffset, builder,
-                                               context);
+                                               recordContext);
             break;
         case ColorDepth::SixteenBit:
             decodePoints<ColorDepth::SixteenBit>(points, count, header, *colorOffset, builder,
-                                                 context);
+                                                 recordContext);
             break;
     }
     context.reportProgress(count, count);

@@ -2,16 +2,29 @@
 
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include "core/PointCloud.h"
 #include "io/ReadContext.h"
 
 namespace subscan {
 
-/// Reads an uncompressed LAS file (versions 1.0-1.4, point formats 0-10) held in memory:
-/// coordinates with scale and offset applied in double, intensity, and RGB where the point
-/// format has it (16-bit reduced to 8-bit; files that store 8-bit values in the 16-bit fields are
-/// detected). Compressed LAS (LAZ, COPC) is rejected with a clear error. Throws subscan::Error.
+/// Reads a LAS file (versions 1.0-1.4, point formats 0-10) held in memory, also compressed as
+/// LAZ (point formats 0-3 and 6-8, see io/laz) or COPC: coordinates with scale and offset
+/// applied in double, intensity, and RGB where the point format has it (16-bit reduced to 8-bit;
+/// files that store 8-bit values in the 16-bit fields are detected). Throws subscan::Error.
 PointCloud readLas(std::span<const std::byte> file, ReadContext& context);
+
+/// A LAS file's point records exactly as an uncompressed file stores them (LAZ and COPC
+/// decompressed), for the fields the cloud does not keep (classification, returns, GPS time).
+struct LasRecords {
+    int pointFormat = 0;
+    std::size_t recordLength = 0;
+    std::vector<std::byte> bytes;  // point count x record length
+
+    std::size_t size() const { return recordLength == 0 ? 0 : bytes.size() / recordLength; }
+};
+
+LasRecords readLasRecords(std::span<const std::byte> file, ReadContext& context);
 
 }  // namespace subscan

@@ -15,6 +15,8 @@ struct ReadContext {
     std::vector<std::string> warnings;
     /// Filled by the reader, e.g. "PLY 1.0 binary_little_endian" or "LAS 1.4, point format 7".
     std::string formatDetail;
+    /// Threads for readers that decode independent blocks (LAZ chunks); 0: one per core.
+    unsigned decodeThreads = 0;
 
     void reportProgress(std::size_t done, std::size_t total) const {
         if (progress && total > 0) {

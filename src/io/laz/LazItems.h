@@ -1,0 +1,60 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "io/laz/ArithmeticDecoder.h"
+
+namespace subscan::laz {
+
+/// Item types of the laszip VLR (LASzip's LASitem::Type).
+enum class ItemType : std::uint16_t {
+    Byte = 0,
+    Point10 = 6,
+    GpsTime11 = 7,
+    Rgb12 = 8,
+    WavePacket13 = 9,
+    Point14 = 10,
+    Rgb14 = 11,
+    RgbNir14 = 12,
+    WavePacket14 = 13,
+    Byte14 = 14,
+};
+
+struct ItemSpec {
+    ItemType type;
+    std::uint16_t size;     // bytes of the item in the point record
+    std::uint16_t version;  // coder generation: 2 (pointwise) or 3 (layered)
+};
+
+/// Decoder of one item of a pointwise-chunked point (compressor 2, item version 2): all items
+/// share one arithmetic stream, item after item, point after point.
+class PointwiseItemDecoder {
+  public:
+    virtual ~PointwiseItemDecoder() = default;
+    /// Starts a chunk from its first point, stored raw.
+    virtual void start(const std::byte* item) = 0;
+    virtual void decode(ArithmeticDecoder& decoder, std::byte* item) = 0;
+};
+
+/// Decoder of one item of a layered-chunked point (compressor 3, item version 3): each item has
+/// one or more layers, separate arithmetic streams whose byte counts precede them in the chunk.
+/// The scanner channel that POINT14 decodes is the context every item uses.
+class LayeredItemDecoder {
+  public:
+    virtual ~LayeredItemDecoder() = default;
+    virtual std::size_t layerCount() const = 0;
+    /// Starts a chunk: the first point raw, then the item's layers (empty ones leave the field as
+    /// in the first point for the whole chunk). `context` is the scanner channel so far.
+    virtual void start(const std::byte* item, std::span<const std::span<const std::byte>> layers,
+                       std::uint32_t& context) = 0;
+    virtual void decode(std::byte* item, std::uint32_t& context) = 0;
+};
+
+std::unique_ptr<PointwiseItemDecoder> makePointwiseItemDecoder(const ItemSpec& item);
+std::unique_ptr<LayeredItemDecoder> makeLayeredItemDecoder(const ItemSpec& item);
+
+}  // namespace subscan::laz
