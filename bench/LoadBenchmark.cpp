@@ -6,7 +6,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include "io/LasReader.h"
 #include "io/MappedFile.h"
+#include "io/ReadContext.h"
 #include "io/ScanLoader.h"
 
 namespace {
@@ -34,6 +36,49 @@ void loadFile(benchmark::State& state, const std::string& name) {
                             static_cast<std::int64_t>(std::filesystem::file_size(path)));
     state.counters["points"] = static_cast<double>(points);
 }
+
+/// LAZ decompression alone (the point records, before the cloud is built) on `threads` threads
+/// (0: one per core); items per second = points per second, in wall-clock time.
+void decodeLaz(benchmark::State& state, const std::string& name, unsigned threads) {
+    const std::filesystem::path path = dataDirectory() / name;
+    if (!std::filesystem::exists(path)) {
+        state.SkipWithError(("missing " + path.string()).c_str());
+        return;
+    }
+    const subscan::MappedFile file(path);
+    std::size_t points = 0;
+    for (auto _ : state) {
+        subscan::ReadContext context;
+        context.decodeThreads = threads;
+        const subscan::LasRecords records = subscan::readLasRecords(file.bytes(), context);
+        points = records.size();
+        benchmark::DoNotOptimize(records.bytes.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * points));
+}
+
+BENCHMARK_CAPTURE(decodeLaz, autzen_format3_1_thread, std::string("autzen_trim.laz"), 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(decodeLaz, autzen_format3_all_threads, std::string("autzen_trim.laz"), 0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(decodeLaz, lone_star_format1_1_thread, std::string("lone_star.laz"), 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(decodeLaz, lone_star_format1_all_threads, std::string("lone_star.laz"), 0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(decodeLaz, lone_star_copc_1_thread, std::string("lone_star.copc.laz"), 1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(decodeLaz, lone_star_copc_all_threads, std::string("lone_star.copc.laz"), 0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(loadFile, autzen_laz, std::string("autzen_trim.laz"))
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(loadFile, autzen_las, std::string("autzen_trim.las"))
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_CAPTURE(loadFile, happy_binary_ply, std::string("happy_stand_registered.ply"))
     ->Unit(benchmark::kMillisecond);

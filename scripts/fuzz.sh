@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) and fuzzes each reader in turn.
-#   scripts/fuzz.sh [--seconds N] [ply|las|pcd|xyz ...]      default: 300 s each, all readers
-# Seeds: tiny files written here, plus small real scans from ../shared/data when present
-# (copied into the build folder only). A finding stops the script with a non-zero exit and
+#   scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57 ...]   default: 300 s each, all
+# Seeds: tiny files written here or by the unit tests that build them (LAZ, COPC, E57; from the
+# Release build in build/), plus small real scans from ../shared/data when present (copied into
+# the build folder only). A finding stops the script with a non-zero exit and
 # leaves the input under build-fuzz/artifacts/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,17 +13,28 @@ readers=()
 while [[ $# -gt 0 ]]; do
     case "$1" in
         --seconds) seconds="$2"; shift 2 ;;
-        ply|las|pcd|xyz) readers+=("$1"); shift ;;
-        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|pcd|xyz ...]" >&2; exit 2 ;;
+        ply|las|laz|copc|pcd|xyz|e57) readers+=("$1"); shift ;;
+        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57 ...]" >&2; exit 2 ;;
     esac
 done
-[[ ${#readers[@]} -gt 0 ]] || readers=(ply las pcd xyz)
+[[ ${#readers[@]} -gt 0 ]] || readers=(ply las laz copc pcd xyz e57)
 
 scripts/setup-deps.sh
 build=build-fuzz
 CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DSUBSCAN_FUZZ=ON \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build "$build" --target "${readers[@]/#/fuzz_}"
+
+# Seeds the unit tests build (a LAZ encoder, an E57 writer live there): run them from the
+# Release build, building just those tests when it lacks them.
+test_seeds() {  # test-binary environment-variable directory
+    local test=$1 variable=$2 dir=$3
+    if [[ ! -x build/tests/$test ]]; then
+        cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+        cmake --build build --target "$test" >/dev/null
+    fi
+    env "$variable=$dir" "build/tests/$test" >/dev/null
+}
 
 # Little-endian integers for the hand-made LAS seed.
 le() {  # value bytes
@@ -59,6 +71,16 @@ write_seeds() {  # reader directory
                 le 0 48                                          # bounds (not checked here)
                 for p in 1 2; do le $p 4; le $((p * 2)) 4; le $((p * 3)) 4; le 100 2; le 0 6
                     le 65535 2; le 0 2; le 255 2; done; } >"$dir/format2.las"
+            ;;
+        e57)
+            printf 'ASTM-E57' >"$dir/magic.e57"
+            ;;
+        laz|copc)
+            local all="$dir/../all-laz"
+            mkdir -p "$all"
+            test_seeds LazReaderTest SUBSCAN_LAZ_SEEDS "$all"
+            if [[ $reader == copc ]]; then cp "$all"/*.copc.laz "$dir/"; else
+                find "$all" -name '*.laz' ! -name '*.copc.laz' -exec cp {} "$dir/" \; ; fi
             ;;
     esac
     local data=../shared/data

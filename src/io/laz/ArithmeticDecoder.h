@@ -96,6 +96,11 @@ class ArithmeticDecoder {
     }
 
     std::uint32_t decodeSymbol(SymbolModel& model) {
+        // A valid stream keeps the value inside the interval; a corrupt one could index past
+        // the decoder table.
+        if (value_ >= length_) {
+            throw Error("the LAZ point data is corrupt (a coded value lies outside its interval)");
+        }
         std::uint32_t upper = length_;
         std::uint32_t symbol;
         std::uint32_t lower;

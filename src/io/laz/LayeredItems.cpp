@@ -128,6 +128,63 @@ enum Point14Layer : std::size_t {
     kPoint14Layers
 };
 
+/// What POINT14 keeps per scanner channel: the last point, the predictors and the models.
+struct Point14ChannelState {
+    bool used = false;
+    Point14 last;
+    std::array<std::uint16_t, 8> lastIntensities{};
+    std::array<Median5, 12> xDiffMedians{};
+    std::array<Median5, 12> yDiffMedians{};
+    std::array<std::int32_t, 8> lastZ{};
+
+    std::array<SymbolModel, 8> changedValues{SymbolModel(128), SymbolModel(128), SymbolModel(128),
+                                             SymbolModel(128), SymbolModel(128), SymbolModel(128),
+                                             SymbolModel(128), SymbolModel(128)};
+    SymbolModel scannerChannel{3};
+    LazySymbolModels numberOfReturns{16, 16};
+    SymbolModel returnNumberGpsSame{13};
+    LazySymbolModels returnNumber{16, 16};
+    IntegerDecompressor dx{32, 2};
+    IntegerDecompressor dy{32, 22};
+    IntegerDecompressor z{32, 20};
+    LazySymbolModels classifications{64, 256};
+    LazySymbolModels flags{64, 64};
+    LazySymbolModels userData{64, 256};
+    IntegerDecompressor intensity{16, 4};
+    IntegerDecompressor scanAngle{16, 2};
+    IntegerDecompressor pointSource{16, 1};
+    GpsTimeDecoder gpsTime{false};
+
+    void reset(const Point14& from) {
+        for (SymbolModel& model : changedValues) {
+            model.reset();
+        }
+        scannerChannel.reset();
+        numberOfReturns.reset();
+        returnNumberGpsSame.reset();
+        returnNumber.reset();
+        dx.reset();
+        dy.reset();
+        for (std::size_t i = 0; i < xDiffMedians.size(); ++i) {
+            xDiffMedians[i].reset();
+            yDiffMedians[i].reset();
+        }
+        z.reset();
+        lastZ.fill(from.z);
+        classifications.reset();
+        flags.reset();
+        userData.reset();
+        intensity.reset();
+        lastIntensities.fill(from.intensity);
+        scanAngle.reset();
+        pointSource.reset();
+        gpsTime.reset(from.gpsTimeBits);
+        last = from;
+        last.gpsTimeChanged = false;
+        used = true;
+    }
+};
+
 class Point14Decoder final : public LayeredItemDecoder {
   public:
     std::size_t layerCount() const override { return kPoint14Layers; }
@@ -137,7 +194,7 @@ class Point14Decoder final : public LayeredItemDecoder {
         for (std::size_t i = 0; i < kPoint14Layers; ++i) {
             layers_[i].start(layers[i]);
         }
-        for (std::optional<ChannelState>& channel : channels_) {
+        for (std::optional<Point14ChannelState>& channel : channels_) {
             if (channel) {
                 channel->used = false;
             }
@@ -153,7 +210,7 @@ class Point14Decoder final : public LayeredItemDecoder {
         if (!layers_[kChannelReturnsXY].changes) {
             throw Error("the LAZ chunk has more than one point but no coordinate layer");
         }
-        ChannelState* state = &*channels_[current_];
+        Point14ChannelState* state = &*channels_[current_];
         Point14* last = &state->last;
 
         std::uint32_t previous = last->returnNumber == 1 ? 1 : 0;
@@ -269,62 +326,6 @@ class Point14Decoder final : public LayeredItemDecoder {
     }
 
   private:
-    struct ChannelState {
-        bool used = false;
-        Point14 last;
-        std::array<std::uint16_t, 8> lastIntensities{};
-        std::array<Median5, 12> xDiffMedians{};
-        std::array<Median5, 12> yDiffMedians{};
-        std::array<std::int32_t, 8> lastZ{};
-
-        std::array<SymbolModel, 8> changedValues{
-            SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128),
-            SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128)};
-        SymbolModel scannerChannel{3};
-        LazySymbolModels numberOfReturns{16, 16};
-        SymbolModel returnNumberGpsSame{13};
-        LazySymbolModels returnNumber{16, 16};
-        IntegerDecompressor dx{32, 2};
-        IntegerDecompressor dy{32, 22};
-        IntegerDecompressor z{32, 20};
-        LazySymbolModels classifications{64, 256};
-        LazySymbolModels flags{64, 64};
-        LazySymbolModels userData{64, 256};
-        IntegerDecompressor intensity{16, 4};
-        IntegerDecompressor scanAngle{16, 2};
-        IntegerDecompressor pointSource{16, 1};
-        GpsTimeDecoder gpsTime{false};
-
-        void reset(const Point14& from) {
-            for (SymbolModel& model : changedValues) {
-                model.reset();
-            }
-            scannerChannel.reset();
-            numberOfReturns.reset();
-            returnNumberGpsSame.reset();
-            returnNumber.reset();
-            dx.reset();
-            dy.reset();
-            for (std::size_t i = 0; i < xDiffMedians.size(); ++i) {
-                xDiffMedians[i].reset();
-                yDiffMedians[i].reset();
-            }
-            z.reset();
-            lastZ.fill(from.z);
-            classifications.reset();
-            flags.reset();
-            userData.reset();
-            intensity.reset();
-            lastIntensities.fill(from.intensity);
-            scanAngle.reset();
-            pointSource.reset();
-            gpsTime.reset(from.gpsTimeBits);
-            last = from;
-            last.gpsTimeChanged = false;
-            used = true;
-        }
-    };
-
     /// A channel's first point in the chunk continues from `from` (the first point, or the last
     /// point of the channel the stream switched from).
     void startChannel(std::uint32_t channel, const Point14& from) {
@@ -336,7 +337,7 @@ class Point14Decoder final : public LayeredItemDecoder {
     }
 
     std::array<Layer, kPoint14Layers> layers_;
-    std::array<std::optional<ChannelState>, kChannels> channels_;
+    std::array<std::optional<Point14ChannelState>, kChannels> channels_;
     std::uint32_t current_ = 0;
 };
 

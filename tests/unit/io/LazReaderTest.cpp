@@ -6,10 +6,14 @@
 // them against an independent encoder.
 #include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -265,6 +269,7 @@ struct LazFile {
     std::vector<std::string> chunks;
     std::vector<std::uint32_t> chunkPoints;
     std::uint64_t pointCount = 0;
+    bool copcInfoVlr = false;  // a "copc" info VLR (zeros, for the test to fill) comes first
 
     std::size_t recordLength() const {
         std::size_t length = 0;
@@ -318,6 +323,13 @@ struct LazFile {
         const auto payloadSize = static_cast<std::uint16_t>(payload.size());
         std::memcpy(vlr.data() + 20, &payloadSize, 2);
         vlr += payload;
+        if (copcInfoVlr) {
+            std::string info(54 + 160, '\0');
+            std::memcpy(info.data() + 2, "copc", 4);
+            info[18] = 1;  // record 1
+            info[20] = static_cast<char>(160);
+            vlr = info + vlr;
+        }
 
         const std::size_t pointData = headerSize + vlr.size();
         std::string points;
@@ -333,7 +345,7 @@ struct LazFile {
         };
         put(94, static_cast<std::uint16_t>(headerSize));
         put(96, static_cast<std::uint32_t>(pointData));
-        put(100, std::uint32_t{1});
+        put(100, std::uint32_t{copcInfoVlr ? 2u : 1u});
         put(104, static_cast<std::uint8_t>(pointFormat | 0x80));
         put(105, static_cast<std::uint16_t>(recordLength()));
         put(107, static_cast<std::uint32_t>(pointFormat < 6 ? pointCount : 0));
@@ -348,6 +360,14 @@ struct LazFile {
         return file + points + chunkTable();
     }
 };
+
+/// scripts/fuzz.sh starts the LAZ and COPC fuzzers from the files these tests build: with
+/// SUBSCAN_LAZ_SEEDS set, they are also written there.
+void saveFuzzSeed(const std::string& name, const std::string& bytes) {
+    if (const char* directory = std::getenv("SUBSCAN_LAZ_SEEDS"); directory && *directory) {
+        std::ofstream(std::filesystem::path(directory) / name, std::ios::binary) << bytes;
+    }
+}
 
 std::string recordsError(const std::string& file) {
     try {
@@ -442,6 +462,7 @@ TEST(LazReaderTest, PointwiseFormat0WithExtraBytesInFixedChunks) {
     const Format0Points points(7);
     // Chunks of 3, 3 and 1 points: the last holds only its raw first point.
     const std::string file = format0File(points, 3).bytes();
+    saveFuzzSeed("format0-extra-bytes.laz", file);
     const LasRecords records = decodeRecords(file);
     ASSERT_EQ(records.recordLength, 22u);
     ASSERT_EQ(records.size(), 7u);
@@ -663,6 +684,7 @@ TEST(LazReaderTest, LayeredFormats7And8WithExtraBytesInVariableChunks) {
         const Layered14Points points(format, 40, 3);
         // Variable chunks, one of them a single point (no layers at all).
         const std::string file = layeredFile(points, {25, 1, 14}).bytes();
+        saveFuzzSeed(fmt::format("format{}-extra-bytes.laz", format), file);
         const LasRecords records = decodeRecords(file);
         ASSERT_EQ(records.pointFormat, format);
         ASSERT_EQ(records.recordLength, 30 + points.colourBytes() + 3);
@@ -701,6 +723,95 @@ TEST(LazReaderTest, MalformedLayeredChunksAreRefused) {
     LazFile pointwiseItems = file;
     pointwiseItems.compressor = 2;
     EXPECT_THAT(recordsError(pointwiseItems.bytes()), HasSubstr("must match the compressor"));
+}
+
+/// A COPC file of `points` (format 6-8) in two nodes: the root (key 0-0-0-0) and one child
+/// (1-0-0-0) listed on a second hierarchy page that the root page points to.
+struct CopcLayout {
+    std::string bytes;
+    std::size_t infoPayload = 0;  // offset of the copc info VLR's payload
+    std::size_t rootPage = 0;
+    std::size_t childPage = 0;
+};
+
+CopcLayout copcFile(const Layered14Points& points, std::size_t rootPoints) {
+    LazFile file = layeredFile(points, {rootPoints, points.x.size() - rootPoints});
+    file.copcInfoVlr = true;
+    CopcLayout copc;
+    copc.bytes = file.bytes();
+    copc.infoPayload = 375 + 54;
+    const auto pointData = loadLittleEndian<std::uint32_t>(copc.bytes.data() + 96);
+    const std::uint64_t firstChunk = pointData + 8;
+    const auto entry = [](std::string& page, std::array<std::int32_t, 4> key, std::uint64_t offset,
+                          std::int32_t byteSize, std::int32_t pointCount) {
+        for (std::int32_t k : key) {
+            appendBytes(page, k);
+        }
+        appendBytes(page, offset);
+        appendBytes(page, byteSize);
+        appendBytes(page, pointCount);
+    };
+    // The hierarchy EVLR's 60-byte header (not read: the info VLR points at the page itself).
+    copc.bytes += std::string(60, '\0');
+    copc.rootPage = copc.bytes.size();
+    copc.childPage = copc.rootPage + 64;
+    std::string pages;
+    entry(pages, {0, 0, 0, 0}, firstChunk, static_cast<std::int32_t>(file.chunks[0].size()),
+          static_cast<std::int32_t>(rootPoints));
+    entry(pages, {1, 0, 0, 0}, copc.childPage, 32, -1);
+    entry(pages, {1, 0, 0, 0}, firstChunk + file.chunks[0].size(),
+          static_cast<std::int32_t>(file.chunks[1].size()),
+          static_cast<std::int32_t>(points.x.size() - rootPoints));
+    copc.bytes += pages;
+    const auto put = [&](std::size_t offset, auto value) {
+        std::memcpy(copc.bytes.data() + offset, &value, sizeof(value));
+    };
+    put(copc.infoPayload + 24, 100.0);  // half size
+    put(copc.infoPayload + 32, 0.5);    // root spacing
+    put(copc.infoPayload + 40, static_cast<std::uint64_t>(copc.rootPage));
+    put(copc.infoPayload + 48, std::uint64_t{64});
+    return copc;
+}
+
+TEST(LazReaderTest, CopcNodesAreReadThroughTheHierarchyPages) {
+    const Layered14Points points(7, 30, 0);
+    const CopcLayout copc = copcFile(points, 18);
+    saveFuzzSeed("two-nodes.copc.laz", copc.bytes);
+    const LasRecords records = decodeRecords(copc.bytes);
+    ASSERT_EQ(records.size(), 30u);
+    for (std::size_t i = 0; i < 30; ++i) {
+        const std::string expected = points.record(i);
+        EXPECT_EQ(0, std::memcmp(records.bytes.data() + records.recordLength * i, expected.data(),
+                                 expected.size()))
+            << "point " << i;
+    }
+    EXPECT_THAT(test::decode(copc.bytes, "x.copc.laz").formatDetail,
+                HasSubstr("octree of 2 levels, 2 nodes, root spacing 0.5"));
+}
+
+TEST(LazReaderTest, MalformedCopcHierarchiesAreRefused) {
+    const Layered14Points points(7, 20, 0);
+    const CopcLayout copc = copcFile(points, 12);
+    const auto with = [&](std::size_t offset, auto value) {
+        std::string bytes = copc.bytes;
+        std::memcpy(bytes.data() + offset, &value, sizeof(value));
+        return bytes;
+    };
+    // The child page's entry (the one with the points) sits at the child page.
+    EXPECT_THAT(recordsError(with(copc.rootPage + 32 + 16, std::uint64_t{1} << 40)),
+                HasSubstr("hierarchy page at byte 1099511627776"));
+    EXPECT_THAT(recordsError(with(copc.childPage + 24, std::int32_t{1} << 30)),
+                HasSubstr("node 1-0-0-0 lies beyond the end of the file"));
+    EXPECT_THAT(recordsError(with(copc.childPage + 28, std::int32_t{-5})),
+                HasSubstr("point count -5"));
+    EXPECT_THAT(recordsError(with(copc.childPage + 28, std::int32_t{9})),
+                HasSubstr("nodes hold 21 points, but the LAS header declares 20"));
+    EXPECT_THAT(recordsError(with(copc.infoPayload + 48, std::uint64_t{40})),
+                HasSubstr("multiple of its 32-byte entries"));
+    // A child page that lists the root page again is read once, not forever.
+    const std::string cycle =
+        with(copc.rootPage + 32 + 16, static_cast<std::uint64_t>(copc.rootPage));
+    EXPECT_THAT(recordsError(cycle), HasSubstr("nodes hold 12 points"));
 }
 
 }  // namespace
