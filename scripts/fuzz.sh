@@ -74,6 +74,7 @@ write_seeds() {  # reader directory
             ;;
         e57)
             printf 'ASTM-E57' >"$dir/magic.e57"
+            test_seeds E57ReaderTest SUBSCAN_E57_SEEDS "$dir"
             ;;
         laz|copc)
             local all="$dir/../all-laz"

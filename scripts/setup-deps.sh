@@ -14,7 +14,7 @@ packages=(
     libglfw3-dev libimgui-dev xvfb xauth
     # libraries
     libglm-dev libstb-dev libcli11-dev libfmt-dev nlohmann-json3-dev libfast-float-dev
-    liblzf-dev libnanoflann-dev libeigen3-dev
+    liblzf-dev libnanoflann-dev libeigen3-dev libpugixml-dev
     # tests and benchmarks
     libgtest-dev libgmock-dev libbenchmark-dev
     # run time: `subscan turntable -o OUT.mp4` encodes with ffmpeg (folders of PNGs need nothing)

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/Error.h"
+#include "io/E57Reader.h"
 #include "io/LasReader.h"
 #include "io/MappedFile.h"
 #include "io/PcdReader.h"
@@ -143,9 +144,9 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
             scan.cloud = readXyz(file, context);
             break;
         case ScanFormat::E57:
-            throw Error(
-                "E57 files are not supported yet; convert the scan to PLY, LAS or PCD "
-                "(e.g. with CloudCompare or PDAL)");
+            scan.format = "e57";
+            scan.cloud = readE57(file, context);
+            break;
         case ScanFormat::Off:
             throw Error(
                 "OFF meshes are not supported yet; convert the file to PLY (e.g. with MeshLab, "

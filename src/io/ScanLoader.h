@@ -19,7 +19,7 @@ ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::
 
 struct LoadedScan {
     PointCloud cloud;
-    std::string format;        // "ply", "las", "pcd", "xyz" or "synthetic"
+    std::string format;        // "ply", "las", "pcd", "xyz", "e57" or "synthetic"
     std::string formatDetail;  // e.g. "PLY 1.0 binary_little_endian"
     std::vector<std::string> warnings;
     double loadMilliseconds = 0.0;  // reading and decoding, nothing after

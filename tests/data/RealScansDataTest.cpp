@@ -1,5 +1,7 @@
 // `subscan info` and `subscan render` on every file of the shared real-scan folder
 // (../shared/data or $SUBSCAN_TEST_DATA; see its README). Skipped, visibly, when it is absent.
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/Image.h"
+#include "io/ScanLoader.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
@@ -39,8 +42,8 @@ const Expected kFiles[] = {
     {"bun_zipper_res2.ply", 8171, 16301, nullptr},
     {"bun_zipper_res3.ply", 1889, 3851, nullptr},
     {"bun_zipper_res4.ply", 453, 948, nullptr},
-    {"bunnyDouble.e57", 0, 0, "E57 files are not supported yet"},
-    {"bunnyInt32.e57", 0, 0, "E57 files are not supported yet"},
+    {"bunnyDouble.e57", 30571, 0, nullptr},
+    {"bunnyInt32.e57", 30571, 0, nullptr},
     {"bunny_scans_registered.ply", 362272, 0, nullptr},
     {"dragon_stand_registered.ply", 469193, 0, nullptr},
     {"happy_stand_registered.ply", 1099005, 0, nullptr},
@@ -147,6 +150,37 @@ TEST(RealScansDataTest, UtmCoordinatesStayInUtm) {
     // Northing around 5.4e6 m, easting around 5.1e5 m (README).
     EXPECT_NEAR(json["bounds_min"][1].get<double>(), 5.4e6, 1e4);
     EXPECT_NEAR(json["bounds_min"][0].get<double>(), 5.13e5, 1e4);
+}
+
+TEST(RealScansDataTest, BunnyE57InDoubleAndScaledIntegerHoldTheSamePoints) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const LoadedScan doubles = loadScan((data / "bunnyDouble.e57").string());
+    const LoadedScan integers = loadScan((data / "bunnyInt32.e57").string());
+    EXPECT_EQ(doubles.formatDetail, "E57 1.0, 1 scan, cartesian Float (double)");
+    EXPECT_EQ(integers.formatDetail, "E57 1.0, 1 scan, cartesian ScaledInteger");
+    EXPECT_TRUE(doubles.warnings.empty());
+    EXPECT_TRUE(integers.warnings.empty());
+    ASSERT_EQ(doubles.cloud.size(), 30571u);
+    ASSERT_EQ(integers.cloud.size(), 30571u);
+    // The Int32 file stores the same scan quantised to its scale of 1e-6 m: a writer rounding
+    // to the nearest step moves a coordinate by at most half a step, 5e-7. Both clouds keep
+    // floats relative to their centre over a 0.16 m extent, adding ~1e-8. (In these two files
+    // the doubles happen to be whole micrometres, so the decoded values agree exactly.)
+    constexpr double kTolerance = 5e-7 + 2e-8;
+    double largest = 0.0;
+    for (std::size_t i = 0; i < doubles.cloud.size(); ++i) {
+        const glm::dvec3 d = doubles.cloud.fileCoordinates(i) - integers.cloud.fileCoordinates(i);
+        largest = std::max({largest, std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    }
+    EXPECT_LE(largest, kTolerance);
+    // The cartesianBounds both files' XML declares.
+    const glm::dvec3 low{-0.094689, 0.040011, -0.061873}, high{0.061009, 0.187321, 0.058799};
+    for (const LoadedScan* scan : {&doubles, &integers}) {
+        for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_NEAR(scan->cloud.bounds.min[axis], low[axis], 1e-12);
+            EXPECT_NEAR(scan->cloud.bounds.max[axis], high[axis], 1e-12);
+        }
+    }
 }
 
 TEST(RealScansDataTest, EveryReadableFileRenders) {

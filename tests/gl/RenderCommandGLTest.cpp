@@ -84,11 +84,6 @@ std::string asciiPly(const std::vector<glm::dvec3>& points) {
 }
 
 /// A PFM reader written here, independent of subscan's, as an outside tool would.
-std::string fileBytes(const std::filesystem::path& path) {
-    std::ifstream stream(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(stream), {}};
-}
-
 std::vector<float> readDepthPfm(const std::filesystem::path& path, int& width, int& height) {
     std::ifstream stream(path, std::ios::binary);
     std::string magic;
@@ -192,7 +187,7 @@ TEST(RenderCommandGLTest, FarFromTheOriginRendersLikeAtTheOrigin) {
     }
     // 4e6 m stored as float would move points by 0.25 m, i.e. many pixels: identical images
     // show the double-precision path keeps every point in its pixel.
-    EXPECT_EQ(fileBytes(dir / "near.png"), fileBytes(dir / "far.png"));
+    EXPECT_EQ(test::fileBytes(dir / "near.png"), test::fileBytes(dir / "far.png"));
 }
 
 TEST(RenderCommandGLTest, EveryModeDrawsTheObject) {
@@ -290,7 +285,7 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
         EXPECT_FALSE(std::filesystem::exists(out));
     }
     // The refused overwrite left the input intact.
-    EXPECT_EQ(fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+    EXPECT_EQ(test::fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
 }
 
 /// The RGB of pixel i of a 3-channel PFM.

@@ -18,11 +18,6 @@ namespace {
 using test::runSubscan;
 using ::testing::HasSubstr;
 
-std::string fileBytes(const std::filesystem::path& path) {
-    std::ifstream stream(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(stream), {}};
-}
-
 const std::vector<std::string> kScene = {
     "synthetic:sphere?points=4000", "--mode", "surface", "--width", "40", "--height", "32"};
 
@@ -52,16 +47,17 @@ TEST(TurntableCommandGLTest, FramesStartConvergedAndTurnByDegreesOverFrames) {
                         {"--yaw", "10", "--samples", "16", "-o", (dir / "still.png").string(),
                          "--export-buffers", (dir / "still").string()}));
     ASSERT_EQ(still.exitCode, 0) << still.err;
-    EXPECT_EQ(fileBytes(dir / "frames" / "0000.png"), fileBytes(dir / "still.png"));
+    EXPECT_EQ(test::fileBytes(dir / "frames" / "0000.png"), test::fileBytes(dir / "still.png"));
 
     // Frame 2's camera is render's at yaw 10 + 2 x 90 / 3, without jitter.
     const auto render = runSubscan(
         with(with({"render"}, kScene), {"--yaw", "70", "-o", (dir / "yaw70.png").string(),
                                         "--export-buffers", (dir / "yaw70").string()}));
     ASSERT_EQ(render.exitCode, 0) << render.err;
-    const nlohmann::json expected = nlohmann::json::parse(fileBytes(dir / "yaw70" / "camera.json"));
+    const nlohmann::json expected =
+        nlohmann::json::parse(test::fileBytes(dir / "yaw70" / "camera.json"));
     const nlohmann::json actual =
-        nlohmann::json::parse(fileBytes(dir / "buffers" / "0002" / "camera.json"));
+        nlohmann::json::parse(test::fileBytes(dir / "buffers" / "0002" / "camera.json"));
     for (const char* matrix : {"view", "projection"}) {
         for (int r = 0; r < 4; ++r) {
             for (int c = 0; c < 4; ++c) {
@@ -84,7 +80,7 @@ TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
     const auto result = runSubscan(
         with(with({"turntable"}, kScene), {"-o", (dir / "spin.mp4").string(), "--frames", "4"}));
     ASSERT_EQ(result.exitCode, 0) << result.err;
-    const std::string video = fileBytes(dir / "spin.mp4");
+    const std::string video = test::fileBytes(dir / "spin.mp4");
     ASSERT_GT(video.size(), 8u);
     EXPECT_EQ(video.substr(4, 4), "ftyp");  // an ISO media file
     // Nothing left beside it: the frames' folder and the partial file are gone.
@@ -110,7 +106,7 @@ TEST(TurntableCommandGLTest, RefusesWhatItCannotDoWithOneSentence) {
     const auto overInput = runSubscan({"turntable", scan.string(), "-o", scan.string()});
     EXPECT_EQ(overInput.exitCode, 1);
     EXPECT_THAT(overInput.err, HasSubstr("refusing to write"));
-    EXPECT_EQ(fileBytes(scan), "0 0 0\n1 0 0\n0 1 0\n");
+    EXPECT_EQ(test::fileBytes(scan), "0 0 0\n1 0 0\n0 1 0\n");
 
     // --save-settings over the settings file it reads.
     const std::filesystem::path settings = dir.write("settings.json", "{}");
@@ -119,7 +115,7 @@ TEST(TurntableCommandGLTest, RefusesWhatItCannotDoWithOneSentence) {
                                         settings.string(), "--save-settings", settings.string()}));
     EXPECT_EQ(overSettings.exitCode, 1);
     EXPECT_THAT(overSettings.err, HasSubstr("refusing to write the settings"));
-    EXPECT_EQ(fileBytes(settings), "{}");
+    EXPECT_EQ(test::fileBytes(settings), "{}");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "support/TestSupport.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <random>
@@ -10,7 +12,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
 
 #include "core/Error.h"
 
@@ -71,16 +75,27 @@ std::string decodeError(std::string_view bytes, std::string_view fileName) {
     return {};
 }
 
-namespace {
-
-std::string readWhole(const std::filesystem::path& file) {
+std::string fileBytes(const std::filesystem::path& file) {
     std::ifstream stream(file, std::ios::binary);
-    std::ostringstream contents;
-    contents << stream.rdbuf();
-    return contents.str();
+    return {std::istreambuf_iterator<char>(stream), {}};
 }
 
-}  // namespace
+std::size_t lineCount(std::string_view text) {
+    return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+void expectUnwritablePathIsAnErrorNamingIt(
+    const std::function<void(const std::filesystem::path&)>& write, std::string_view fileName) {
+    const TempDir dir;
+    const std::filesystem::path path = dir / "missing" / fileName;
+    try {
+        write(path);
+        ADD_FAILURE() << "no error for a directory that does not exist";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr(path.string()));
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir.path())) << "something was written";
+}
 
 CommandResult runSubscan(const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment) {
@@ -131,9 +146,43 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
 
     CommandResult result;
     result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = readWhole(outPath);
-    result.err = readWhole(errPath);
+    result.out = fileBytes(outPath);
+    result.err = fileBytes(errPath);
     return result;
+}
+
+void expectPositionsNear(const PointCloud& actual, const PointCloud& expected, double tolerance) {
+    ASSERT_EQ(actual.size(), expected.size());
+    int failures = 0;
+    for (std::size_t i = 0; i < expected.size() && failures < 10; ++i) {
+        const glm::dvec3 a = actual.fileCoordinates(i);
+        const glm::dvec3 e = expected.fileCoordinates(i);
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!(std::abs(a[axis] - e[axis]) <= tolerance)) {
+                ADD_FAILURE() << "point " << i << " axis " << axis << ": " << a[axis] << " vs "
+                              << e[axis] << " (tolerance " << tolerance << ")";
+                ++failures;  // a few are enough to see what is wrong with 110,000 points
+            }
+        }
+    }
+}
+
+PointCloud utmCloudWithEveryAttribute() {
+    const glm::dvec3 corner(512345.25, 5432109.5, 97.0);
+    const glm::dvec3 offsets[] = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {2.5, 5, 10}, {10, 10, 7.5}};
+    const float intensities[] = {0.0f, 1.25f, 2.5f, 70000.0f, -3.0f};
+    PointCloudBuilder builder({.color = true, .normal = true, .intensity = true}, 5);
+    for (int i = 0; i < 5; ++i) {
+        PointRecord record;
+        record.position = corner + offsets[i];
+        record.color = {static_cast<std::uint8_t>(60 * i), 200, static_cast<std::uint8_t>(255 - i),
+                        255};
+        record.normal = glm::normalize(glm::vec3(i, 1, -i));
+        record.intensity = intensities[i];
+        builder.add(record);
+    }
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
 }
 
 std::optional<std::filesystem::path> testDataDirectory() {

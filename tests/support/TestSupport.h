@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -34,6 +35,17 @@ class TempDir {
 
 std::span<const std::byte> asBytes(std::string_view text);
 
+/// The whole file's bytes (empty when it cannot be read).
+std::string fileBytes(const std::filesystem::path& file);
+
+/// The number of newline characters in `text`.
+std::size_t lineCount(std::string_view text);
+
+/// Expects `write` to a file in a folder that does not exist to throw subscan::Error naming the
+/// path, and to leave nothing behind.
+void expectUnwritablePathIsAnErrorNamingIt(
+    const std::function<void(const std::filesystem::path&)>& write, std::string_view fileName);
+
 /// Decodes an in-memory file as loadScan would after reading it (format by content, then name).
 LoadedScan decode(std::string_view bytes, std::string_view fileName = "scan");
 
@@ -58,6 +70,17 @@ std::optional<std::filesystem::path> testDataDirectory();
 /// Expects point i of `cloud` at (x, y, z) in file coordinates. Positions are floats relative to
 /// the cloud's centre; the test clouds span less than 10 units, where float steps are ~1e-6.
 void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, double z);
+
+/// Expects `actual` to hold as many points as `expected`, each within `tolerance` of its
+/// counterpart's file coordinates on every axis (the caller says why that tolerance).
+void expectPositionsNear(const PointCloud& actual, const PointCloud& expected, double tolerance);
+
+/// The writers' round-trip cloud: 5 points with colour, intensity and normals at UTM-like
+/// coordinates, 10 m across from (512345.25, 5432109.5, 97) to (512355.25, 5432119.5, 107).
+/// Every coordinate is a multiple of 0.25 m, so the float positions relative to the centre are
+/// exact and the file coordinates known to the last bit. Intensities include a fraction, a
+/// value above 65535 and a negative one (what LAS must round or clamp).
+PointCloud utmCloudWithEveryAttribute();
 
 /// Appends the bytes of `value` in little- or big-endian order.
 template <class T>

@@ -18,10 +18,6 @@ namespace {
 using test::runSubscan;
 using ::testing::HasSubstr;
 
-std::size_t lineCount(const std::string& text) {
-    return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
-}
-
 TEST(ScanCommandTest, SyntheticSceneScanPrintsJsonAndWritesThePly) {
     const test::TempDir dir;
     const auto out = dir / "torus.ply";
@@ -58,7 +54,7 @@ TEST(ScanCommandTest, MeshScanPrintsOneLine) {
     const test::CommandResult result =
         runSubscan({"scan", mesh.string(), "-o", out.string(), "--resolution", "32"});
     ASSERT_EQ(result.exitCode, 0) << result.err;
-    EXPECT_EQ(lineCount(result.out), 1u);
+    EXPECT_EQ(test::lineCount(result.out), 1u);
     EXPECT_THAT(result.out, HasSubstr("points scanned from " + mesh.string()));
     const LoadedScan scan = loadScan(out.string());
     EXPECT_GT(scan.cloud.size(), 1000u);   // 8 views of 32 x 32, the ball fills ~half of each
@@ -81,7 +77,7 @@ TEST(ScanCommandTest, RefusesToWriteOverItsInput) {
         const test::CommandResult result =
             runSubscan({"scan", mesh.string(), "-o", output, "--resolution", "8"});
         EXPECT_EQ(result.exitCode, 1);
-        EXPECT_EQ(lineCount(result.err), 1u) << result.err;
+        EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
         EXPECT_THAT(result.err, HasSubstr("refusing to write the scan over its own input"));
         EXPECT_EQ(std::filesystem::file_size(mesh), before);
     }
@@ -106,7 +102,7 @@ TEST(ScanCommandTest, InputErrorsExitWithOneAndLeaveNoOutput) {
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const test::CommandResult result = runSubscan(cases[i]);
         EXPECT_EQ(result.exitCode, 1) << cases[i][1];
-        EXPECT_EQ(lineCount(result.err), 1u) << result.err;
+        EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
         EXPECT_THAT(result.err, HasSubstr(messages[i]));
         EXPECT_TRUE(result.out.empty());
     }

@@ -24,6 +24,11 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code ignored;  // a path that does not exist is no other file
+    return std::filesystem::equivalent(a, b, ignored);
+}
+
 std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text) {
     glm::vec3 value;
     char comma1 = 0, comma2 = 0;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -15,6 +16,10 @@ namespace subscan::cli {
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".
 LoadedScan loadScanForCommand(std::string_view source);
+
+/// Whether `a` and `b` are the same existing file, also through another spelling of the path or
+/// a link: the guard that keeps commands from writing over their inputs.
+bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
 
 /// "R,G,B": three numbers separated by commas (no spaces), or nullopt when `text` is not that.
 std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text);

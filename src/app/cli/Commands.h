@@ -14,6 +14,7 @@ struct Command {
 };
 
 Command addBenchCommand(CLI::App& parent);
+Command addConvertCommand(CLI::App& parent);
 Command addEvalCommand(CLI::App& parent);
 Command addFitProfileCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);

@@ -1,7 +1,5 @@
 #include "app/cli/FrameOptions.h"
 
-#include <system_error>
-
 #include <fmt/format.h>
 #include <glm/vector_relational.hpp>
 
@@ -26,11 +24,6 @@ glm::vec3 parseBackground(const std::string& text) {
             fmt::format("--background '{}' is not R,G,B with values in 0..1 or #rrggbb", text));
     }
     return *color;
-}
-
-bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
-    std::error_code ignored;
-    return std::filesystem::equivalent(a, b, ignored);
 }
 
 }  // namespace

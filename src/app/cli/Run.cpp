@@ -23,10 +23,11 @@ int run(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "subscan 0.1.0");
 
-    const std::vector<Command> commands{
-        addInfoCommand(app),       addRenderCommand(app), addScanCommand(app),
-        addEvalCommand(app),       addBenchCommand(app),  addMaterialsCommand(app),
-        addFitProfileCommand(app), addViewCommand(app),   addTurntableCommand(app)};
+    const std::vector<Command> commands{addInfoCommand(app),      addRenderCommand(app),
+                                        addScanCommand(app),      addConvertCommand(app),
+                                        addEvalCommand(app),      addBenchCommand(app),
+                                        addMaterialsCommand(app), addFitProfileCommand(app),
+                                        addViewCommand(app),      addTurntableCommand(app)};
 
     try {
         app.parse(argc, argv);

@@ -1,8 +1,6 @@
 #include <chrono>
-#include <filesystem>
 #include <memory>
 #include <string>
-#include <system_error>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -51,8 +49,7 @@ ScanSource openSource(const ScanOptions& options) {
             throw Error(fmt::format("{}: {}", source, error.what()));
         }
     }
-    std::error_code ignored;
-    if (std::filesystem::equivalent(options.source, options.output, ignored)) {
+    if (sameFile(options.source, options.output)) {
         throw Error(
             fmt::format("{}: refusing to write the scan over its own input file; "
                         "choose another output path",

@@ -33,11 +33,6 @@ struct ViewCommandOptions {
     bool hidePanel = false;
 };
 
-bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
-    std::error_code ignored;
-    return std::filesystem::equivalent(a, b, ignored);
-}
-
 /// Everything that can be wrong with the input is found before a window opens, so that a bad
 /// file reads the same with and without a display.
 viewer::ViewerOptions checkedOptions(const ViewCommandOptions& command) {

@@ -11,6 +11,7 @@
 #include "core/Error.h"
 #include "io/PlyWriter.h"
 #include "io/ScanLoader.h"
+#include "io/WriterSupport.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
@@ -83,7 +84,7 @@ TEST(PlyWriterTest, UtmCoordinatesAreWrittenAsDouble) {
     const test::TempDir dir;
     const glm::dvec3 utm(512345.25, 5432109.5, 97.0);
     const PointCloud cloud = everyAttribute(utm, 10.0, true);
-    EXPECT_TRUE(plyNeedsDoubleCoordinates(cloud));
+    EXPECT_TRUE(needsDoubleCoordinates(cloud));
     const auto path = dir / "utm.ply";
     writePly(path, cloud);
     const std::string header = headerOf(path);
@@ -105,9 +106,9 @@ TEST(PlyWriterTest, UtmCoordinatesAreWrittenAsDouble) {
 
 TEST(PlyWriterTest, FloatIsChosenWhileItKeepsAMillionthOfTheExtent) {
     // 1 m wide at 10 m from the origin: a float step there is 1e-6, its half 5e-7 of the extent.
-    EXPECT_FALSE(plyNeedsDoubleCoordinates(everyAttribute({10.0, 0.0, 0.0}, 1.0)));
+    EXPECT_FALSE(needsDoubleCoordinates(everyAttribute({10.0, 0.0, 0.0}, 1.0)));
     // The same at 100 km: a step of 8 mm.
-    EXPECT_TRUE(plyNeedsDoubleCoordinates(everyAttribute({1e5, 0.0, 0.0}, 1.0)));
+    EXPECT_TRUE(needsDoubleCoordinates(everyAttribute({1e5, 0.0, 0.0}, 1.0)));
 }
 
 TEST(PlyWriterTest, PositionsOnlyAndNoFaces) {
@@ -134,15 +135,11 @@ TEST(PlyWriterTest, PositionsOnlyAndNoFaces) {
 }
 
 TEST(PlyWriterTest, UnwritablePathIsAnErrorNamingIt) {
-    const test::TempDir dir;
-    const auto path = dir / "missing" / "out.ply";
-    try {
-        writePly(path, everyAttribute({0, 0, 0}, 1.0));
-        FAIL() << "no error";
-    } catch (const Error& error) {
-        EXPECT_THAT(error.what(), HasSubstr(path.string()));
-    }
-    EXPECT_FALSE(std::filesystem::exists(dir / "missing"));
+    test::expectUnwritablePathIsAnErrorNamingIt(
+        [](const std::filesystem::path& path) {
+            writePly(path, everyAttribute({0, 0, 0}, 1.0));
+        },
+        "out.ply");
 }
 
 }  // namespace

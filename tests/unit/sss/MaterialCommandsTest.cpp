@@ -24,10 +24,6 @@ std::vector<std::string> keysOf(const nlohmann::json& object) {
     return keys;
 }
 
-std::size_t lineCount(const std::string& text) {
-    return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
-}
-
 TEST(MaterialCommandsTest, MaterialsJsonListsTheLibrary) {
     const test::CommandResult result = runSubscan({"materials", "--json"});
     ASSERT_EQ(result.exitCode, 0) << result.err;
@@ -66,7 +62,7 @@ TEST(MaterialCommandsTest, MaterialsTableHasALinePerMaterial) {
     EXPECT_THAT(result.out, HasSubstr("wholemilk"));
     EXPECT_THAT(result.out, HasSubstr("marble-jimenez"));
     // A header, the materials, a blank line and a hint.
-    EXPECT_EQ(lineCount(result.out), materialLibrary().size() + 3);
+    EXPECT_EQ(test::lineCount(result.out), materialLibrary().size() + 3);
 }
 
 TEST(MaterialCommandsTest, FitProfileJson) {
@@ -98,13 +94,13 @@ TEST(MaterialCommandsTest, FitProfileErrorsAreOneSentence) {
         runSubscan({"fit-profile", "--material", "jade", "--gaussians", "4"});
     EXPECT_EQ(unknown.exitCode, 1);
     EXPECT_TRUE(unknown.out.empty());
-    EXPECT_EQ(lineCount(unknown.err), 1u) << unknown.err;
+    EXPECT_EQ(test::lineCount(unknown.err), 1u) << unknown.err;
     EXPECT_THAT(unknown.err, HasSubstr("there is no material 'jade'"));
 
     const test::CommandResult gaussianOnly =
         runSubscan({"fit-profile", "--material", "skin-deon", "--gaussians", "4"});
     EXPECT_EQ(gaussianOnly.exitCode, 1);
-    EXPECT_EQ(lineCount(gaussianOnly.err), 1u) << gaussianOnly.err;
+    EXPECT_EQ(test::lineCount(gaussianOnly.err), 1u) << gaussianOnly.err;
     EXPECT_THAT(gaussianOnly.err, HasSubstr("'skin-deon'"));
     EXPECT_THAT(gaussianOnly.err, HasSubstr("no diffusion profile"));
 }

@@ -1,0 +1,126 @@
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "app/cli/CommandSupport.h"
+#include "app/cli/Commands.h"
+#include "core/Error.h"
+#include "io/LasWriter.h"
+#include "io/PcdWriter.h"
+#include "io/PlyWriter.h"
+#include "io/WriterSupport.h"
+#include "io/XyzWriter.h"
+
+namespace subscan::cli {
+
+namespace {
+
+struct ConvertOptions {
+    std::string source;
+    std::string output;
+};
+
+/// A format convert writes, and what of a cloud it can hold besides positions, colour and
+/// intensity (which all of them hold): whatever else the cloud has is reported as not written.
+struct OutputFormat {
+    std::string_view extension;  // lowercase
+    std::string_view name;
+    void (*write)(const std::filesystem::path&, const PointCloud&);
+    bool normals;
+    bool alphaAndFaces;
+};
+
+constexpr std::array<OutputFormat, 4> kOutputFormats{{
+    {".ply", "PLY", writePly, true, true},
+    {".las", "LAS 1.2", writeLas, false, false},
+    {".pcd", "PCD", writePcd, true, false},
+    {".xyz", "XYZ text", writeXyz, true, false},
+}};
+
+/// The format named by the output's extension (any case), or nullptr.
+const OutputFormat* outputFormat(const std::filesystem::path& output) {
+    std::string extension = output.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const auto* format = std::find_if(
+        kOutputFormats.begin(), kOutputFormats.end(),
+        [&](const OutputFormat& candidate) { return candidate.extension == extension; });
+    return format == kOutputFormats.end() ? nullptr : format;
+}
+
+std::string supportedExtensions() {
+    std::string list;
+    for (const OutputFormat& format : kOutputFormats) {
+        list += list.empty() ? "" : ", ";
+        list += format.extension;
+    }
+    return list;
+}
+
+/// Data is dropped only with a warning, as loaders warn about what they could not read.
+void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& format,
+                               const PointCloud& cloud) {
+    const auto warn = [&](std::string_view what) {
+        fmt::print(stderr, "subscan: warning: {}: {} cannot hold {}; they are not written\n",
+                   output, format.name, what);
+    };
+    if (cloud.hasNormals() && !format.normals) {
+        warn("normals");
+    }
+    if (!format.alphaAndFaces) {
+        if (hasTranslucentColors(cloud)) {
+            warn("colour alpha values");
+        }
+        if (!cloud.triangles.empty()) {
+            warn(fmt::format("faces ({} of them)", cloud.triangles.size()));
+        }
+    }
+}
+
+int runConvert(const ConvertOptions& options) {
+    const std::filesystem::path output = options.output;
+    const OutputFormat& format = *outputFormat(output);  // the option's check accepted it
+    if (!options.source.starts_with("synthetic:") && sameFile(output, options.source)) {
+        throw Error(fmt::format(
+            "{}: refusing to write the converted scan over its input; choose another output path",
+            options.output));
+    }
+    const LoadedScan scan = loadScanForCommand(options.source);
+    format.write(output, scan.cloud);
+    warnAboutWhatIsNotWritten(options.output, format, scan.cloud);
+    fmt::print("{}: {} points written as {} (from {})\n", options.output, scan.cloud.size(),
+               format.name, options.source);
+    return 0;
+}
+
+}  // namespace
+
+Command addConvertCommand(CLI::App& parent) {
+    auto options = std::make_shared<ConvertOptions>();
+    CLI::App* convert = parent.add_subcommand(
+        "convert",
+        "Write a scan as PLY, LAS, PCD or XYZ text, with its colour, intensity and normals");
+    convert->add_option("scan", options->source, "Scan file, or synthetic:NAME")->required();
+    convert
+        ->add_option("-o,--output", options->output,
+                     fmt::format("File to write; its extension picks the format ({})",
+                                 supportedExtensions()))
+        ->required()
+        ->check(
+            [](const std::string& path) -> std::string {
+                return outputFormat(path) != nullptr
+                           ? std::string()
+                           : fmt::format("'{}' has no extension of a format convert writes ({})",
+                                         path, supportedExtensions());
+            },
+            "FILE");
+    return {convert, [options] { return runConvert(*options); }};
+}
+
+}  // namespace subscan::cli

@@ -1,0 +1,142 @@
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <unistd.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/ScanLoader.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::runSubscan;
+using ::testing::HasSubstr;
+
+/// Converts `source` to `output`, expecting success and its one line.
+void convert(const std::string& source, const std::filesystem::path& output) {
+    const test::CommandResult result = runSubscan({"convert", source, "-o", output.string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(test::lineCount(result.out), 1u) << result.out;
+    EXPECT_THAT(result.out, HasSubstr(output.string() + ": "));
+}
+
+TEST(ConvertCommandTest, SyntheticSceneToEveryFormatAndBack) {
+    const test::TempDir dir;
+    const std::string source = "synthetic:sphere?points=500";
+    const LoadedScan original = loadScan(source);
+    ASSERT_TRUE(original.cloud.hasColors() && original.cloud.hasNormals());
+    // Upper case extensions pick the format as well.
+    for (const std::string name :
+         {"sphere.ply", "sphere.las", "sphere.pcd", "sphere.xyz", "SPHERE.PLY"}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / name;
+        const test::CommandResult result = runSubscan({"convert", source, "-o", output.string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        EXPECT_EQ(result.out, output.string() + ": 500 points written as " +
+                                  (name.ends_with(".las")   ? "LAS 1.2"
+                                   : name.ends_with(".pcd") ? "PCD"
+                                   : name.ends_with(".xyz") ? "XYZ text"
+                                                            : "PLY") +
+                                  " (from " + source + ")\n");
+        const LoadedScan read = loadScan(output.string());
+        // A unit sphere: float positions are good to 6e-8 on either side, the LAS scale is 1e-9
+        // (offset -1, reaching 2 m); 1e-6 leaves room for both.
+        test::expectPositionsNear(read.cloud, original.cloud, 1e-6);
+        EXPECT_EQ(read.cloud.colors, original.cloud.colors);
+        if (name.ends_with(".las")) {
+            EXPECT_FALSE(read.cloud.hasNormals());
+            EXPECT_THAT(result.err,
+                        HasSubstr("warning: " + output.string() + ": LAS 1.2 cannot hold normals"));
+        } else {
+            EXPECT_EQ(read.cloud.normals, original.cloud.normals);
+            EXPECT_TRUE(result.err.empty()) << result.err;
+        }
+    }
+}
+
+TEST(ConvertCommandTest, RealLasToEveryFormatKeepsPointsAndColours) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const auto source = data / "autzen_trim.las";
+    const LoadedScan original = loadScan(source.string());
+    ASSERT_EQ(original.cloud.size(), 110000u);
+    const test::TempDir dir;
+    for (const std::string name : {"autzen.las", "autzen.ply", "autzen.pcd", "autzen.xyz"}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / name;
+        convert(source.string(), output);
+        const LoadedScan read = loadScan(output.string());
+        ASSERT_EQ(read.cloud.size(), 110000u);
+        // Half the source's 0.01 m scale: far more than what converting adds (float rounding in
+        // memory at ~1 km from the centre, 3e-5 m, and the new LAS file's finer scale).
+        test::expectPositionsNear(read.cloud, original.cloud, 0.005);
+        EXPECT_EQ(read.cloud.colors, original.cloud.colors);
+        EXPECT_EQ(read.cloud.intensities, original.cloud.intensities);
+    }
+}
+
+TEST(ConvertCommandTest, UnknownExtensionIsAUsageError) {
+    const test::TempDir dir;
+    const auto output = dir / "sphere.obj";
+    const test::CommandResult result =
+        runSubscan({"convert", "synthetic:sphere", "-o", output.string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr(".ply, .las, .pcd, .xyz"));
+    EXPECT_FALSE(std::filesystem::exists(output));
+}
+
+TEST(ConvertCommandTest, RefusesToWriteOverItsInput) {
+    const test::TempDir dir;
+    const auto input = dir / "in.ply";
+    convert("synthetic:sphere", input);
+    const std::string before = test::fileBytes(input);
+    const auto link = dir / "link.ply";
+    std::filesystem::create_hard_link(input, link);
+    // The same path, another spelling of it, and a hard link to the file.
+    for (const auto& output : {input, dir / "." / "in.ply", link}) {
+        const test::CommandResult result =
+            runSubscan({"convert", input.string(), "-o", output.string()});
+        EXPECT_EQ(result.exitCode, 1) << output;
+        EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
+        EXPECT_THAT(result.err, HasSubstr("refusing to write"));
+        EXPECT_EQ(test::fileBytes(input), before) << output;
+    }
+}
+
+TEST(ConvertCommandTest, UnwritableDirectoryIsOneSentence) {
+    const test::TempDir dir;
+    const auto missing = dir / "missing" / "out.las";
+    const test::CommandResult result =
+        runSubscan({"convert", "synthetic:sphere", "-o", missing.string()});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_TRUE(result.out.empty()) << result.out;
+    EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
+    EXPECT_THAT(result.err, HasSubstr(missing.string() + ": cannot write"));
+}
+
+TEST(ConvertCommandTest, ReadOnlyDirectoryIsOneSentence) {
+    const test::TempDir dir;
+    const auto readOnly = dir / "read-only";
+    std::filesystem::create_directory(readOnly);
+    std::filesystem::permissions(
+        readOnly, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+    if (access(readOnly.c_str(), W_OK) == 0) {
+        GTEST_SKIP() << "running as root: a read-only directory is writable, not tested";
+    }
+    const auto denied = readOnly / "out.pcd";
+    const test::CommandResult refused =
+        runSubscan({"convert", "synthetic:sphere", "-o", denied.string()});
+    std::filesystem::permissions(readOnly, std::filesystem::perms::owner_all);
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_EQ(test::lineCount(refused.err), 1u) << refused.err;
+    EXPECT_THAT(refused.err, HasSubstr(denied.string() + ": cannot write"));
+    EXPECT_TRUE(std::filesystem::is_empty(readOnly));
+}
+
+}  // namespace
+}  // namespace subscan
