@@ -403,6 +403,7 @@ nlohmann::json toJson(const EvaluationReport& report) {
             {"coverage", m.coverage},
             {"leakage", m.leakage},
             {"depth_error_median_h", m.depthErrorMedianH},
+            {"depth_bias_h", m.depthBiasH},
             {"occlusion_error_rate", m.occlusionErrorRate},
             {"normal_error_mean_deg", nullptr},
             {"normal_error_p95_deg", nullptr},

@@ -30,6 +30,7 @@ QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
                                     const GroundTruthImages& truth, double spacing) {
     std::size_t truthPixels = 0, reconstructed = 0, both = 0, occluded = 0;
     std::vector<double> depthErrors;
+    std::vector<double> signedDepthErrors;
     std::vector<double> normalErrors;
     const bool hasNormals = !reconstruction.normals.empty();
     for (std::size_t i = 0; i < truth.depth.size(); ++i) {
@@ -43,6 +44,7 @@ QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
         ++both;
         const double difference = static_cast<double>(reconstruction.depth[i]) - truth.depth[i];
         depthErrors.push_back(std::abs(difference) / spacing);
+        signedDepthErrors.push_back(difference / spacing);
         occluded += difference > 3.0 * spacing;
         if (hasNormals) {
             const double cosine =
@@ -59,6 +61,7 @@ QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
                                           static_cast<double>(reconstructed)
                                     : 0.0;
     metrics.depthErrorMedianH = percentile(depthErrors, 0.5);
+    metrics.depthBiasH = percentile(signedDepthErrors, 0.5);
     metrics.occlusionErrorRate =
         both ? static_cast<double>(occluded) / static_cast<double>(both) : 0.0;
     if (hasNormals) {
@@ -103,6 +106,7 @@ QualityMetrics average(const std::vector<QualityMetrics>& views) {
         mean.coverage += view.coverage / n;
         mean.leakage += view.leakage / n;
         mean.depthErrorMedianH += view.depthErrorMedianH / n;
+        mean.depthBiasH += view.depthBiasH / n;
         mean.occlusionErrorRate += view.occlusionErrorRate / n;
         mean.psnrDb += view.psnrDb / n;
         hasNormals = hasNormals && view.normalErrorMeanDeg.has_value();

@@ -22,6 +22,7 @@ struct QualityMetrics {
     double coverage = 0.0;            // |rec ∩ gt| / |gt|
     double leakage = 0.0;             // |rec \ gt| / |rec|
     double depthErrorMedianH = 0.0;   // median |z_rec - z_gt| / h over rec ∩ gt
+    double depthBiasH = 0.0;          // median (z_rec - z_gt) / h over rec ∩ gt: < 0 in front
     double occlusionErrorRate = 0.0;  // share of rec ∩ gt with z_rec - z_gt > 3 h
     std::optional<double> normalErrorMeanDeg;
     std::optional<double> normalErrorP95Deg;

@@ -1,10 +1,13 @@
 #include "gpu/GlContext.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 
 #include <epoxy/gl.h>
 #include <fmt/format.h>
+
+#include "core/Error.h"
 
 namespace subscan {
 
@@ -45,6 +48,21 @@ std::vector<std::string> GlContext::takeDebugErrors() {
         errors.push_back(fmt::format("glGetError 0x{:04x}", error));
     }
     return errors;
+}
+
+void GlContext::throwOnErrors(std::string_view during) {
+    if (const std::vector<std::string> errors = takeDebugErrors(); !errors.empty()) {
+        throw Error(fmt::format("OpenGL reported an error {}: {}", during, errors.front()));
+    }
+}
+
+bool glDebugOutputRequested() {
+#ifndef NDEBUG
+    return true;
+#else
+    const char* requested = std::getenv("SUBSCAN_GL_DEBUG");
+    return requested != nullptr && std::string_view(requested) == "1";
+#endif
 }
 
 void GlContext::initialize(bool debugOutput) {

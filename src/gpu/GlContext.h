@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace subscan {
@@ -41,6 +42,10 @@ class GlContext {
     /// output was not requested.
     std::vector<std::string> takeDebugErrors();
 
+    /// Throws subscan::Error naming the first error takeDebugErrors() returns, if any: what a
+    /// command calls once its GL work is done, so an error outside the passes fails it too.
+    void throwOnErrors(std::string_view during);
+
   protected:
     /// Call once the context is current: fills capabilities() and installs debug output.
     void initialize(bool debugOutput);
@@ -56,6 +61,10 @@ struct HeadlessContextOptions {
     /// Record GL errors from KHR_debug (tests and debug builds turn this on).
     bool debugOutput = false;
 };
+
+/// Whether a program should ask for GL debug output: in debug builds, and wherever the
+/// environment sets SUBSCAN_GL_DEBUG to 1 (the tests set it, since they run Release builds).
+bool glDebugOutputRequested();
 
 /// An OpenGL 4.5 core context without any window or display: an EGL device (hardware first)
 /// through EGL_EXT_platform_device, else Mesa's surfaceless platform (llvmpipe). Throws

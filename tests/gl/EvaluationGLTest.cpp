@@ -39,7 +39,7 @@ TEST(EvaluationGLTest, EvalCommandJsonHasTheDocumentedShape) {
     EXPECT_EQ(json["points"], 3000);
     for (const char* method : {"points", "splats", "surface"}) {
         for (const char* key :
-             {"coverage", "leakage", "depth_error_median_h", "occlusion_error_rate",
+             {"coverage", "leakage", "depth_error_median_h", "depth_bias_h", "occlusion_error_rate",
               "normal_error_mean_deg", "normal_error_p95_deg", "psnr_db"}) {
             EXPECT_TRUE(json["methods"][method].contains(key)) << method << "." << key;
         }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <ostream>
 #include <random>
 #include <vector>
 
@@ -19,6 +20,12 @@
 #include "support/GlTestSupport.h"
 
 namespace subscan {
+
+/// googletest names a RasterPath parameter by this (instead of its bytes) in listings.
+void PrintTo(RasterPath path, std::ostream* out) {
+    *out << toString(path);
+}
+
 namespace {
 
 constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
@@ -152,32 +159,35 @@ std::size_t expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
     return covered;
 }
 
-TEST(RasterizePointsGLTest, BothPathsMatchTheCpuReferenceWithChunking) {
+/// The compute path under test, run whole and in chunks of 97 points.
+class RasterPathGLTest : public ::testing::TestWithParam<RasterPath> {};
+
+TEST_P(RasterPathGLTest, MatchesTheCpuReferenceWithChunking) {
     GlContext& context = test::glTestContext();
+    if (GetParam() == RasterPath::Int64 && !context.capabilities().int64Atomics) {
+        GTEST_SKIP() << context.capabilities().renderer
+                     << " has no 64-bit atomics (GL_NV_shader_atomic_int64); the int64 path "
+                        "is tested where a driver has them";
+    }
     const Camera camera = smallCamera();
     const PointCloud cloud = testCloud(camera, 1);
     const Reference reference = rasterizeOnCpu(cloud, camera);
-
-    std::vector<RasterPath> paths{RasterPath::TwoPass32};
-    if (context.capabilities().int64Atomics) {
-        paths.push_back(RasterPath::Int64);
-    } else {
-        std::printf("note: %s has no 64-bit atomics; the int64 path is tested where it does\n",
-                    context.capabilities().renderer.c_str());
-    }
-    for (const RasterPath path : paths) {
-        for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
-            SCOPED_TRACE(toString(path) + (chunk ? ", chunks of 97" : ", one chunk"));
-            Renderer renderer(context, cloud, std::nullopt, chunk);
-            RenderSettings settings;
-            settings.raster.path = path;
-            renderer.render(camera, settings);
-            // The test cloud covers most pixels.
-            EXPECT_GT(expectMatchesReference(renderer, cloud, reference),
-                      reference.winner.size() / 2);
-        }
+    for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
+        SCOPED_TRACE(chunk ? "chunks of 97" : "one chunk");
+        Renderer renderer(context, cloud, std::nullopt, chunk);
+        RenderSettings settings;
+        settings.raster.path = GetParam();
+        renderer.render(camera, settings);
+        // The test cloud covers most pixels.
+        EXPECT_GT(expectMatchesReference(renderer, cloud, reference), reference.winner.size() / 2);
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(RasterizePointsGLTest, RasterPathGLTest,
+                         ::testing::Values(RasterPath::TwoPass32, RasterPath::Int64),
+                         [](const ::testing::TestParamInfo<RasterPath>& tested) {
+                             return tested.param == RasterPath::Int64 ? "Int64" : "TwoPass32";
+                         });
 
 TEST(RasterizePointsGLTest, ColorBlendAveragesThePointsNearTheNearest) {
     // Per pixel: the mean linear colour of the points whose depth is within 2 % of the
@@ -278,12 +288,22 @@ TEST(RasterizePointsGLTest, GlPointsBaselineSeesTheSameNearestPoints) {
     settings.raster.mode = RenderMode::PointsGl;
     renderer.render(camera, settings);
     const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
     for (std::size_t pixel = 0; pixel < reference.depth.size(); ++pixel) {
         if (std::isinf(reference.depth[pixel])) {
             EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
-        } else {
-            // Same float transform as the compute path: ~1e-6 relative.
-            EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel])
+            continue;
+        }
+        // Same float transform as the compute path: ~1e-6 relative.
+        EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel])
+            << "pixel " << pixel;
+        // The nearest point's colour; an exact duplicate (its own random colour) drawn later
+        // fails GL_LESS, as the smaller index wins in the reference.
+        const Rgba8 expected = cloud.colors[reference.winner[pixel]];
+        const std::uint8_t channels[3] = {expected.r, expected.g, expected.b};
+        for (int c = 0; c < 3; ++c) {
+            // RGBA16F keeps 11 significant bits: 1e-3 relative, plus the sRGB curve's rounding.
+            EXPECT_NEAR(color[4 * pixel + c], srgbToLinear(channels[c] / 255.0f), 2e-3)
                 << "pixel " << pixel;
         }
     }

@@ -18,7 +18,10 @@
 #include <glm/matrix.hpp>
 #include <nlohmann/json.hpp>
 
+#include "eval/GroundTruth.h"
+#include "io/CameraJson.h"
 #include "io/Image.h"
+#include "scan/Scene.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
@@ -190,23 +193,80 @@ TEST(RenderCommandGLTest, FarFromTheOriginRendersLikeAtTheOrigin) {
     EXPECT_EQ(test::fileBytes(dir / "near.png"), test::fileBytes(dir / "far.png"));
 }
 
-TEST(RenderCommandGLTest, EveryModeDrawsTheObject) {
+TEST(RenderCommandGLTest, EveryModeDrawsTheObjectWhereTheTruthIs) {
+    // The built-in sphere from a camera file, each mode's drawn pixels (on black) against the
+    // pixels whose ray meets the analytic sphere. The sphere stays 7 pixels from the image's
+    // border: nearer than the fill's reach, the surface would grow to the border, where fill
+    // removal counts beyond the image as surface (so that close-ups fill to their edges).
     const test::TempDir dir;
-    for (const char* mode : {"points", "points-gl", "splats", "surface", "sss"}) {
-        const auto out = dir / (std::string(mode) + ".png");
+    const auto cameraFile = dir.write(
+        "camera.json",
+        cameraJson(glm::lookAt(glm::dvec3(0.5, 0.4, 4.0), glm::dvec3(0.0), glm::dvec3(0, 1, 0)))
+            .dump());
+    const GroundTruthImages truth =
+        renderGroundTruth(*makeBuiltInScene("sphere"), readCameraFile(cameraFile));
+    const auto covered = [&](int x, int y) {
+        return x >= 0 && y >= 0 && x < kWidth && y < kHeight &&
+               !std::isinf(truth.depth[static_cast<std::size_t>(y * kWidth + x)]);
+    };
+    // Truth pixels with an uncovered neighbour: where a pixel's centre and its points may
+    // fall on either side of the silhouette.
+    int truthPixels = 0, rim = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            if (covered(x, y)) {
+                ++truthPixels;
+                rim += !covered(x - 1, y) || !covered(x + 1, y) || !covered(x, y - 1) ||
+                       !covered(x, y + 1);
+            }
+        }
+    }
+    ASSERT_GT(truthPixels, kWidth * kHeight / 5) << "the sphere should fill much of the view";
+
+    struct Expectation {
+        const char* mode;
+        double leastCoverage;  // of the truth's pixels
+        int reach;             // pixels beyond the silhouette a drawn pixel may lie
+    };
+    // 3000 points, half of them facing the camera, put about 1.5 points in each of the
+    // sphere's pixels: 1-pixel points leave about e^-1.5 = 22 % (more at the rim) empty, so
+    // they must cover half; 4-pixel splats and the reconstructions close those holes and
+    // lose at most rim pixels (checked below). Splats reach 2 pixels (half their size) out.
+    for (const Expectation& expected : {Expectation{"points", 0.5, 1},
+                                        {"points-gl", 0.5, 1},
+                                        {"splats", 0.9, 2},
+                                        {"surface", 1.0, 1},
+                                        {"sss", 1.0, 1}}) {
+        SCOPED_TRACE(expected.mode);
+        const auto out = dir / (std::string(expected.mode) + ".png");
         const auto result =
             runSubscan({"render", "synthetic:sphere?points=3000", "-o", out.string(), "--mode",
-                        mode, "--width", "64", "--height", "48", "--background", "#000000",
+                        expected.mode, "--camera", cameraFile.string(), "--background", "#000000",
                         "--material", "skin-deon", "--unit", "cm"});
-        ASSERT_EQ(result.exitCode, 0) << mode << ": " << result.err;
+        ASSERT_EQ(result.exitCode, 0) << result.err;
         const Image8 image = readPng(out);
-        int lit = 0;
-        for (std::size_t i = 0; i < image.pixels.size(); i += 4) {
-            lit += image.pixels[i] > 0;
+        ASSERT_EQ(image.width, kWidth);
+        int drawnOnTruth = 0, outside = 0;
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                const std::size_t i = 4 * static_cast<std::size_t>(y * kWidth + x);
+                if (image.pixels[i] + image.pixels[i + 1] + image.pixels[i + 2] == 0) {
+                    continue;
+                }
+                bool nearTruth = false;
+                for (int dy = -expected.reach; dy <= expected.reach; ++dy) {
+                    for (int dx = -expected.reach; dx <= expected.reach; ++dx) {
+                        nearTruth = nearTruth || covered(x + dx, y + dy);
+                    }
+                }
+                outside += nearTruth ? 0 : 1;
+                drawnOnTruth += covered(x, y) ? 1 : 0;
+            }
         }
-        // A sphere filling the view covers about pi/4 of the frame; 1-pixel points from 3000
-        // samples cover far fewer pixels but certainly more than 5 %.
-        EXPECT_GT(lit, 64 * 48 / 20) << mode;
+        EXPECT_EQ(outside, 0) << "drawn pixels far from the sphere";
+        EXPECT_GE(drawnOnTruth,
+                  expected.leastCoverage * truthPixels - (expected.leastCoverage == 1.0 ? rim : 0))
+            << "of " << truthPixels << " sphere pixels (" << rim << " on its rim)";
     }
 }
 
@@ -286,6 +346,42 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
     }
     // The refused overwrite left the input intact.
     EXPECT_EQ(test::fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+}
+
+TEST(RenderCommandGLTest, OutputsAreWrittenOnlyAfterTheWorkAndNeverOverAnInput) {
+    const test::TempDir dir;
+    const auto scan = dir.write("scan.ply", asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
+    // --save-settings of a render that fails after the scan loads (the GPU cannot make a
+    // picture that wide): no settings file, no picture.
+    const auto settings = dir / "saved.json";
+    const auto tooWide = runSubscan({"render", scan.string(), "-o", (dir / "wide.png").string(),
+                                     "--width", "60000", "--save-settings", settings.string()});
+    EXPECT_EQ(tooWide.exitCode, 1) << tooWide.err;
+    EXPECT_FALSE(std::filesystem::exists(settings));
+    EXPECT_FALSE(std::filesystem::exists(dir / "wide.png"));
+
+    // --export-buffers into the folder whose camera.json is the --camera input.
+    const std::string cameraText =
+        cameraJson(
+            glm::lookAt(glm::dvec3(0.3, 0.2, 4.0), glm::dvec3(0.3, 0.3, 0.0), glm::dvec3(0, 1, 0)))
+            .dump();
+    const auto camera = dir.write("camera.json", cameraText);
+    const auto overCamera =
+        runSubscan({"render", scan.string(), "-o", (dir / "x.png").string(), "--camera",
+                    camera.string(), "--export-buffers", dir.path().string()});
+    EXPECT_EQ(overCamera.exitCode, 1);
+    EXPECT_THAT(overCamera.err, HasSubstr("refusing to write the camera over the input camera"));
+    EXPECT_EQ(test::fileBytes(camera), cameraText);
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+
+    // The same render to another folder succeeds and writes every output.
+    const auto good = runSubscan(
+        {"render", scan.string(), "-o", (dir / "x.png").string(), "--camera", camera.string(),
+         "--export-buffers", (dir / "buffers").string(), "--save-settings", settings.string()});
+    ASSERT_EQ(good.exitCode, 0) << good.err;
+    EXPECT_TRUE(std::filesystem::exists(dir / "x.png"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "buffers" / "camera.json"));
+    EXPECT_TRUE(std::filesystem::exists(settings));
 }
 
 /// The RGB of pixel i of a 3-channel PFM.

@@ -117,12 +117,19 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, errPath.c_str(),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    // GL errors fail the command in the Release builds tests run, unless a test says otherwise.
     std::vector<std::string> variables = environment;
+    if (std::none_of(environment.begin(), environment.end(), [](const std::string& added) {
+            return added.starts_with("SUBSCAN_GL_DEBUG=");
+        })) {
+        variables.emplace_back("SUBSCAN_GL_DEBUG=1");
+    }
+    const std::size_t given = variables.size();
     for (char** entry = environ; *entry != nullptr; ++entry) {
         const std::string_view existing(*entry);
         const std::string_view name = existing.substr(0, existing.find('='));
         const bool overridden = std::any_of(
-            environment.begin(), environment.end(),
+            variables.begin(), variables.begin() + static_cast<std::ptrdiff_t>(given),
             [&](const std::string& added) { return added.starts_with(std::string(name) + "="); });
         if (!overridden) {
             variables.emplace_back(existing);

@@ -285,6 +285,7 @@ int runBench(const BenchOptions& options) {
         options.up == "z" || (options.up == "auto" && scan.format == "las") ? UpAxis::Z : UpAxis::Y;
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
+    contextOptions.debugOutput = glDebugOutputRequested();
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
 
     nlohmann::json report = {
@@ -302,6 +303,7 @@ int runBench(const BenchOptions& options) {
     }
     const std::vector<nlohmann::json> summaries =
         benchModes(*context, scan, settings, modes, options, up);
+    context->throwOnErrors("while benchmarking");
     for (std::size_t i = 0; i < modes.size(); ++i) {
         report["modes"][modes[i].name] = summaries[i];
     }

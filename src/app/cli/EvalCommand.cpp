@@ -75,10 +75,12 @@ int runEval(const EvalOptions& options) {
 
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
+    contextOptions.debugOutput = glDebugOutputRequested();
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
     if (options.temporal) {
         const TemporalReport report = evaluateTemporal(*context, *truth, points, options.evaluation,
                                                        options.temporalEvaluation, render);
+        context->throwOnErrors("while evaluating");
         if (options.json) {
             fmt::print("{}\n", toJson(report).dump(2));
             return 0;
@@ -102,6 +104,7 @@ int runEval(const EvalOptions& options) {
         return 0;
     }
     const EvaluationReport report = evaluate(*context, *truth, points, options.evaluation, render);
+    context->throwOnErrors("while evaluating");
     if (options.json) {
         fmt::print("{}\n", toJson(report).dump(2));
         return 0;
@@ -112,14 +115,15 @@ int runEval(const EvalOptions& options) {
                            ? ""
                            : fmt::format(" ({} of them reconstructed at reduced resolution)",
                                          report.surfaceReducedViews));
-    fmt::print("{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "method", "coverage",
-               "leakage", "depth/h", "occluded", "normal°", "normal95", "PSNR");
+    fmt::print("{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "method",
+               "coverage", "leakage", "depth/h", "bias/h", "occluded", "normal°", "normal95",
+               "PSNR");
     auto row = [](const std::string& name, const QualityMetrics& m) {
-        fmt::print("{:<14} {:>9.4f} {:>9.4f} {:>10.3f} {:>10.4f} {:>10} {:>10} {:>8.2f}\n", name,
-                   m.coverage, m.leakage, m.depthErrorMedianH, m.occlusionErrorRate,
-                   m.normalErrorMeanDeg ? fmt::format("{:.2f}", *m.normalErrorMeanDeg) : "-",
-                   m.normalErrorP95Deg ? fmt::format("{:.2f}", *m.normalErrorP95Deg) : "-",
-                   m.psnrDb);
+        fmt::print(
+            "{:<14} {:>9.4f} {:>9.4f} {:>10.3f} {:>10.3f} {:>10.4f} {:>10} {:>10} {:>8.2f}\n", name,
+            m.coverage, m.leakage, m.depthErrorMedianH, m.depthBiasH, m.occlusionErrorRate,
+            m.normalErrorMeanDeg ? fmt::format("{:.2f}", *m.normalErrorMeanDeg) : "-",
+            m.normalErrorP95Deg ? fmt::format("{:.2f}", *m.normalErrorP95Deg) : "-", m.psnrDb);
     };
     row("points", report.points1px);
     row(fmt::format("splats ({}px)", report.splatSize), report.splats);

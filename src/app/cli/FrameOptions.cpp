@@ -121,9 +121,7 @@ Camera FrameOptions::camera(const LoadedScan& scan) const {
 std::unique_ptr<GlContext> FrameOptions::context() const {
     HeadlessContextOptions options;
     options.preferHardware = !software;
-#ifndef NDEBUG
-    options.debugOutput = true;  // debug builds turn GL errors into errors
-#endif
+    options.debugOutput = glDebugOutputRequested();
     std::unique_ptr<GlContext> context = createHeadlessContext(options);
     if (verbose) {
         const GlCapabilities& caps = context->capabilities();

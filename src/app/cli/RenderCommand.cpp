@@ -58,6 +58,7 @@ int runRender(const RenderOptions& options) {
     const FrameOptions& frame = options.frame;
     const std::filesystem::path output = options.output;
     frame.refuseToOverwriteInputs(output, "the image");
+    frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     if (!options.exportDirectory.empty()) {
         frame.refuseToOverwriteInputs(
             std::filesystem::path(options.exportDirectory) / "camera.json", "the camera");
@@ -80,7 +81,6 @@ int runRender(const RenderOptions& options) {
         settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, samples);
     }
     const LoadedScan scan = loadScanForCommand(frame.source);
-    frame.saveSettings(settings);
     const Camera camera = frame.camera(scan);
     const std::unique_ptr<GlContext> context = frame.context();
     Renderer renderer(*context, scan.cloud);
@@ -102,10 +102,15 @@ int runRender(const RenderOptions& options) {
         }
     }
 
+    const Image8 picture{camera.width, camera.height, 4, renderer.readImage()};
+    context->throwOnErrors("while rendering");
+    // Outputs only once the picture exists, so a failed render leaves none behind.
     if (!options.exportDirectory.empty()) {
         exportBuffers(options.exportDirectory, renderer, settings);
+        context->throwOnErrors("while reading the buffers back");
     }
-    writePng(output, {camera.width, camera.height, 4, renderer.readImage()});
+    writePng(output, picture);
+    frame.saveSettings(settings);
     return 0;
 }
 

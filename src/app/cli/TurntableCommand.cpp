@@ -122,6 +122,7 @@ int runTurntable(const TurntableOptions& options) {
     const FrameOptions& frame = options.frame;
     const std::filesystem::path output = options.output;
     frame.refuseToOverwriteInputs(output, "the turntable");
+    frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     const bool video = writesVideo(output);
     std::optional<std::filesystem::path> ffmpeg;
     if (video) {
@@ -141,7 +142,6 @@ int runTurntable(const TurntableOptions& options) {
     const bool filtered = filtersTemporally(settings);
 
     const LoadedScan scan = loadScanForCommand(frame.source);
-    frame.saveSettings(settings);
     const Camera first = frame.camera(scan);
     // Each frame turns the scene about the up axis through the bounds' middle: the eye's yaw
     // grows by degrees / frames, as --yaw would.
@@ -178,8 +178,9 @@ int runTurntable(const TurntableOptions& options) {
     for (int index = 0; index < options.frames; ++index) {
         const Camera camera = cameraAt(index);
         renderer.render(camera, settings, outputs);
-        writePng(folder / fmt::format("{:04}.png", index),
-                 {camera.width, camera.height, 4, renderer.readImage()});
+        const Image8 picture{camera.width, camera.height, 4, renderer.readImage()};
+        context->throwOnErrors(fmt::format("while rendering frame {}", index));
+        writePng(folder / fmt::format("{:04}.png", index), picture);
         if (!options.exportDirectory.empty()) {
             const std::filesystem::path buffers =
                 std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index);
@@ -207,6 +208,7 @@ int runTurntable(const TurntableOptions& options) {
                 fmt::format("{}: cannot write the video: {}", output.string(), error.message()));
         }
     }
+    frame.saveSettings(settings);
     return 0;
 }
 

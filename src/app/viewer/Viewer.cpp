@@ -65,9 +65,7 @@ WindowOptions windowOptions(const ViewerOptions& options) {
     window.width = options.width;
     window.height = options.height;
     window.title = "subscan: " + options.source;
-#ifndef NDEBUG
-    window.debugOutput = true;  // debug builds turn GL errors into errors, as the CLI does
-#endif
+    window.debugOutput = glDebugOutputRequested();  // GL errors become errors, as in the CLI
     return window;
 }
 

@@ -34,8 +34,23 @@ TEST(MetricsTest, CountsCoverageLeakageDepthAndOcclusion) {
     // Median of 6 values (0 1 2 3.5 4 10): the element at index round(2.5) = 3 after sorting.
     // Float depths make the errors inexact by ~1e-5 h.
     EXPECT_NEAR(m.depthErrorMedianH, 3.5, 1e-3);
+    EXPECT_NEAR(m.depthBiasH, 3.5, 1e-3);               // all behind: the signed median is the same
     EXPECT_DOUBLE_EQ(m.occlusionErrorRate, 3.0 / 6.0);  // 3.5, 4 and 10 exceed 3 h
     EXPECT_FALSE(m.normalErrorMeanDeg.has_value());     // no normals given
+}
+
+TEST(MetricsTest, DepthBiasIsTheSignedMedianInFrontOfTheTruthNegative) {
+    GroundTruthImages truth{5, 1, std::vector<float>(5, 2.0f), std::vector<glm::vec3>(5, {0, 0, 1}),
+                            std::vector<glm::vec3>(5)};
+    const float h = 0.01f;
+    // Errors in h of -3, -2, -1, 0.5, 4: sorted, the middle is -1; unsigned, 2.
+    ReconstructionImages reconstruction{
+        {2.0f - 3 * h, 2.0f - 2 * h, 2.0f - h, 2.0f + 0.5f * h, 2.0f + 4 * h}, {}};
+    const QualityMetrics m = compareToGroundTruth(reconstruction, truth, h);
+    // Float depths around 2 carry ~2e-7 / h = 2e-5 h of rounding.
+    EXPECT_NEAR(m.depthBiasH, -1.0, 1e-3);
+    EXPECT_NEAR(m.depthErrorMedianH, 2.0, 1e-3);
+    EXPECT_DOUBLE_EQ(m.occlusionErrorRate, 1.0 / 5.0);  // only the 4 h behind counts
 }
 
 TEST(MetricsTest, NormalErrorsInDegrees) {

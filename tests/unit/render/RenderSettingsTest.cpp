@@ -127,6 +127,7 @@ TEST(RenderSettingsTest, BadValuesAreNamed) {
     EXPECT_THROW(nlohmann::json({{"background_srgb", {2, 0, 0}}}).get<RasterSettings>(), Error);
     try {
         parseRenderMode("voxels");
+        FAIL() << "accepted the mode 'voxels'";
     } catch (const Error& error) {
         EXPECT_THAT(error.what(), ::testing::HasSubstr("points, points-gl, splats, surface"));
     }
@@ -260,7 +261,6 @@ TEST(RenderSettingsTest, ImpossibleScatteringValuesAreNamed) {
     const auto gaussian =
         dir.write("gaussian.json",
                   R"({"scattering": {"coefficients": "material", "material": "skin-deon"}})");
-    EXPECT_NO_THROW(readSettingsFile(gaussian));
     EXPECT_EQ(readSettingsFile(gaussian).scattering.coefficients, CoefficientSource::Material);
 }
 
