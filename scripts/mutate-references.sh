@@ -7,7 +7,9 @@
 #     (EvaluationGLTest: the sculpture's depth bias against the analytic truth);
 #   - a GL error left in a pass that harness tests run directly, not through PassRunner
 #     (SurfacePassesGLTest: every GL test fails on a GL error raised during it);
-#   - the directional lights turned into view space by the wrong matrix (ShadeGLTest).
+#   - the directional lights turned into view space by the wrong matrix (ShadeGLTest);
+#   - the profile's widest, or its middle, Gaussian left out of the blur
+#     (SubsurfaceScatteringGLTest: one lit pixel against the profile, within 3 % of each value).
 # Shader changes load through SUBSCAN_SHADER_DIR; source changes rebuild one test in build/ and
 # are put back afterwards. Needs a built tree (scripts/test.sh, or cmake --build build).
 set -euo pipefail
@@ -26,5 +28,9 @@ check_source_mutations SurfacePassesGLTest \
     status=1
 check_source_mutations ShadeGLTest \
     "lights turned by the transposed view|src/render/ShadePass.cpp|            camera.view * glm::dvec4(towardsLightInWorld|            glm::transpose(camera.view) * glm::dvec4(towardsLightInWorld" ||
+    status=1
+check_source_mutations SubsurfaceScatteringGLTest \
+    "the widest Gaussian left out|src/render/SubsurfaceScatteringPass.cpp|    for (const Gaussian& term : terms) {|    terms.pop_back(); for (const Gaussian& term : terms) {" \
+    "the middle Gaussian left out|src/render/SubsurfaceScatteringPass.cpp|    for (const Gaussian& term : terms) {|    terms.erase(terms.begin() + terms.size() / 2); for (const Gaussian& term : terms) {" ||
     status=1
 exit "$status"

@@ -278,6 +278,65 @@ TEST(RasterizePointsGLTest, ForcingInt64WithoutSupportIsAClearError) {
     EXPECT_THROW(renderer.render(camera, settings), Error);
 }
 
+TEST(RasterizePointsGLTest, SplatsShowTheNearestPointWhoseSquareCoversThePixel) {
+    // GL_POINTS of 3 pixels: a point lying 0.2..0.8 into its pixel covers exactly the 3x3
+    // pixels around it (their centres lie 0.7 px or more inside its square), and the depth test
+    // keeps the nearest of the covering points, the first drawn (smaller index) on a tie.
+    GlContext& context = test::glTestContext();
+    const Camera camera = smallCamera();
+    const PointCloud cloud = testCloud(camera, 4);
+    const Reference centres = rasterizeOnCpu(cloud, camera);
+    std::vector<std::uint32_t> winner(centres.winner.size(), kEmpty);
+    std::vector<double> nearest(centres.winner.size(), std::numeric_limits<double>::infinity());
+    const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
+    const glm::dmat4 projection = camera.projection();
+    for (std::uint32_t i = 0; i < cloud.size(); ++i) {
+        const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(cloud.positions[i]), 1.0);
+        const glm::dvec4 clip = projection * view;
+        const int px = static_cast<int>(std::floor((clip.x / clip.w + 1.0) * 0.5 * camera.width));
+        const int py = static_cast<int>(std::floor((1.0 - clip.y / clip.w) * 0.5 * camera.height));
+        if (-view.z < camera.nearPlane || -view.z > camera.farPlane || px < 0 || py < 0 ||
+            px >= camera.width || py >= camera.height) {
+            continue;  // GL discards a point whose centre is outside the view volume
+        }
+        for (int y = std::max(py - 1, 0); y <= std::min(py + 1, camera.height - 1); ++y) {
+            for (int x = std::max(px - 1, 0); x <= std::min(px + 1, camera.width - 1); ++x) {
+                const std::size_t pixel = static_cast<std::size_t>(y) * camera.width + x;
+                if (-view.z < nearest[pixel]) {
+                    nearest[pixel] = -view.z;
+                    winner[pixel] = i;
+                }
+            }
+        }
+    }
+
+    Renderer renderer(context, cloud, std::nullopt, 500);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Splats;
+    settings.raster.pointSize = 3.0f;
+    renderer.render(camera, settings);
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
+    std::size_t covered = 0;
+    for (std::size_t pixel = 0; pixel < winner.size(); ++pixel) {
+        if (winner[pixel] == kEmpty) {
+            EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+            continue;
+        }
+        ++covered;
+        // Same float transform as the compute path: ~1e-6 relative.
+        EXPECT_NEAR(depth[pixel], nearest[pixel], 1e-5 * nearest[pixel]) << "pixel " << pixel;
+        const Rgba8 expected = cloud.colors[winner[pixel]];
+        const std::uint8_t channels[3] = {expected.r, expected.g, expected.b};
+        for (int c = 0; c < 3; ++c) {
+            // RGBA16F keeps 11 significant bits: 1e-3 relative, plus the sRGB curve's rounding.
+            EXPECT_NEAR(color[4 * pixel + c], srgbToLinear(channels[c] / 255.0f), 2e-3)
+                << "pixel " << pixel;
+        }
+    }
+    EXPECT_GT(covered, winner.size() * 9 / 10) << "3-pixel splats of this cloud cover nearly all";
+}
+
 TEST(RasterizePointsGLTest, GlPointsBaselineSeesTheSameNearestPoints) {
     GlContext& context = test::glTestContext();
     const Camera camera = smallCamera();

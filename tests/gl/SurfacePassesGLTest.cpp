@@ -14,6 +14,7 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 
+#include "core/Srgb.h"
 #include "gpu/ShaderSources.h"
 #include "render/FillRemovalPass.h"
 #include "render/FrameUniforms.h"
@@ -22,6 +23,7 @@
 #include "render/NormalsPass.h"
 #include "render/PullPushPass.h"
 #include "render/ShadePass.h"
+#include "render/StageViewPass.h"
 #include "support/GlTestSupport.h"
 #include "support/PassHarness.h"
 
@@ -71,9 +73,11 @@ using test::PassHarness;
 // h: HPR looks up to ~log2(4 * 0.4 * 24.7 / 5) = 3 levels at depth 5.
 constexpr double kSpacing = 0.4;
 
-/// The 37x23 frame of these tests.
-PassHarness makeHarness() {
+/// The 37x23 frame of these tests; `stageLevel` is the level the pyramid and pull stage views
+/// show.
+PassHarness makeHarness(int stageLevel = 3) {
     RenderSettings settings;
+    settings.raster.stageLevel = stageLevel;
     // A threshold amid the many mean omegas of this frame (0.6..0.9), so that a formula
     // error flips flags instead of hiding between the two clusters.
     settings.surface.visibilityThreshold = 0.7f;
@@ -611,6 +615,95 @@ TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
                 EXPECT_NEAR(radianceOnly[4 * i + c], expectedRadiance,
                             2e-3 * (1 + expectedRadiance));
                 EXPECT_NEAR(splitAlbedo[4 * i + c], a, 2e-3);
+            }
+        }
+    }
+}
+
+TEST(SurfacePassesGLTest, StageViewsShowTheirBuffers) {
+    // Each panel of --stage against its rule applied on the CPU to the buffers it shows; level
+    // 1, where pull weights are fractions (coarser ones reach 1 on this frame).
+    PassHarness harness = makeHarness(1);
+    std::vector<float> depth, color;
+    runUpToNormals(harness, depth, color);
+    FrameContext frame = harness.context();
+    const FrameResources& resources = harness.resources();
+    const Camera& camera = harness.camera();
+    const auto all = levels();
+    const int level =
+        std::clamp(harness.settings().raster.stageLevel, 0, static_cast<int>(all.size()) - 1);
+    const glm::dvec3 background(srgbToLinear(harness.settings().raster.backgroundSrgb.r),
+                                srgbToLinear(harness.settings().raster.backgroundSrgb.g),
+                                srgbToLinear(harness.settings().raster.backgroundSrgb.b));
+    const auto depthShade = [&](double d) {
+        const double t =
+            std::clamp((d - camera.nearPlane) / (camera.farPlane - camera.nearPlane), 0.0, 1.0);
+        return std::isinf(d) ? background : glm::dvec3(0.9 + (0.05 - 0.9) * t);
+    };
+    const auto rgbaAt = [](const std::vector<float>& image, int i) {
+        return glm::dvec4(image[4 * i], image[4 * i + 1], image[4 * i + 2], image[4 * i + 3]);
+    };
+    const auto depth16 = resources.texture("depth").readFloats();
+    const auto color16 = resources.texture("color").readFloats();
+    const auto visible = resources.texture("visibility").readFloats();
+    const auto pyramid = resources.buffer("pyramid").read<float>();
+    const auto pullValues = resources.buffer("pullValues").read<glm::vec4>();
+    const auto pullWeights = resources.buffer("pullWeights").read<float>();
+    const auto filled = resources.texture("filledColor").readFloats();
+    const auto mask = resources.texture("mask").readFloats();
+    const auto normals = resources.texture("normals").readFloats();
+    const Level& shown = all[static_cast<std::size_t>(level)];
+
+    for (const Stage stage : {Stage::Depth, Stage::Pyramid, Stage::Visibility, Stage::Pull,
+                              Stage::Push, Stage::Fill, Stage::Normals}) {
+        SCOPED_TRACE(toString(stage));
+        StageViewPass(harness.sources(), stage).execute(frame);
+        const auto picture = resources.texture("stage").readFloats();
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                const int i = y * kWidth + x;
+                const int texel = shown.offset + (y >> level) * shown.width + (x >> level);
+                glm::dvec3 expected = background;
+                switch (stage) {
+                    case Stage::Depth:
+                        expected = depthShade(depth16[i]);
+                        break;
+                    case Stage::Pyramid:
+                        expected = depthShade(pyramid[texel]);
+                        break;
+                    case Stage::Visibility:
+                        if (!std::isinf(depth16[i])) {
+                            expected = visible[i] > 0.5f ? glm::dvec3(rgbaAt(color16, i))
+                                                         : glm::dvec3(0.8, 0.02, 0.02);
+                        }
+                        break;
+                    case Stage::Pull:
+                        if (const double w = pullWeights[texel]; w > 0.0) {
+                            const glm::dvec3 value(pullValues[texel].y, pullValues[texel].z,
+                                                   pullValues[texel].w);
+                            expected = background + (value / w - background) * w;
+                        }
+                        break;
+                    case Stage::Push:
+                        expected = glm::dvec3(rgbaAt(filled, i));
+                        break;
+                    case Stage::Fill:
+                        expected = mask[i] > 0.5f ? glm::dvec3(rgbaAt(filled, i))
+                                                  : glm::dvec3(0.25, 0.02, 0.02);
+                        break;
+                    case Stage::Normals:
+                        if (const glm::dvec4 n = rgbaAt(normals, i); n.w > 0.0) {
+                            expected = 0.5 + 0.5 * glm::dvec3(n);
+                        }
+                        break;
+                    default:
+                        break;
+                }
+                for (int c = 0; c < 3; ++c) {
+                    // RGBA16F picture: 11 significant bits, ~5e-4 relative.
+                    EXPECT_NEAR(picture[4 * i + c], expected[c], 1e-3 * (1.0 + expected[c]))
+                        << x << "," << y;
+                }
             }
         }
     }

@@ -47,6 +47,23 @@ TEST(AtomicFileTest, FailureLeavesTheOldFileAndNoTemporary) {
     EXPECT_EQ(fileCount(dir.path()), 1u);
 }
 
+TEST(AtomicFileTest, AFailedRenameLeavesTheTargetAndNoTemporary) {
+    // A non-empty directory where the file should go: the content is written, the rename fails.
+    const test::TempDir dir;
+    const auto path = dir / "out.bin";
+    std::filesystem::create_directory(path);
+    const auto inside = dir.write("out.bin/kept.txt", "kept");
+    try {
+        writeFileAtomically(path, "new");
+        FAIL() << "no error";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("cannot replace the file"));
+        EXPECT_THAT(error.what(), ::testing::HasSubstr(path.string()));
+    }
+    EXPECT_EQ(contents(inside), "kept");
+    EXPECT_EQ(fileCount(dir.path()), 1u);
+}
+
 TEST(AtomicFileTest, MissingDirectoryIsAClearError) {
     const test::TempDir dir;
     try {

@@ -1,9 +1,13 @@
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 
 #include <gtest/gtest.h>
 
+#include "core/Error.h"
 #include "io/Image.h"
 #include "support/TestSupport.h"
 
@@ -39,6 +43,25 @@ TEST(ImageTest, PngRoundTrips) {
     EXPECT_EQ(back.height, 3);
     EXPECT_EQ(back.channels, 4);
     EXPECT_EQ(back.pixels, image.pixels);
+}
+
+TEST(ImageTest, AFailedWriteKeepsTheOldFile) {
+    // Writers refuse an image they cannot encode, or fail to replace what is there, without
+    // touching the file already at the path or leaving a temporary beside it.
+    const test::TempDir dir;
+    const auto png = dir.write("old.png", "old png");
+    const auto pfm = dir.write("old.pfm", "old pfm");
+    EXPECT_THROW(writePng(png, Image8{4, 4, 4, std::vector<std::uint8_t>(10)}), Error);
+    EXPECT_THROW(writePfm(pfm, ImageF{2, 2, 2, std::vector<float>(8)}), Error);  // 2 channels
+    EXPECT_EQ(test::fileBytes(png), "old png");
+    EXPECT_EQ(test::fileBytes(pfm), "old pfm");
+    // A folder where the picture should go: encoded, then the rename fails.
+    const auto folder = dir / "busy.png";
+    std::filesystem::create_directory(folder);
+    dir.write("busy.png/inside", "kept");
+    EXPECT_THROW(writePng(folder, Image8{1, 1, 4, {1, 2, 3, 4}}), Error);
+    EXPECT_EQ(test::fileBytes(folder / "inside"), "kept");
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 3);
 }
 
 }  // namespace
