@@ -17,6 +17,8 @@ packages=(
     liblzf-dev libnanoflann-dev libeigen3-dev libpugixml-dev
     # tests and benchmarks
     libgtest-dev libgmock-dev libbenchmark-dev
+    # tests: compiles the 64-bit rasterizer's shaders where no driver can run them
+    glslang-tools
     # run time: `subscan turntable -o OUT.mp4` encodes with ffmpeg (folders of PNGs need nothing)
     ffmpeg
 )

@@ -50,6 +50,15 @@ const RasterizePointsPass::BlendPrograms& RasterizePointsPass::blendPrograms(boo
     return *programs;
 }
 
+std::string_view RasterizePointsPass::shaderPath() {
+    return kShader;
+}
+
+std::vector<std::string> RasterizePointsPass::int64VariantDefines() {
+    return {stageDefines(RasterStage::Int64, true), stageDefines(RasterStage::Resolve, true),
+            stageDefines(RasterStage::Blend, true), stageDefines(RasterStage::Resolve, true, true)};
+}
+
 RasterPath RasterizePointsPass::resolvePath(RasterPath requested,
                                             const GlCapabilities& capabilities) {
     if (requested == RasterPath::Int64 && !capabilities.int64Atomics) {

@@ -1,6 +1,9 @@
 #pragma once
 
 #include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "gpu/GlObjects.h"
 #include "gpu/ShaderSources.h"
@@ -29,6 +32,11 @@ class RasterizePointsPass final : public RenderPass {
     /// The path `requested` resolves to on this driver; throws subscan::Error when Int64 is
     /// forced without 64-bit atomics.
     static RasterPath resolvePath(RasterPath requested, const GlCapabilities& capabilities);
+
+    /// The shader and the defines of every variant that needs 64-bit atomics, for checking
+    /// that they compile where the driver cannot run them.
+    static std::string_view shaderPath();
+    static std::vector<std::string> int64VariantDefines();
 
     /// The winning point index per pixel of the last frame rendered into `resources`
     /// (0xFFFFFFFF where empty), row 0 at the top: for checking the rasterizer against a CPU
