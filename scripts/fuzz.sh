@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) and fuzzes each reader in turn.
-#   scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57 ...]   default: 300 s each, all
+#   scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off ...]   default: 300 s each, all
 # Seeds: tiny files written here or by the unit tests that build them (LAZ, COPC, E57; from the
 # Release build in build/), plus small real scans from ../shared/data when present (copied into
 # the build folder only). A finding stops the script with a non-zero exit and
@@ -13,11 +13,11 @@ readers=()
 while [[ $# -gt 0 ]]; do
     case "$1" in
         --seconds) seconds="$2"; shift 2 ;;
-        ply|las|laz|copc|pcd|xyz|e57) readers+=("$1"); shift ;;
-        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57 ...]" >&2; exit 2 ;;
+        ply|las|laz|copc|pcd|xyz|e57|off) readers+=("$1"); shift ;;
+        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off ...]" >&2; exit 2 ;;
     esac
 done
-[[ ${#readers[@]} -gt 0 ]] || readers=(ply las laz copc pcd xyz e57)
+[[ ${#readers[@]} -gt 0 ]] || readers=(ply las laz copc pcd xyz e57 off)
 
 scripts/setup-deps.sh
 build=build-fuzz
@@ -71,6 +71,11 @@ write_seeds() {  # reader directory
                 le 0 48                                          # bounds (not checked here)
                 for p in 1 2; do le $p 4; le $((p * 2)) 4; le $((p * 3)) 4; le 100 2; le 0 6
                     le 65535 2; le 0 2; le 255 2; done; } >"$dir/format2.las"
+            ;;
+        off)
+            printf 'OFF\n# cube\n8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n' >"$dir/cube.off"
+            printf 'STCNOFF 2 1 0\n1 2 3 0 0 1 0.5 0.5 0.5 1 0.25 0.75\n4OFF\n3 0 1 1\n' >"$dir/variants.off"
+            printf 'COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n' >"$dir/colour.off"
             ;;
         e57)
             printf 'ASTM-E57' >"$dir/magic.e57"

@@ -11,6 +11,7 @@
 #include "io/E57Reader.h"
 #include "io/LasReader.h"
 #include "io/MappedFile.h"
+#include "io/OffReader.h"
 #include "io/PcdReader.h"
 #include "io/PlyReader.h"
 #include "io/ReadContext.h"
@@ -148,13 +149,13 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
             scan.cloud = readE57(file, context);
             break;
         case ScanFormat::Off:
-            throw Error(
-                "OFF meshes are not supported yet; convert the file to PLY (e.g. with MeshLab, "
-                "CloudCompare or Open3D), whose vertices subscan reads as points");
+            scan.format = "off";
+            scan.cloud = readOff(file, context);
+            break;
         case ScanFormat::Unknown:
             throw Error(
-                "its format is unknown: it is not PLY, LAS, PCD, E57 or a text list of "
-                "coordinates");
+                "its format is unknown: it is not PLY, LAS, LAZ, PCD, E57, OFF or a text list "
+                "of coordinates");
     }
     scan.formatDetail = std::move(context.formatDetail);
     scan.warnings = std::move(context.warnings);
