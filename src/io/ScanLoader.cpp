@@ -173,7 +173,22 @@ LoadedScan loadScan(std::string_view source, const std::function<void(double)>& 
         } else {
             const std::filesystem::path path{std::string(source)};
             const MappedFile mapped(path);
-            scan = decodeScan(mapped.bytes(), detectFormat(mapped.bytes(), path), progress);
+            // A file shortened while it is read decodes zeros past its new end: whatever the
+            // reader made of them, the truncation is what to report.
+            const Error shrank(
+                "the file became shorter while it was read (another program "
+                "truncated or rewrote it); read it again once it is complete");
+            try {
+                scan = decodeScan(mapped.bytes(), detectFormat(mapped.bytes(), path), progress);
+            } catch (const Error&) {
+                if (mapped.shrank()) {
+                    throw shrank;
+                }
+                throw;
+            }
+            if (mapped.shrank()) {
+                throw shrank;
+            }
         }
     } catch (const Error& error) {
         throw Error(fmt::format("{}: {}", source, error.what()));

@@ -74,6 +74,41 @@ TEST(ScanLoaderTest, ErrorsNameTheFile) {
     EXPECT_THAT(loadError(dir.path().string()), HasSubstr("is a directory"));
 }
 
+TEST(ScanLoaderTest, AFileThatShrinksWhileItIsReadIsOneSentenceNotASignal) {
+    // A binary PLY of 200,000 points (2.4 MB); the loader's first progress report, before the
+    // first vertex, cuts the file to 4 KiB, as another program rewriting it would. The pages
+    // past the new end are gone from the mapping: without the guard, reading them is SIGBUS.
+    const test::TempDir dir;
+    constexpr int kPoints = 200000;
+    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                      std::to_string(kPoints) +
+                      "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    for (int i = 0; i < kPoints; ++i) {
+        for (const float value : {float(i), 1.0f, 2.0f}) {
+            test::appendBytes(ply, value);
+        }
+    }
+    const auto path = dir.write("shrinking.ply", ply);
+    bool cut = false;
+    try {
+        loadScan(path.string(), [&](double) {
+            if (!cut) {
+                std::filesystem::resize_file(path, 4096);
+                cut = true;
+            }
+        });
+        FAIL() << "the shortened file loaded";
+    } catch (const Error& error) {
+        EXPECT_EQ(std::string(error.what()),
+                  path.string() +
+                      ": the file became shorter while it was read (another program "
+                      "truncated or rewrote it); read it again once it is complete");
+    }
+    EXPECT_TRUE(cut) << "the reader never reported progress, so nothing was cut";
+    // The same file, now complete in its shorter form, is an ordinary truncated PLY.
+    EXPECT_THAT(loadError(path.string()), HasSubstr("truncated"));
+}
+
 TEST(ScanLoaderTest, SyntheticScenes) {
     const LoadedScan sphere = loadScan("synthetic:sphere?points=500");
     EXPECT_EQ(sphere.format, "synthetic");
