@@ -490,6 +490,10 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
          {},
          1,
          "outside what the GPU can render"},
+        {{"render", scan.string(), "-o", (dir / "out.exr").string()},
+         {},
+         1,
+         "pictures are written as .png or .jpg/.jpeg"},
         {{"render", scan.string(), "-o", out.string(), "--width", "0"}, {}, 2, ""},
         {{"render", scan.string(), "-o", out.string(), "--mode", "voxels"}, {}, 2, ""},
         {{"render", scan.string(), "-o", out.string(), "--mode", "sss", "--material", "jade"},
@@ -538,6 +542,7 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
             EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
         }
         EXPECT_FALSE(std::filesystem::exists(out));
+        EXPECT_FALSE(std::filesystem::exists(dir / "out.exr"));
     }
     // The refused overwrite left the input intact.
     EXPECT_EQ(test::fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
@@ -569,6 +574,11 @@ TEST(RenderCommandGLTest, OutputsAreWrittenOnlyAfterTheWorkAndNeverOverAnInput) 
     EXPECT_THAT(overCamera.err, HasSubstr("refusing to write the camera over the input camera"));
     EXPECT_EQ(test::fileBytes(camera), cameraText);
     EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+
+    // A .jpg output is a JPEG.
+    const auto jpeg = runSubscan({"render", scan.string(), "-o", (dir / "view.jpg").string()});
+    ASSERT_EQ(jpeg.exitCode, 0) << jpeg.err;
+    EXPECT_EQ(test::fileBytes(dir / "view.jpg").substr(0, 3), "\xFF\xD8\xFF");
 
     // The same render to another folder succeeds and writes every output.
     const auto good = runSubscan(

@@ -58,6 +58,7 @@ int runRender(const RenderOptions& options) {
     const FrameOptions& frame = options.frame;
     const std::filesystem::path output = options.output;
     frame.refuseToOverwriteInputs(output, "the image");
+    checkPictureExtension(output);
     frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     if (!options.exportDirectory.empty()) {
         frame.refuseToOverwriteInputs(
@@ -109,7 +110,7 @@ int runRender(const RenderOptions& options) {
         exportBuffers(options.exportDirectory, renderer, settings);
         context->throwOnErrors("while reading the buffers back");
     }
-    writePng(output, picture);
+    writePicture(output, picture);
     frame.saveSettings(settings);
     return 0;
 }
@@ -120,7 +121,8 @@ Command addRenderCommand(CLI::App& parent) {
     auto options = std::make_shared<RenderOptions>();
     CLI::App* render = parent.add_subcommand("render", "Render one image headless (EGL)");
     options->frame.add(*render);
-    render->add_option("-o,--output", options->output, "PNG to write")->required();
+    render->add_option("-o,--output", options->output, "Picture to write: .png, .jpg or .jpeg")
+        ->required();
     render->add_option("--export-buffers", options->exportDirectory,
                        "Directory for camera.json, depth.pfm, color.png");
     render

@@ -45,6 +45,36 @@ TEST(ImageTest, PngRoundTrips) {
     EXPECT_EQ(back.pixels, image.pixels);
 }
 
+TEST(ImageTest, PicturesFollowTheirExtension) {
+    const test::TempDir dir;
+    Image8 image{6, 4, 4, std::vector<std::uint8_t>(6 * 4 * 4, 200)};
+    writePicture(dir / "a.PNG", image);
+    EXPECT_EQ(test::fileBytes(dir / "a.PNG").substr(0, 8), "\x89PNG\r\n\x1a\n");
+    for (const char* name : {"b.jpg", "c.JPEG"}) {
+        writePicture(dir / name, image);
+        const std::string jpeg = test::fileBytes(dir / name);
+        ASSERT_GT(jpeg.size(), 100u) << name;
+        EXPECT_EQ(jpeg.substr(0, 3), "\xFF\xD8\xFF") << name;  // start of image
+        // The baseline frame header (SOF0) holds the height, then the width, big-endian.
+        const std::size_t frame = jpeg.find("\xFF\xC0");
+        ASSERT_NE(frame, std::string::npos) << name;
+        EXPECT_EQ(static_cast<unsigned char>(jpeg[frame + 6]), 4) << name;
+        EXPECT_EQ(static_cast<unsigned char>(jpeg[frame + 8]), 6) << name;
+    }
+    for (const char* name : {"d.exr", "e.bmp", "noextension"}) {
+        try {
+            writePicture(dir / name, image);
+            ADD_FAILURE() << name << " written";
+        } catch (const Error& error) {
+            EXPECT_EQ(std::string(error.what()),
+                      (dir / name).string() +
+                          ": pictures are written as .png or .jpg/.jpeg (the extension picks the "
+                          "format); the linear radiance is radiance.pfm of --export-buffers");
+        }
+        EXPECT_FALSE(std::filesystem::exists(dir / name));
+    }
+}
+
 TEST(ImageTest, AFailedWriteKeepsTheOldFile) {
     // Writers refuse an image they cannot encode, or fail to replace what is there, without
     // touching the file already at the path or leaving a temporary beside it.
