@@ -76,6 +76,58 @@ glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds) {
             static_cast<int>(last.y)};
 }
 
+namespace {
+
+/// The least eye distance from `target` at which every corner of `bounds` lies within 95 % of
+/// the half-fields (tangents `tanX`, `tanY`) of a camera turned by `rotation` (world to view):
+/// a corner at (x, y, z) relative to the target in view axes is d - z deep, so it fits when
+/// d >= z + |x| / (0.95 tanX) and d >= z + |y| / (0.95 tanY). At least a hundredth of `radius`
+/// in front of the nearest corner, for a box that is flat towards the eye.
+double boxFramingDistance(const Bounds& bounds, const glm::dvec3& target,
+                          const glm::dmat3& rotation, double tanX, double tanY, double radius) {
+    constexpr double kFill = 0.95;
+    double distance = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::dvec3 v = rotation * (bounds.corner(corner) - target);
+        distance = std::max({distance, v.z + std::abs(v.x) / (kFill * tanX),
+                             v.z + std::abs(v.y) / (kFill * tanY), v.z + 0.01 * radius});
+    }
+    return distance;
+}
+
+struct BoxFit {
+    glm::dvec3 target;
+    double distance;
+};
+
+/// Frames the box's corners: the distance above, with the target moved across the line of
+/// sight (the view's direction kept) until their projection is centred. Perspective makes the
+/// near side of a box look larger, so about the bounds' middle one side would touch the border
+/// and the other stay well inside; a few steps of moving by the projection's offset centre it.
+BoxFit fitBox(const Bounds& bounds, const glm::dvec3& center, const glm::dmat3& rotation,
+              double tanX, double tanY, double radius) {
+    BoxFit fit{center, 0.0};
+    for (int step = 0; step < 4; ++step) {
+        fit.distance = boxFramingDistance(bounds, fit.target, rotation, tanX, tanY, radius);
+        glm::dvec2 low(std::numeric_limits<double>::infinity());
+        glm::dvec2 high(-std::numeric_limits<double>::infinity());
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::dvec3 v = rotation * (bounds.corner(corner) - fit.target);
+            const glm::dvec2 ndc(v.x / ((fit.distance - v.z) * tanX),
+                                 v.y / ((fit.distance - v.z) * tanY));
+            low = glm::min(low, ndc);
+            high = glm::max(high, ndc);
+        }
+        const glm::dvec2 offset = 0.5 * (low + high);
+        fit.target += glm::transpose(rotation) * glm::dvec3(offset.x * tanX * fit.distance,
+                                                            offset.y * tanY * fit.distance, 0.0);
+    }
+    fit.distance = boxFramingDistance(bounds, fit.target, rotation, tanX, tanY, radius);
+    return fit;
+}
+
+}  // namespace
+
 Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int height,
                    double fovyDegrees) {
     Camera camera;
@@ -91,10 +143,6 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
     const double halfFovy = 0.5 * glm::radians(fovyDegrees);
     const double halfFovx =
         std::atan(std::tan(halfFovy) * static_cast<double>(width) / static_cast<double>(height));
-    constexpr double kMargin = 1.05;
-    const double distance =
-        orbit.distance.value_or(kMargin * radius / std::sin(std::min(halfFovy, halfFovx)));
-
     const double yaw = glm::radians(orbit.yawDegrees);
     const double pitch = glm::radians(orbit.pitchDegrees);
     glm::dvec3 direction;  // from the centre towards the eye
@@ -112,13 +160,26 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
     if (std::abs(glm::dot(direction, up)) > 0.9999) {
         up = orbit.up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
     }
-    camera.view = glm::lookAt(center + distance * direction, center, up);
+    constexpr double kMargin = 1.05;
+    double distance = kMargin * radius / std::sin(std::min(halfFovy, halfFovx));
+    glm::dvec3 target = center;
+    if (orbit.distance) {
+        distance = *orbit.distance;
+    } else if (orbit.framing == Framing::Box && !bounds.empty()) {
+        const BoxFit fit = fitBox(orbit.framed.value_or(bounds), center,
+                                  glm::dmat3(glm::lookAt(direction, glm::dvec3(0.0), up)),
+                                  std::tan(halfFovx), std::tan(halfFovy), radius);
+        target = fit.target;
+        distance = fit.distance;
+    }
+    camera.view = glm::lookAt(target + distance * direction, target, up);
 
-    // Near and far hug the bounding sphere, wherever the orbited point lies.
-    const double reach = radius + glm::length(center - middle);
+    // Near and far hug the bounding sphere, wherever the orbited point lies: its middle is this
+    // deep along the line of sight, and no point of it is more than `radius` nearer or farther.
+    const double toMiddle = glm::dot(target + distance * direction - middle, direction);
     const double margin = 0.02 * radius;
-    camera.farPlane = distance + reach + margin;
-    camera.nearPlane = std::max(distance - reach - margin, 1e-4 * camera.farPlane);
+    camera.farPlane = toMiddle + radius + margin;
+    camera.nearPlane = std::max(toMiddle - radius - margin, 1e-4 * camera.farPlane);
     return camera;
 }
 

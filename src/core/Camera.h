@@ -52,16 +52,27 @@ glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds);
 
 enum class UpAxis { Y, Z };
 
+/// How an orbit without a given distance frames the bounds: their bounding sphere fits the
+/// narrower field of view with 5 % to spare, the same distance from every direction (what the
+/// evaluation's and benchmark's views are defined by); or the box's corners, as seen from the
+/// orbit's direction, reach 95 % of the half-field on the limiting side (what users see first:
+/// the object fills the picture from any yaw and pitch).
+enum class Framing { Sphere, Box };
+
 /// A camera orbiting the middle of `bounds`: yaw turns around the up axis, pitch raises the eye.
 /// Yaw 0, pitch 0 looks at the front: from +Z for Y-up data, from -Y for Z-up data (LiDAR).
 struct OrbitView {
     double yawDegrees = 30.0;
     double pitchDegrees = 20.0;
-    /// Eye distance from the centre; by default the bounds' sphere fills the view with a margin.
+    /// Eye distance from the centre; by default from `framing`.
     std::optional<double> distance;
     UpAxis up = UpAxis::Y;
     /// The point orbited, file coordinates; by default the middle of the bounds.
     std::optional<glm::dvec3> center;
+    Framing framing = Framing::Sphere;
+    /// The box Framing::Box fills, when not the bounds themselves (framingBounds(), which
+    /// leaves stray points out); the depth range still holds all of the bounds.
+    std::optional<Bounds> framed;
 };
 
 /// Frames `bounds` as `orbit` says; near and far hug the bounding sphere.

@@ -1,5 +1,8 @@
 #include "core/PointCloud.h"
 
+#include <algorithm>
+#include <vector>
+
 #include <fmt/format.h>
 
 #include "core/Error.h"
@@ -74,6 +77,32 @@ PointCloud PointCloudBuilder::finish(std::vector<std::string>& warnings) {
     }
     cloud_.origin = newOrigin;
     return std::move(cloud_);
+}
+
+Bounds framingBounds(const PointCloud& cloud) {
+    constexpr std::size_t kFewest = 1000;
+    constexpr std::size_t kSample = 200000;
+    constexpr double kTail = 0.001;
+    if (cloud.size() < kFewest) {
+        return cloud.bounds;
+    }
+    const std::size_t stride = std::max<std::size_t>(1, cloud.size() / kSample);
+    std::vector<float> values;
+    values.reserve(cloud.size() / stride + 1);
+    Bounds framed;
+    for (int axis = 0; axis < 3; ++axis) {
+        values.clear();
+        for (std::size_t i = 0; i < cloud.size(); i += stride) {
+            values.push_back(cloud.positions[i][axis]);
+        }
+        const auto low = static_cast<std::ptrdiff_t>(kTail * static_cast<double>(values.size()));
+        const auto high = static_cast<std::ptrdiff_t>(values.size()) - 1 - low;
+        std::nth_element(values.begin(), values.begin() + low, values.end());
+        framed.min[axis] = cloud.origin[axis] + values[static_cast<std::size_t>(low)];
+        std::nth_element(values.begin(), values.begin() + high, values.end());
+        framed.max[axis] = cloud.origin[axis] + values[static_cast<std::size_t>(high)];
+    }
+    return framed;
 }
 
 }  // namespace subscan

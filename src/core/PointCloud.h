@@ -82,6 +82,12 @@ inline float saturateToFloat(double value) {
                                : static_cast<float>(value);
 }
 
+/// The box to frame the cloud by: per axis from the 0.1 % to the 99.9 % quantile of the
+/// coordinates (from a sample of at most 200,000 points), so that a few stray points far from
+/// the object (common in scans) do not shrink it to a corner of the picture. A cloud of fewer
+/// than 1,000 points keeps its exact bounds.
+Bounds framingBounds(const PointCloud& cloud);
+
 /// One decoded point as a reader produces it; attributes not announced to the builder are ignored.
 struct PointRecord {
     glm::dvec3 position{0.0};

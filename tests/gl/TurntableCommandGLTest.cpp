@@ -29,30 +29,33 @@ std::vector<std::string> with(std::vector<std::string> arguments,
 
 TEST(TurntableCommandGLTest, FramesStartConvergedAndTurnByDegreesOverFrames) {
     const test::TempDir dir;
-    const auto turntable =
-        runSubscan(with(with({"turntable"}, kScene),
-                        {"-o", (dir / "frames").string(), "--frames", "3", "--degrees", "90",
-                         "--yaw", "10", "--export-buffers", (dir / "buffers").string()}));
+    const auto turntable = runSubscan(
+        with(with({"turntable"}, kScene),
+             {"-o", (dir / "frames").string(), "--frames", "3", "--degrees", "90", "--yaw", "10",
+              "--distance", "3", "--export-buffers", (dir / "buffers").string()}));
     ASSERT_EQ(turntable.exitCode, 0) << turntable.err;
     for (const char* name : {"0000.png", "0001.png", "0002.png"}) {
         EXPECT_TRUE(std::filesystem::is_regular_file(dir / "frames" / name)) << name;
     }
     EXPECT_FALSE(std::filesystem::exists(dir / "frames" / "0003.png"));
 
+    // (The same --distance for both: render frames the box from its one view, a turntable the
+    // bounding sphere, which holds for every yaw.)
     // Frame 0 is the still the filter converges to over its 16 warm-up frames: the same
     // picture, bit for bit, as `render --samples 16` from that camera (exporting too, so that
     // both run the pass-by-pass chain, whose half floats round unlike FinishSurface).
     const auto still =
-        runSubscan(with(with({"render"}, kScene),
-                        {"--yaw", "10", "--samples", "16", "-o", (dir / "still.png").string(),
-                         "--export-buffers", (dir / "still").string()}));
+        runSubscan(with(with({"render"}, kScene), {"--yaw", "10", "--distance", "3", "--samples",
+                                                   "16", "-o", (dir / "still.png").string(),
+                                                   "--export-buffers", (dir / "still").string()}));
     ASSERT_EQ(still.exitCode, 0) << still.err;
     EXPECT_EQ(test::fileBytes(dir / "frames" / "0000.png"), test::fileBytes(dir / "still.png"));
 
     // Frame 2's camera is render's at yaw 10 + 2 x 90 / 3, without jitter.
-    const auto render = runSubscan(
-        with(with({"render"}, kScene), {"--yaw", "70", "-o", (dir / "yaw70.png").string(),
-                                        "--export-buffers", (dir / "yaw70").string()}));
+    const auto render =
+        runSubscan(with(with({"render"}, kScene),
+                        {"--yaw", "70", "--distance", "3", "-o", (dir / "yaw70.png").string(),
+                         "--export-buffers", (dir / "yaw70").string()}));
     ASSERT_EQ(render.exitCode, 0) << render.err;
     const nlohmann::json expected =
         nlohmann::json::parse(test::fileBytes(dir / "yaw70" / "camera.json"));

@@ -106,7 +106,7 @@ UpAxis FrameOptions::upAxis(const LoadedScan& scan) const {
     return up == "z" || (up == "auto" && scan.format == "las") ? UpAxis::Z : UpAxis::Y;
 }
 
-Camera FrameOptions::camera(const LoadedScan& scan) const {
+Camera FrameOptions::camera(const LoadedScan& scan, Framing framing) const {
     if (!cameraFile.empty()) {
         return readCameraFile(cameraFile);
     }
@@ -115,6 +115,8 @@ Camera FrameOptions::camera(const LoadedScan& scan) const {
     orbit.pitchDegrees = pitch;
     orbit.distance = distance;
     orbit.up = upAxis(scan);
+    orbit.framing = framing;
+    orbit.framed = framingBounds(scan.cloud);
     return orbitCamera(scan.cloud.bounds, orbit, width, height, fovy);
 }
 

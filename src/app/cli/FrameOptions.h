@@ -44,8 +44,8 @@ struct FrameOptions {
     /// throws subscan::Error naming a bad value.
     RenderSettings settings() const;
     /// The camera of --camera, or the orbit of --yaw, --pitch, --distance, --up and --fovy
-    /// around the scan's bounds.
-    Camera camera(const LoadedScan& scan) const;
+    /// around the scan's bounds, framed by `framing` when --distance is not given.
+    Camera camera(const LoadedScan& scan, Framing framing = Framing::Box) const;
     /// The up axis --up names for `scan` (auto: Z for LAS, else Y).
     UpAxis upAxis(const LoadedScan& scan) const;
     /// A headless context (hardware unless --software), its renderer printed with --verbose.

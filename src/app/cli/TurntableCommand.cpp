@@ -142,7 +142,8 @@ int runTurntable(const TurntableOptions& options) {
     const bool filtered = filtersTemporally(settings);
 
     const LoadedScan scan = loadScanForCommand(frame.source);
-    const Camera first = frame.camera(scan);
+    // The bounding sphere frames every yaw alike; the box's fit holds for the first one only.
+    const Camera first = frame.camera(scan, Framing::Sphere);
     // Each frame turns the scene about the up axis through the bounds' middle: the eye's yaw
     // grows by degrees / frames, as --yaw would.
     const glm::dvec3 centre = scan.cloud.bounds.center();

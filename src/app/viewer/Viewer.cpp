@@ -391,7 +391,8 @@ void Viewer::finishLoading() {
         const UpAxis up =
             options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
         const glm::ivec2 size = viewportSize();
-        camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1));
+        camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
+                               framingBounds(cloud));
         renderedCamera_.reset();
         renderedImage_ = false;
         glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());

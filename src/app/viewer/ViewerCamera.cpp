@@ -31,8 +31,9 @@ double focalLengthPixels(int height) {
 
 }  // namespace
 
-ViewerCamera::ViewerCamera(const Bounds& bounds, UpAxis up, int width, int height)
-    : bounds_(bounds), up_(up) {
+ViewerCamera::ViewerCamera(const Bounds& bounds, UpAxis up, int width, int height,
+                           std::optional<Bounds> framed)
+    : bounds_(bounds), framed_(framed), up_(up) {
     // orbitCamera's radius, so that reset() reproduces it exactly.
     sceneRadius_ =
         std::max(0.5 * glm::length(bounds.extent()), 1e-9 * (1.0 + glm::length(bounds.center())));
@@ -46,14 +47,15 @@ void ViewerCamera::reset(int width, int height) {
 }
 
 void ViewerCamera::frameAll(int width, int height) {
-    const double halfFovy = 0.5 * glm::radians(kFovyDegrees);
-    const double halfFovx = std::atan(std::tan(halfFovy) * static_cast<double>(std::max(width, 1)) /
-                                      static_cast<double>(std::max(height, 1)));
-    // orbitCamera's margin: the bounding sphere fills the narrower field of view with 5% to
-    // spare.
-    constexpr double kMargin = 1.05;
-    centre_ = bounds_.empty() ? glm::dvec3(0.0) : bounds_.center();
-    distance_ = kMargin * sceneRadius_ / std::sin(std::min(halfFovy, halfFovx));
+    // orbitCamera's framing of the box from this direction, as render's default view: its eye,
+    // and the point it looks at (the bounds' middle moved across the line of sight to centre
+    // the picture) as the orbit's centre.
+    const glm::dvec3 middle = bounds_.empty() ? glm::dvec3(0.0) : bounds_.center();
+    OrbitView orbit{yawDegrees_, pitchDegrees_, std::nullopt, up_, middle, Framing::Box, framed_};
+    const glm::dvec3 eye =
+        orbitCamera(bounds_, orbit, std::max(width, 1), std::max(height, 1), kFovyDegrees).eye();
+    distance_ = glm::dot(eye - middle, towardsEye());
+    centre_ = eye - distance_ * towardsEye();
 }
 
 glm::dvec3 ViewerCamera::towardsEye() const {
@@ -167,9 +169,10 @@ Camera ViewerCamera::camera(int width, int height) const {
     camera.fovyDegrees = kFovyDegrees;
     const glm::dvec3 eyePosition = eye();
     camera.view = glm::lookAt(eyePosition, centre_, upAxisVector(up_));
-    // orbitCamera's depth range, measured from wherever the eye is now.
+    // orbitCamera's depth range, measured from wherever the eye is now: the bounding sphere's
+    // middle lies this deep along the line of sight.
     const double toScene =
-        bounds_.empty() ? distance_ : glm::length(eyePosition - bounds_.center());
+        bounds_.empty() ? distance_ : glm::dot(eyePosition - bounds_.center(), towardsEye());
     const double margin = 0.02 * sceneRadius_;
     camera.farPlane = toScene + sceneRadius_ + margin;
     camera.nearPlane = std::max(toScene - sceneRadius_ - margin, 1e-4 * camera.farPlane);

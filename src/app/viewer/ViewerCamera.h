@@ -1,5 +1,7 @@
 #pragma once
 
+#include <optional>
+
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -24,8 +26,10 @@ class ViewerCamera {
     static constexpr double kMaxPitchDegrees = 89.0;  // lookAt needs a horizon
 
     ViewerCamera() = default;
-    /// The scene to frame; resets to the auto-framed view for a viewport of width x height.
-    ViewerCamera(const Bounds& bounds, UpAxis up, int width, int height);
+    /// The scene to frame; resets to the auto-framed view for a viewport of width x height,
+    /// which fills the picture with `framed` (by default the bounds; see framingBounds()).
+    ViewerCamera(const Bounds& bounds, UpAxis up, int width, int height,
+                 std::optional<Bounds> framed = std::nullopt);
 
     /// The view orbitCamera gives with its default angles (what `R` goes back to).
     void reset(int width, int height);
@@ -89,6 +93,7 @@ class ViewerCamera {
     void clampDistance();
 
     Bounds bounds_;
+    std::optional<Bounds> framed_;
     UpAxis up_ = UpAxis::Y;
     double sceneRadius_ = 1.0;
     glm::dvec3 centre_{0.0};

@@ -55,8 +55,10 @@ TEST(ViewerCameraTest, ResetIsTheAutoFramedViewOfOrbitCamera) {
     for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
         ViewerCamera camera = movedCamera(up);
         camera.reset(kWidth, kHeight);
-        const Camera expected = orbitCamera(kScene, {30.0, 20.0, std::nullopt, up}, kWidth, kHeight,
-                                            ViewerCamera::kFovyDegrees);
+        OrbitView orbit{30.0, 20.0, std::nullopt, up};
+        orbit.framing = Framing::Box;
+        const Camera expected =
+            orbitCamera(kScene, orbit, kWidth, kHeight, ViewerCamera::kFovyDegrees);
         const Camera actual = camera.camera(kWidth, kHeight);
         for (int column = 0; column < 4; ++column) {
             for (int row = 0; row < 4; ++row) {

@@ -62,6 +62,48 @@ TEST(CameraTest, AutoFramingKeepsEveryCornerInsideTheImageAndDepthRange) {
     }
 }
 
+TEST(CameraTest, BoxFramingFillsTheLimitingSideFromEveryDirection) {
+    // A cube, a 4:1:1 bar, a flat slab and far UTM-like bounds, from around the sphere, into
+    // wide, tall and square pictures: every corner inside the image and the depth range, and
+    // the corners' projection at least 85 % of the image on the side that limits it.
+    const Bounds shapes[] = {box({0, 0, 0}, {1, 1, 1}), box({-2, 0, 0}, {2, 1, 1}),
+                             box({0, 0, 0}, {3, 0.05, 2}),
+                             box({500000, 5400000, 10}, {500040, 5400010, 25})};
+    double least = 1.0;  // over all the views
+    for (const Bounds& bounds : shapes) {
+        for (const auto& [width, height] : {std::pair{160, 90}, {90, 160}, {100, 100}}) {
+            for (double yaw = 0.0; yaw < 360.0; yaw += 30.0) {
+                for (const double pitch : {-89.0, -45.0, 0.0, 20.0, 60.0, 90.0}) {
+                    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+                        OrbitView orbit{yaw, pitch, std::nullopt, up};
+                        orbit.framing = Framing::Box;
+                        const Camera camera = orbitCamera(bounds, orbit, width, height, 45);
+                        glm::dvec2 low(1e9), high(-1e9);
+                        for (int corner = 0; corner < 8; ++corner) {
+                            const glm::dvec4 view =
+                                camera.view * glm::dvec4(bounds.corner(corner), 1.0);
+                            const glm::dvec4 clip = camera.projection() * view;
+                            const glm::dvec2 ndc(clip.x / clip.w, clip.y / clip.w);
+                            ASSERT_GT(-view.z, camera.nearPlane);
+                            ASSERT_LT(-view.z, camera.farPlane);
+                            // Within 95 % of the half-field, by construction.
+                            ASSERT_LE(std::abs(ndc.x), 0.95 + 1e-9);
+                            ASSERT_LE(std::abs(ndc.y), 0.95 + 1e-9);
+                            low = glm::min(low, ndc);
+                            high = glm::max(high, ndc);
+                        }
+                        const double filled = std::max(high.x - low.x, high.y - low.y) / 2.0;
+                        least = std::min(least, filled);
+                        EXPECT_GE(filled, 0.85) << "yaw " << yaw << " pitch " << pitch;
+                    }
+                }
+            }
+        }
+    }
+    // A corner touches 95 % and the projection is centred; the least found is 0.905.
+    EXPECT_GT(least, 0.9);
+}
+
 TEST(CameraTest, YawZeroLooksAtTheFront) {
     const Bounds bounds = box({-1, -1, -1}, {1, 1, 1});
     const Camera yUp = orbitCamera(bounds, {0, 0, 10.0, UpAxis::Y}, 100, 100, 40);

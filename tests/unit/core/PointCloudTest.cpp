@@ -1,4 +1,5 @@
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -115,6 +116,38 @@ TEST(PointCloudTest, EmptyAndAllInvalidCloudsAreErrors) {
             }
         },
         Error);
+}
+
+TEST(PointCloudTest, FramingBoundsLeaveStrayPointsOut) {
+    // 20,000 points in the box (10..11, 20..22, 30..33) and 5 strays 1000 units away: the
+    // framing box is the dense box within its sampling (a 0.1 % quantile of uniform
+    // coordinates lies 0.1 % of the side inside), the bounds hold the strays.
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    PointCloudBuilder builder({}, 20005);
+    for (int i = 0; i < 20000; ++i) {
+        builder.add(at(10 + unit(random), 20 + 2 * unit(random), 30 + 3 * unit(random)));
+    }
+    for (int i = 0; i < 5; ++i) {
+        builder.add(at(1000, -1000, 1000));
+    }
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    const Bounds framed = framingBounds(cloud);
+    const glm::dvec3 low(10, 20, 30), side(1, 2, 3);
+    for (int axis = 0; axis < 3; ++axis) {
+        // 0.1 % of the side inside, give or take sampling (2 % of a side) and float storage.
+        EXPECT_NEAR(framed.min[axis], low[axis] + 0.001 * side[axis], 0.02 * side[axis]);
+        EXPECT_NEAR(framed.max[axis], low[axis] + 0.999 * side[axis], 0.02 * side[axis]);
+    }
+    EXPECT_EQ(cloud.bounds.max.x, 1000.0);
+    // A small cloud keeps its exact bounds: 0.1 % of it is not a point.
+    PointCloudBuilder small({}, 3);
+    small.add(at(0, 0, 0));
+    small.add(at(1, 1, 1));
+    small.add(at(500, 0, 0));
+    const PointCloud few = small.finish(warnings);
+    EXPECT_EQ(framingBounds(few).max.x, few.bounds.max.x);
 }
 
 }  // namespace
