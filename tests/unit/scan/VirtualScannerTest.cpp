@@ -3,6 +3,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -57,6 +58,37 @@ TEST_P(ScannedSceneTest, WithoutNoiseEveryPointIsOnTheSurface) {
     }
 }
 
+/// A ray of the scan and the surface it hit, cast here again as scanScene documents it: every
+/// view of scannerViews, a resolution x resolution grid of rays through pixel centres, the first
+/// hit within the scanner's reach of 4 bounding-sphere radii, in the order of the cloud's points.
+struct ScanRay {
+    glm::dvec3 origin;
+    glm::dvec3 direction;  // unit
+    glm::dvec3 normal;     // the surface's at the noiseless hit
+    double distance;       // to the noiseless hit
+};
+
+std::vector<ScanRay> scanRays(const Scene& scene, const ScannerSettings& settings) {
+    const Bounds bounds = scene.bounds();
+    const double reach = 4.0 * 0.5 * glm::length(bounds.extent());
+    std::vector<ScanRay> rays;
+    for (const ScannerView& view : scannerViews(bounds, settings.views)) {
+        for (int row = 0; row < settings.resolution; ++row) {
+            const double y = (1.0 - 2.0 * (row + 0.5) / settings.resolution) * view.tanHalfFov;
+            for (int column = 0; column < settings.resolution; ++column) {
+                const double x =
+                    (2.0 * (column + 0.5) / settings.resolution - 1.0) * view.tanHalfFov;
+                const Ray ray{view.position,
+                              glm::normalize(view.forward + x * view.right + y * view.up)};
+                if (const auto hit = scene.intersect(ray, reach)) {
+                    rays.push_back({ray.origin, ray.direction, hit->normal, hit->distance});
+                }
+            }
+        }
+    }
+    return rays;
+}
+
 TEST_P(ScannedSceneTest, NoiseMovesPointsOffTheSurfaceByAboutSigma) {
     const auto scene = makeBuiltInScene(GetParam());
     ScannerSettings settings = smallScan();
@@ -65,20 +97,48 @@ TEST_P(ScannedSceneTest, NoiseMovesPointsOffTheSurfaceByAboutSigma) {
     const double sigma = noiseSigma(scene->bounds(), settings);
     EXPECT_DOUBLE_EQ(sigma, 0.5 * scanSpacing(scene->bounds(), settings));
     const PointCloud cloud = scanScene(*scene, settings);
-    double sumOfSquares = 0.0;
+    const std::vector<ScanRay> rays = scanRays(*scene, settings);
+    ASSERT_EQ(rays.size(), cloud.size());
+    double sumOfSquares = 0.0, sumCos2 = 0.0, sumCos4 = 0.0;
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const double distance = scene->surfaceDistance(cloud.fileCoordinates(i));
+        const glm::dvec3 p = cloud.fileCoordinates(i);
+        const ScanRay& ray = rays[i];
+        // Point i was moved along ray i only: it lies on the ray, up to float storage (plus
+        // 1e-12 for the double arithmetic, ~1e-15 at these distances).
+        const glm::dvec3 fromOrigin = p - ray.origin;
+        ASSERT_LE(glm::length(fromOrigin - glm::dot(fromOrigin, ray.direction) * ray.direction),
+                  floatStorageError(cloud) + 1e-12)
+            << "point " << i;
+        const double distance = scene->surfaceDistance(p);
         // A point is at most its range error from the surface. 6 sigma, not 5: among ~10^4
         // points a 5-sigma draw (p = 6e-7 each) may well happen, a 6-sigma one (2e-9) not.
         ASSERT_LE(distance, 6.0 * sigma + floatStorageError(cloud)) << "point " << i;
         sumOfSquares += distance * distance;
+        const double cosine = std::abs(glm::dot(ray.normal, ray.direction));
+        sumCos2 += cosine * cosine;
+        sumCos4 += cosine * cosine * cosine * cosine;
     }
-    // Range noise along the ray moves a point off the surface by sigma times the cosine of the
-    // incidence angle, whose root mean square over a scan is about 0.7; distance bounds below
-    // the true distance on the composite scenes lower it further, never to half of that.
-    const double rms = std::sqrt(sumOfSquares / static_cast<double>(cloud.size()));
-    EXPECT_GT(rms, 0.3 * sigma);
-    EXPECT_LT(rms, 1.0 * sigma);
+    const double n = static_cast<double>(cloud.size());
+    const double rms = std::sqrt(sumOfSquares / n);
+    // Range noise g sigma along a ray (g standard normal) moves its point off the tangent plane
+    // at the hit by |g| sigma cos(theta), theta between the ray and the normal. Over these rays
+    // the expected rms is sigma sqrt(mean cos^2): 0.70 sigma on the sphere, 0.68-0.70 on the
+    // others.
+    const double expected = sigma * std::sqrt(sumCos2 / n);
+    // Statistical margin: rms^2 is the mean of n draws of sigma^2 cos^2 g^2 (Var g^2 = 2), so
+    // its relative standard deviation is sqrt(2 sum cos^4) / sum cos^2, and the rms's half of
+    // that: 1.0-1.4 % for these 3,600-7,300 points. Four of them (p = 6e-5 per side) hold any
+    // fair draw of the noise. Curvature adds a second-order 3/4 sigma^2 kappa^2 sin^4 to the
+    // squares, under 1 % of the rms even on the torus's 35 mm tube.
+    const double margin = 4.0 * 0.5 * std::sqrt(2.0 * sumCos4) / sumCos2;
+    // On the sculpture surfaceDistance is only a lower bound (smooth unions), and the fins
+    // (4 mm) and the ring's tube (5.6 mm) are thinner than +-sigma (4.4 mm): a point pushed
+    // through one lies near its far side. Measured 2026-12-03, rms / expected: sphere 0.9987,
+    // torus 0.9884, box-with-hole 0.9757 (its concave edges, 2.4 sd), sculpture 0.8812; the
+    // sculpture's shortfall of 12 % is allowed below, nothing more.
+    const double shortfall = GetParam() == "sculpture" ? 0.12 : 0.0;
+    EXPECT_LE(rms, expected * (1.0 + margin));
+    EXPECT_GE(rms, expected * (1.0 - shortfall - margin));
 }
 
 TEST_P(ScannedSceneTest, NormalsAreUnitAndFaceTheScanner) {

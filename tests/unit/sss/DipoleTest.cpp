@@ -51,9 +51,14 @@ TEST(DipoleTest, TotalReflectanceReproducesJensensTable) {
             DipoleProfile(*material.sigmaSPrime, *material.sigmaA, material.eta).totalReflectance();
         for (int c = 0; c < 3; ++c) {
             // The table prints two digits (±0.005) and was computed by Jensen et al. with their
-            // own rounding of σs′ and σa; all but one entry agree within 0.008, Chicken1's blue
-            // (0.126 against 0.10) by 0.026.
-            EXPECT_NEAR(computed[c], (*material.rd)[c], 0.03)
+            // own rounding of σs′ and σa: 35 of the 36 entries agree within 0.008 (measured
+            // 2026-12-03: at most 0.0077, skimmilk's blue; median 0.003). Chicken1's blue does
+            // not: 0.1264 against a printed 0.10. Half a unit in the last digit of its σs′ (0.38)
+            // and σa (0.19) moves α′ by 0.009 and R_d by ~0.004; with the printing that is ~0.01,
+            // not 0.026. It is the same 0.10 as chicken2's blue (which computes to 0.108): likely
+            // a misprint, so this entry alone gets 0.027.
+            const bool misprint = material.name == "chicken1" && c == 2;
+            EXPECT_NEAR(computed[c], (*material.rd)[c], misprint ? 0.027 : 0.008)
                 << material.name << " " << kChannel[c];
         }
         ++checked;
