@@ -80,6 +80,12 @@ BENCHMARK_CAPTURE(loadFile, autzen_laz, std::string("autzen_trim.laz"))
 BENCHMARK_CAPTURE(loadFile, autzen_las, std::string("autzen_trim.las"))
     ->Unit(benchmark::kMillisecond);
 
+// E57: the same 30,571 points as double floats and as 32-bit scaled integers.
+BENCHMARK_CAPTURE(loadFile, bunny_e57_double, std::string("bunnyDouble.e57"))
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(loadFile, bunny_e57_int32, std::string("bunnyInt32.e57"))
+    ->Unit(benchmark::kMillisecond);
+
 BENCHMARK_CAPTURE(loadFile, happy_binary_ply, std::string("happy_stand_registered.ply"))
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(loadFile, bunny_ascii_ply, std::string("bun_zipper.ply"))
