@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "core/Coloring.h"
 #include "core/Error.h"
 #include "shared/bindings.h"
 
@@ -31,20 +32,9 @@ std::vector<std::uint32_t> displayColors(const PointCloud& cloud) {
         std::fill(packed.begin(), packed.end(), pack({kNeutral, kNeutral, kNeutral, 255}));
         return packed;
     }
-    // Percentiles from a sample: intensity ranges differ wildly between scanners.
-    std::vector<float> sample;
-    const std::size_t step = std::max<std::size_t>(1, cloud.size() / 100000);
-    for (std::size_t i = 0; i < cloud.size(); i += step) {
-        sample.push_back(cloud.intensities[i]);
-    }
-    std::sort(sample.begin(), sample.end());
-    const float low = sample[sample.size() / 100];
-    const float high = sample[sample.size() - 1 - sample.size() / 100];
-    const float range = high > low ? high - low : 1.0f;
+    const std::vector<std::uint8_t> greys = intensityGreys(cloud);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const float t = std::clamp((cloud.intensities[i] - low) / range, 0.0f, 1.0f);
-        const auto grey = static_cast<std::uint8_t>(std::lround(40.0f + 215.0f * t));
-        packed[i] = pack({grey, grey, grey, 255});
+        packed[i] = pack({greys[i], greys[i], greys[i], 255});
     }
     return packed;
 }

@@ -433,6 +433,56 @@ TEST(RenderCommandGLTest, ExportedSurfaceBuffersMatchTheTruthAndTheShadingFormul
     EXPECT_LE(normalErrorSum / interior, 10.0);
 }
 
+TEST(RenderCommandGLTest, ColorChoosesWhatThePointsShow) {
+    const test::TempDir dir;
+    const auto cameraFile = sphereCameraFile(dir);
+    const auto render = [&](const std::string& color) {
+        const auto out = dir / (color + ".png");
+        const auto result =
+            runSubscan({"render", "synthetic:sphere?points=3000", "-o", out.string(), "--camera",
+                        cameraFile.string(), "--color", color, "--background", "#000000"});
+        EXPECT_EQ(result.exitCode, 0) << color << ": " << result.err;
+        return result.exitCode == 0 ? readPng(out) : Image8{};
+    };
+    // Uniform: every drawn point the same light grey (sRGB 200, through linear RGBA16F and
+    // back: within one level).
+    const Image8 uniform = render("uniform");
+    int drawn = 0;
+    for (std::size_t i = 0; i < uniform.pixels.size(); i += 4) {
+        if (uniform.pixels[i] + uniform.pixels[i + 1] + uniform.pixels[i + 2] > 0) {
+            ++drawn;
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(uniform.pixels[i + c], 200, 1);
+            }
+        }
+    }
+    EXPECT_GT(drawn, 300);
+    // Height along y: the sphere's top rows are yellow-green, its bottom rows blue-violet
+    // (viridis), so the top's green exceeds the bottom's by far.
+    const Image8 height = render("height");
+    const auto meanGreen = [&](int firstRow, int lastRow) {
+        double sum = 0.0;
+        int count = 0;
+        for (int y = firstRow; y <= lastRow; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                const std::size_t i = 4 * static_cast<std::size_t>(y * kWidth + x);
+                if (height.pixels[i] + height.pixels[i + 1] + height.pixels[i + 2] > 0) {
+                    sum += height.pixels[i + 1];
+                    ++count;
+                }
+            }
+        }
+        return count > 0 ? sum / count : 0.0;
+    };
+    EXPECT_GT(meanGreen(0, kHeight / 4), meanGreen(3 * kHeight / 4, kHeight - 1) + 80);
+    // What the scan lacks is one sentence naming it.
+    const auto noIntensity = runSubscan({"render", "synthetic:sphere?points=3000", "-o",
+                                         (dir / "i.png").string(), "--color", "intensity"});
+    EXPECT_EQ(noIntensity.exitCode, 1);
+    EXPECT_THAT(noIntensity.err,
+                HasSubstr("synthetic:sphere?points=3000: the scan has no intensities to show"));
+}
+
 TEST(RenderCommandGLTest, SavedSettingsHoldTheOptionsAndReproduceThePicture) {
     const test::TempDir dir;
     const auto cameraFile = sphereCameraFile(dir);

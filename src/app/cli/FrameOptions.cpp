@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <glm/vector_relational.hpp>
 
+#include "core/Coloring.h"
 #include "core/Error.h"
 #include "io/CameraJson.h"
 
@@ -55,6 +56,11 @@ void FrameOptions::add(CLI::App& command) {
         ->check(CLI::PositiveNumber);
     command.add_option("--up", up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));
+    command
+        .add_option("--color", color,
+                    "What the points' colour shows: auto (rgb, else height for Z-up data, else "
+                    "uniform) | rgb | intensity | height | uniform")
+        ->check(CLI::IsMember({"auto", "rgb", "intensity", "height", "uniform"}));
     command.add_option("--fovy", fovy, "Vertical field of view, degrees")
         ->check(CLI::Range(1.0, 170.0));
     command.add_option("--camera", cameraFile, "camera.json to render from")
@@ -100,6 +106,14 @@ RenderSettings FrameOptions::settings() const {
     }
     scattering.apply(settings.scattering);
     return settings;
+}
+
+void FrameOptions::applyColoring(LoadedScan& scan) const {
+    try {
+        scan.cloud.colors = pointColors(scan.cloud, parseColoring(color), upAxis(scan));
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", source, error.what()));
+    }
 }
 
 UpAxis FrameOptions::upAxis(const LoadedScan& scan) const {

@@ -36,6 +36,7 @@ struct FrameOptions {
     ScatteringOptions scattering;
     std::string settingsFile;
     std::string saveSettingsFile;
+    std::string color = "auto";  // Coloring
     bool verbose = false;
     bool software = false;
 
@@ -48,6 +49,9 @@ struct FrameOptions {
     Camera camera(const LoadedScan& scan, Framing framing = Framing::Box) const;
     /// The up axis --up names for `scan` (auto: Z for LAS, else Y).
     UpAxis upAxis(const LoadedScan& scan) const;
+    /// Replaces the scan's colours by what --color shows (core/Coloring.h); throws
+    /// subscan::Error when the scan lacks what it needs.
+    void applyColoring(LoadedScan& scan) const;
     /// A headless context (hardware unless --software), its renderer printed with --verbose.
     std::unique_ptr<GlContext> context() const;
     /// Throws subscan::Error when `output` is the input scan or the settings file: nothing is

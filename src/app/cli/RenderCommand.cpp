@@ -81,7 +81,8 @@ int runRender(const RenderOptions& options) {
         settings.temporal.enabled = true;
         settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, samples);
     }
-    const LoadedScan scan = loadScanForCommand(frame.source);
+    LoadedScan scan = loadScanForCommand(frame.source);
+    frame.applyColoring(scan);
     const Camera camera = frame.camera(scan);
     const std::unique_ptr<GlContext> context = frame.context();
     Renderer renderer(*context, scan.cloud);

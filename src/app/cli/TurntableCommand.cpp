@@ -141,7 +141,8 @@ int runTurntable(const TurntableOptions& options) {
     settings.temporal.enabled = true;
     const bool filtered = filtersTemporally(settings);
 
-    const LoadedScan scan = loadScanForCommand(frame.source);
+    LoadedScan scan = loadScanForCommand(frame.source);
+    frame.applyColoring(scan);
     // The bounding sphere frames every yaw alike; the box's fit holds for the first one only.
     const Camera first = frame.camera(scan, Framing::Sphere);
     // Each frame turns the scene about the up axis through the bounds' middle: the eye's yaw

@@ -27,6 +27,7 @@ struct ViewCommandOptions {
     ScatteringOptions scattering;
     std::string settingsFile;
     std::string up = "auto";
+    std::string color = "auto";
     std::string scriptFile;
     std::string screenshot;
     std::optional<int> exitAfterFrames;
@@ -46,6 +47,7 @@ viewer::ViewerOptions checkedOptions(const ViewCommandOptions& command) {
     if (command.up != "auto") {
         options.up = command.up == "z" ? UpAxis::Z : UpAxis::Y;
     }
+    options.coloring = parseColoring(command.color);
     if (!command.settingsFile.empty()) {
         options.settings = readSettingsFile(command.settingsFile, viewer::viewerDefaultSettings());
     }
@@ -101,6 +103,9 @@ Command addViewCommand(CLI::App& parent) {
         ->check(CLI::ExistingFile);
     view->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));
+    view->add_option("--color", options->color,
+                     "What the points' colour shows: auto | rgb | intensity | height | uniform")
+        ->check(CLI::IsMember({"auto", "rgb", "intensity", "height", "uniform"}));
     view->add_option("--script", options->scriptFile,
                      "JSON list of timed camera actions (see README)")
         ->check(CLI::ExistingFile);

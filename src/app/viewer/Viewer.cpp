@@ -375,6 +375,9 @@ void Viewer::finishLoading() {
         for (const std::string& warning : prepared.scan.warnings) {
             fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
         }
+        const UpAxis up =
+            options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
+        prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, options_.coloring, up);
         const PointCloud& cloud = prepared.scan.cloud;
         // Built before the old one goes, so a failure keeps the scan on screen.
         auto renderer = std::make_unique<Renderer>(
@@ -388,8 +391,6 @@ void Viewer::finishLoading() {
         status_.points = cloud.size();
         status_.spacing = renderer_->spacing();
         status_.loadMilliseconds = prepared.scan.loadMilliseconds;
-        const UpAxis up =
-            options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
         const glm::ivec2 size = viewportSize();
         camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
                                framingBounds(cloud));

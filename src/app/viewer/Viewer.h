@@ -14,6 +14,7 @@
 #include "app/viewer/ViewerPanel.h"
 #include "app/viewer/ViewerScript.h"
 #include "core/Camera.h"
+#include "core/Coloring.h"
 #include "gpu/GlfwContext.h"
 #include "render/RenderSettings.h"
 
@@ -35,6 +36,7 @@ struct ViewerOptions {
     int height = 800;
     RenderSettings settings = viewerDefaultSettings();
     std::optional<UpAxis> up;  // default: Z for LAS, Y otherwise
+    Coloring coloring = Coloring::Auto;
     std::vector<ScriptAction> script;
     std::filesystem::path screenshotAtExit;  // empty: none
     std::optional<int> exitAfterFrames;      // frames that show the scan
