@@ -19,6 +19,9 @@ packages=(
     libgtest-dev libgmock-dev libbenchmark-dev
     # tests: compiles the 64-bit rasterizer's shaders where no driver can run them
     glslang-tools
+    # the Python module (import subscan) and its tests; PIL reads the CLI's PNGs in them and
+    # shows pictures in the examples
+    python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-pil
     # run time: `subscan turntable -o OUT.mp4` encodes with ffmpeg (folders of PNGs need nothing)
     ffmpeg
 )

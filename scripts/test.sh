@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The whole test suite: installs what is missing, builds, runs every test with ctest, then the
-# unit tests again under AddressSanitizer + UndefinedBehaviorSanitizer, then each reader's
+# The whole test suite: installs what is missing, builds, runs every test with ctest (the
+# Python module's pytest suite among them, label python), then the unit tests again under
+# AddressSanitizer + UndefinedBehaviorSanitizer (without the Python module), then each reader's
 # fuzzer for a short while. Real-scan tests read $SUBSCAN_TEST_DATA or ../shared/data and are
 # skipped with a message when neither exists.
 set -euo pipefail

@@ -1,6 +1,8 @@
 // Headless OpenGL through EGL: a hardware EGL device when there is one, Mesa's software
 // rasterizer (llvmpipe) otherwise. No window system, no display server.
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -29,6 +31,45 @@ bool hasWord(const char* list, const char* word) {
     return false;
 }
 
+/// EGL displays are process-wide: eglGetPlatformDisplay returns the same display for the same
+/// device, and eglTerminate is not counted (Mesa 22 lacks EGL_KHR_display_reference), so
+/// terminating the display when one context goes would destroy every other context on it (two
+/// renderers in one process, as the Python module allows). So the contexts count their users of
+/// each display, under a lock because contexts may be made and dropped on any thread, and the
+/// last one terminates it. Function-local: this mirrors EGL's own process-wide state.
+class DisplayUsers {
+  public:
+    /// eglInitialize, counted; false (with eglGetError() set) when it fails.
+    static bool initialize(EGLDisplay display) {
+        DisplayUsers& users = instance();
+        const std::lock_guard lock(users.mutex_);
+        EGLint major = 0, minor = 0;
+        if (eglInitialize(display, &major, &minor) != EGL_TRUE) {
+            return false;
+        }
+        ++users.count_[display];
+        return true;
+    }
+    /// The counterpart of a successful initialize(): eglTerminate once no user is left.
+    static void release(EGLDisplay display) {
+        DisplayUsers& users = instance();
+        const std::lock_guard lock(users.mutex_);
+        const auto found = users.count_.find(display);
+        if (found != users.count_.end() && --found->second == 0) {
+            users.count_.erase(found);
+            eglTerminate(display);
+        }
+    }
+
+  private:
+    static DisplayUsers& instance() {
+        static DisplayUsers users;
+        return users;
+    }
+    std::mutex mutex_;
+    std::map<EGLDisplay, int> count_;
+};
+
 class EglContext final : public GlContext {
   public:
     EglContext(EGLDisplay display, EGLContext context, bool debugOutput)
@@ -37,9 +78,12 @@ class EglContext final : public GlContext {
         initialize(debugOutput);
     }
     ~EglContext() override {
-        eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        // Only our own context: another one current on this thread stays current.
+        if (eglGetCurrentContext() == context_) {
+            eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        }
         eglDestroyContext(display_, context_);
-        eglTerminate(display_);
+        DisplayUsers::release(display_);
     }
     void makeCurrent() override {
         if (eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) != EGL_TRUE) {
@@ -59,18 +103,17 @@ std::string tryCreateContext(EGLDisplay display, bool debugOutput, EGLContext& c
     if (display == EGL_NO_DISPLAY) {
         return "no EGL display";
     }
-    EGLint major = 0, minor = 0;
-    if (eglInitialize(display, &major, &minor) != EGL_TRUE) {
+    if (!DisplayUsers::initialize(display)) {
         return fmt::format("eglInitialize failed (0x{:x})", eglGetError());
     }
     const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
     if (!hasWord(extensions, "EGL_KHR_surfaceless_context") ||
         !hasWord(extensions, "EGL_KHR_create_context")) {
-        eglTerminate(display);
+        DisplayUsers::release(display);
         return "the EGL display cannot make surfaceless OpenGL contexts";
     }
     if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) {
-        eglTerminate(display);
+        DisplayUsers::release(display);
         return "the EGL display has no desktop OpenGL";
     }
     EGLConfig config = EGL_NO_CONFIG_KHR;
@@ -78,7 +121,7 @@ std::string tryCreateContext(EGLDisplay display, bool debugOutput, EGLContext& c
         const EGLint wanted[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
         EGLint found = 0;
         if (eglChooseConfig(display, wanted, &config, 1, &found) != EGL_TRUE || found == 0) {
-            eglTerminate(display);
+            DisplayUsers::release(display);
             return "no EGL config supports OpenGL";
         }
     }
@@ -94,7 +137,7 @@ std::string tryCreateContext(EGLDisplay display, bool debugOutput, EGLContext& c
     context = eglCreateContext(display, config, EGL_NO_CONTEXT, attributes);
     if (context == EGL_NO_CONTEXT) {
         const EGLint error = eglGetError();
-        eglTerminate(display);
+        DisplayUsers::release(display);
         return fmt::format("no OpenGL 4.5 core context (EGL error 0x{:x})", error);
     }
     return {};

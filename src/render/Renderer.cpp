@@ -23,7 +23,9 @@ namespace {
 
 /// h for the screen-space radii; a cloud without two distinct points still needs a scale.
 double usableSpacing(const PointCloud& cloud, std::optional<double> spacing) {
-    const double h = spacing.value_or(estimateSpacing(cloud));
+    // Not value_or: it would estimate (a k-d tree over every point, seconds for millions) even
+    // when the caller knows h.
+    const double h = spacing ? *spacing : estimateSpacing(cloud);
     if (h > 0.0 && std::isfinite(h)) {
         return h;
     }

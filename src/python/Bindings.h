@@ -1,0 +1,66 @@
+// What the binding files of the Python module share: the types that cross between them and
+// the functions that add each part of the API to the module.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <pybind11/pybind11.h>
+
+#include "core/PointCloud.h"
+#include "render/RenderSettings.h"
+
+namespace subscan::python {
+
+/// A subscan.Cloud: an immutable PointCloud (the Renderer and the array views may share it),
+/// where it came from, and its spacing h, estimated once on first use.
+class CloudData {
+  public:
+    CloudData(PointCloud cloud, std::string format) noexcept
+        : cloud_(std::move(cloud)), format_(std::move(format)) {}
+
+    const PointCloud& cloud() const { return cloud_; }
+    /// "ply", "las", "pcd", "xyz", "e57", "off", "synthetic" from subscan.load; "numpy" or
+    /// "open3d" for clouds made from arrays.
+    const std::string& format() const { return format_; }
+    /// estimateSpacing(cloud()), computed on the first call (call without the GIL: it may take
+    /// a second on millions of points; std::call_once makes concurrent first calls wait).
+    double spacing() const;
+
+  private:
+    PointCloud cloud_;
+    std::string format_;
+    mutable std::once_flag spacingOnce_;
+    mutable double spacing_ = 0.0;
+};
+
+using CloudHandle = std::shared_ptr<CloudData>;
+
+/// A subscan.Settings: the settings its sections (subscan.Settings.raster, ...) edit in place,
+/// shared with them.
+struct SettingsData {
+    RenderSettings value;
+};
+
+using SettingsHandle = std::shared_ptr<SettingsData>;
+
+/// What a `settings=` argument may be: a Settings, a dict in the settings file's layout, or
+/// None for the defaults. Throws ValueError (dicts with bad values) or TypeError.
+RenderSettings settingsArgument(const pybind11::handle& argument);
+
+/// The path of a str or os.PathLike argument.
+std::string pathArgument(const pybind11::handle& argument);
+
+/// Python warnings (UserWarning), one per reader warning, as the CLI prints them on stderr.
+void warnAll(const std::string& source, const std::vector<std::string>& warnings);
+
+void bindCloud(pybind11::module_& module);
+void bindCamera(pybind11::module_& module);
+void bindSettings(pybind11::module_& module);
+void bindRenderer(pybind11::module_& module);
+void bindAnalysis(pybind11::module_& module);
+
+}  // namespace subscan::python

@@ -1,0 +1,241 @@
+"""subscan.Renderer against `subscan render`: the same pictures byte for byte, the same buffers
+as --export-buffers, several renderers and threads, the GIL released, every bad call refused."""
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import subscan
+
+from conftest import read_pfm, read_png
+
+SCAN = "synthetic:torus?points=20000"
+WIDTH, HEIGHT = 96, 72
+
+
+@pytest.fixture(scope="module")
+def torus():
+    return subscan.load(SCAN)
+
+
+@pytest.fixture(scope="module")
+def renderer(torus):
+    with subscan.Renderer(torus) as renderer:
+        yield renderer
+
+
+@pytest.fixture(scope="module")
+def camera(torus):
+    """Off the default orbit, so that the CLI reads it from --camera."""
+    return subscan.Camera.look_at((0.15, 0.2, 0.25), (0.02, 0.0, 0.0), width=WIDTH, height=HEIGHT,
+                                  fovy=40, cloud=torus)
+
+
+@pytest.fixture(scope="module")
+def settings():
+    """Not the defaults: the CLI must read them from --settings to match."""
+    settings = subscan.Settings()
+    settings.raster.background_srgb = [0.1, 0.2, 0.3]
+    settings.raster.point_size = 3
+    settings.surface.visibility_threshold = 0.12
+    settings.shading.specular = 0.3
+    settings.scattering.method = "both"
+    settings.scattering.material = "marble-jimenez"
+    return settings
+
+
+def cli_render(cli, tmp_path, camera, settings, mode, *extra):
+    camera.save(tmp_path / "camera.json")
+    settings.save(tmp_path / "settings.json")
+    cli("render", SCAN, "-o", tmp_path / "cli.png", "--camera", tmp_path / "camera.json",
+        "--settings", tmp_path / "settings.json", "--mode", mode, *extra)
+    return read_png(tmp_path / "cli.png")
+
+
+@pytest.mark.parametrize("mode", ["points", "points-gl", "splats", "surface", "sss"])
+def test_render_equals_the_cli_png(cli, tmp_path, renderer, camera, settings, mode):
+    expected = cli_render(cli, tmp_path, camera, settings, mode)
+    image = renderer.render(camera, mode=mode, settings=settings)
+    assert image.dtype == np.uint8 and image.shape == (HEIGHT, WIDTH, 3)
+    assert (expected[:, :, 3] == 255).all()  # the CLI's PNG is opaque: RGB is all it holds
+    np.testing.assert_array_equal(image, expected[:, :, :3])
+    # A picture, not a blank: the torus covers a good part of it, shaded where lit.
+    assert (image != image[0, 0]).any(axis=2).mean() > 0.1
+    if mode in ("surface", "sss"):
+        assert len(np.unique(image.reshape(-1, 3), axis=0)) > 50
+
+
+def test_samples_equal_the_cli_samples(cli, tmp_path, renderer, camera, settings):
+    expected = cli_render(cli, tmp_path, camera, settings, "surface", "--samples", 4)
+    image = renderer.render(camera, mode="surface", settings=settings, samples=4)
+    np.testing.assert_array_equal(image, expected[:, :, :3])
+    # Each call starts afresh, as each command does: the same call gives the same picture.
+    np.testing.assert_array_equal(renderer.render(camera, "surface", settings, samples=4), image)
+
+
+def srgb8(linear):
+    """The sRGB encoding of core/Srgb.h in float64; the C++ one is float32, so a value on a
+    rounding boundary may land one step away (checked below to be rare)."""
+    linear = np.clip(linear.astype(np.float64), 0.0, 1.0)
+    encoded = np.where(linear <= 0.0031308, linear * 12.92,
+                       1.055 * np.power(linear, 1.0 / 2.4) - 0.055)
+    return np.round(encoded * 255.0).astype(np.int64)
+
+
+@pytest.mark.parametrize("mode, files", [
+    ("points", ["depth"]),
+    ("surface", ["depth", "normals", "radiance"]),
+    ("sss", ["depth", "normals", "radiance", "single", "sigma_s", "sigma_a"]),
+])
+def test_buffers_equal_the_cli_export(cli, tmp_path, renderer, camera, settings, mode, files):
+    expected_png = cli_render(cli, tmp_path, camera, settings, mode, "--export-buffers",
+                              tmp_path / "buffers")
+    image = renderer.render(camera, mode=mode, settings=settings, buffers=True)
+    np.testing.assert_array_equal(image, expected_png[:, :, :3])
+    buffers = renderer.buffers()
+    assert renderer.buffer_camera == subscan.Camera.load(tmp_path / "buffers" / "camera.json")
+    expected_keys = {"depth", "color"} | ({"normals", "radiance", "mask"} if mode != "points" else set())
+    assert set(buffers) == expected_keys | set(files)
+    for name in files:
+        expected = read_pfm(tmp_path / "buffers" / f"{name}.pfm")
+        assert buffers[name].dtype == np.float32
+        np.testing.assert_array_equal(buffers[name], expected, err_msg=name)
+    depth = buffers["depth"]
+    assert depth.shape == (HEIGHT, WIDTH)
+    covered = np.isfinite(depth)
+    assert 0.05 < covered.mean() < 0.95  # the torus is in the picture, not all of it
+    color_png = read_png(tmp_path / "buffers" / "color.png")
+    np.testing.assert_array_equal(color_png[:, :, 3], np.where(covered, 255, 0))
+    difference = np.abs(srgb8(buffers["color"]) - color_png[:, :, :3])
+    assert difference.max() <= 1 and (difference > 0).mean() < 0.01
+    if mode != "points":
+        mask_png = read_png(tmp_path / "buffers" / "mask.png")
+        np.testing.assert_array_equal(buffers["mask"] * 255, mask_png)
+        np.testing.assert_array_equal(buffers["mask"], covered.astype(np.float32))
+
+
+def test_default_camera_and_mode_are_the_cli_orbit_and_surface(cli, tmp_path, torus, renderer):
+    cli("render", SCAN, "-o", tmp_path / "cli.png", "--mode", "surface")
+    np.testing.assert_array_equal(renderer.render(), read_png(tmp_path / "cli.png")[:, :, :3])
+
+
+def test_timings_name_the_passes(renderer, camera):
+    renderer.render(camera, mode="surface")
+    timings = renderer.timings()
+    assert "rasterize" in " ".join(timings) or len(timings) >= 3, timings
+    assert all(ms >= 0.0 for ms in timings.values())
+    renderer.render(camera, mode="points-gl")
+    assert set(renderer.timings()) != set(timings)
+
+
+def test_several_renderers_in_one_process(torus, camera, renderer):
+    expected = renderer.render(camera, mode="surface")
+    first, second = subscan.Renderer(torus), subscan.Renderer(torus)
+    np.testing.assert_array_equal(first.render(camera, mode="surface"), expected)
+    del first  # dropping one renderer's context leaves the others working
+    np.testing.assert_array_equal(second.render(camera, mode="surface"), expected)
+    np.testing.assert_array_equal(renderer.render(camera, mode="surface"), expected)
+    second.close()
+    with pytest.raises(subscan.Error, match="the renderer is closed"):
+        second.render(camera)
+
+
+def test_renderers_on_threads(torus, camera, renderer):
+    expected = {mode: renderer.render(camera, mode=mode) for mode in ("points", "surface")}
+    results, errors = {}, []
+    others = {mode: subscan.Renderer(torus) for mode in expected}
+
+    def work(mode):
+        try:
+            for _ in range(3):
+                results[mode] = others[mode].render(camera, mode=mode)
+        except Exception as error:  # reported below: an exception in a thread is otherwise lost
+            errors.append(error)
+
+    threads = [threading.Thread(target=work, args=(mode,)) for mode in expected]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not errors, errors
+    for mode in expected:
+        np.testing.assert_array_equal(results[mode], expected[mode])
+    # A renderer made on this thread renders on another one.
+    thread = threading.Thread(target=work, args=("points",))
+    thread.start()
+    thread.join()
+    assert not errors, errors
+
+
+def longest_pause_during(call):
+    """Runs `call` on another thread while this one keeps reading the clock, and returns the
+    longest time this thread could not run while the call ran, and the call's duration. A call
+    holding the GIL stops this thread for all of its time in C++; Python's switch interval
+    (5 ms) alone would let it run often in between."""
+    window = {}
+
+    def timed():
+        window["start"] = time.perf_counter()
+        call()
+        window["end"] = time.perf_counter()
+
+    thread = threading.Thread(target=timed)
+    ticks = []
+    thread.start()
+    while thread.is_alive():
+        ticks.append(time.perf_counter())
+    thread.join()
+    inside = [window["start"]] + [t for t in ticks if window["start"] < t < window["end"]] + \
+        [window["end"]]
+    return max(np.diff(inside)), window["end"] - window["start"]
+
+
+def test_the_gil_is_released_while_rendering_and_loading(torus):
+    renderer = subscan.Renderer(torus)
+    big = subscan.Camera.orbit(torus, width=1280, height=720)
+    renderer.render(big, mode="sss")  # compiles the shaders: the timed call only renders
+    for call in (lambda: renderer.render(big, mode="sss"),
+                 lambda: subscan.load("synthetic:sculpture?points=100000")):
+        pause, duration = longest_pause_during(call)
+        assert duration > 0.1, "too short to tell"
+        # Held, the GIL would stop this thread for nearly the whole call; released, only the
+        # scheduler pauses it (a few ms, or tens on a busy machine with llvmpipe's threads).
+        assert pause < 0.5 * duration, (pause, duration)
+
+
+@pytest.mark.parametrize("call, error, message", [
+    (lambda r, c: r.render(c, mode="voxels"), ValueError,
+     "'voxels' is not a render mode (expected one of: points, points-gl, splats, surface, sss)"),
+    (lambda r, c: r.render(c, samples=0), ValueError, "samples 0 is outside 1..2048"),
+    (lambda r, c: r.render(c, mode="points", samples=4), ValueError,
+     "samples needs the final picture of the surface or sss mode (the temporal filter "
+     "anti-aliases reconstructed surfaces)"),
+    (lambda r, c: r.render(c, settings={"raster": {"mode": "nope"}}), ValueError,
+     "'nope' is not a render mode (expected one of: points, points-gl, splats, surface, sss)"),
+    (lambda r, c: r.render(c, settings=42), TypeError,
+     "settings must be a subscan.Settings, a dict or None, not int"),
+    (lambda r, c: r.render(subscan.Camera(width=65536, height=65536, near=1, far=2)),
+     subscan.Error, None),
+])
+def test_bad_render_calls_raise(renderer, camera, call, error, message):
+    with pytest.raises(error) as raised:
+        call(renderer, camera)
+    if message is not None:
+        assert str(raised.value) == message
+    else:
+        assert "is outside what the GPU can render" in str(raised.value)
+    renderer.render(camera, mode="points")  # and the renderer still works
+
+
+def test_buffers_need_a_render_that_kept_them(torus, camera):
+    renderer = subscan.Renderer(torus)
+    with pytest.raises(subscan.Error, match=r"no buffers: the last render\(\) did not keep them"):
+        renderer.buffers()
+    renderer.render(camera, mode="surface")
+    with pytest.raises(subscan.Error, match="no buffers"):
+        renderer.buffers()
+    renderer.render(camera, mode="surface", buffers=True)
+    assert "depth" in renderer.buffers()
+    with pytest.raises(TypeError):
+        subscan.Renderer("not a cloud")
