@@ -102,6 +102,9 @@ Camera orbit(const CloudData& cloud, double yaw, double pitch, std::optional<dou
     if (!center.is_none()) {
         view.center = vectorArgument(center, "center");
     }
+    // As render frames a scan: its points' framing box fills the picture.
+    view.framing = Framing::Box;
+    view.framed = framingBounds(cloud.cloud());
     return checked(orbitCamera(cloud.cloud().bounds, view, width, height, fovy));
 }
 
@@ -196,8 +199,9 @@ Bad values raise ValueError with the sentence camera.json's reader gives.
                     py::arg("fovy") = 45.0, py::arg("center") = py::none(), R"doc(
 The camera `subscan render` uses without --camera: orbiting the middle of the cloud's bounds
 (or `center`), `yaw` degrees around the up axis, `pitch` degrees above the horizon, at
-`distance` (default: the bounds fill the view); up 'auto' is Z for LAS files, else Y. Near and
-far hug the bounding sphere.
+`distance` (default: the box of its points, 0.1 to 99.9 % per axis, fills 95 % of the picture's
+limiting side, centred); up 'auto' is Z for LAS files, else Y. Near and far hug the bounding
+sphere.
 )doc")
         .def_static("look_at", &lookAt, py::arg("eye"), py::arg("target"),
                     py::arg("up") = py::make_tuple(0.0, 1.0, 0.0), py::arg("width") = 1280,

@@ -57,7 +57,9 @@ py::array arrayOf(ImageF image) {
 class RendererState {
   public:
     RendererState(const CloudHandle& cloud, bool software)
-        : bounds_(cloud->cloud().bounds), format_(cloud->format()) {
+        : bounds_(cloud->cloud().bounds),
+          framed_(framingBounds(cloud->cloud())),
+          format_(cloud->format()) {
         const py::gil_scoped_release release;
         HeadlessContextOptions options;
         options.preferHardware = !software;
@@ -218,10 +220,13 @@ class RendererState {
     Camera defaultCamera() const {
         OrbitView orbit;
         orbit.up = format_ == "las" ? UpAxis::Z : UpAxis::Y;
+        orbit.framing = Framing::Box;  // as render frames a scan
+        orbit.framed = framed_;
         return orbitCamera(bounds_, orbit, 1280, 720, 45.0);
     }
 
     Bounds bounds_;
+    Bounds framed_;  // framingBounds() of the cloud
     std::string format_;
     std::mutex mutex_;  // one call at a time; the GIL is released while a call works
     std::unique_ptr<GlContext> context_;
