@@ -49,32 +49,11 @@ void checkRange(double value, double low, double high, std::string_view name) {
     }
 }
 
-nlohmann::json optionalRgb(const std::optional<Rgb>& value) {
-    return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-}
-
-nlohmann::json gaussiansJson(const GaussianSet& set) {
-    nlohmann::json gaussians = nlohmann::json::array();
-    for (const Gaussian& term : set.gaussians) {
-        gaussians.push_back({{"variance_mm2", term.varianceMm2}, {"weight", term.weight}});
-    }
-    return gaussians;
-}
-
 /// `subscan materials --json`.
 py::list materials() {
     py::list list;
     for (const Material& material : materialLibrary()) {
-        list.append(toPython({
-            {"name", material.name},
-            {"description", material.description},
-            {"eta", material.eta},
-            {"sigma_s_prime", optionalRgb(material.sigmaSPrime)},
-            {"sigma_a", optionalRgb(material.sigmaA)},
-            {"rd", optionalRgb(material.rd)},
-            {"cumulative", material.gaussians.cumulative},
-            {"gaussians", gaussiansJson(material.gaussians)},
-        }));
+        list.append(toPython(materialJson(material)));
     }
     return list;
 }
@@ -94,12 +73,7 @@ py::object fitProfile(const std::string& materialName, int gaussians, const std:
         const py::gil_scoped_release release;
         fit = fitGaussians(radial, gaussians);
     }
-    return toPython({
-        {"material", material.name},
-        {"gaussians", gaussiansJson(fit.gaussians)},
-        {"fit_error", fit.quality.fitError},
-        {"r_max_mm", fit.quality.rMaxMm},
-    });
+    return toPython(profileFitJson(material, fit));
 }
 
 /// A mesh argument: a Cloud with triangles, or a file to load.

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <nlohmann/json.hpp>
+
 namespace subscan {
 
 std::array<double, 3> GaussianSet::evaluate(double radiusMm) const {
@@ -37,6 +39,23 @@ double GaussianSet::largestVarianceMm2() const {
         largest = std::max(largest, term.varianceMm2);
     }
     return largest;
+}
+
+nlohmann::json gaussiansJson(const GaussianSet& set) {
+    nlohmann::json terms = nlohmann::json::array();
+    for (const Gaussian& term : set.gaussians) {
+        terms.push_back({{"variance_mm2", term.varianceMm2}, {"weight", term.weight}});
+    }
+    return terms;
+}
+
+GaussianSet gaussiansFromJson(const nlohmann::json& terms) {
+    GaussianSet set;
+    for (const nlohmann::json& term : terms) {
+        set.gaussians.push_back({term.at("variance_mm2").get<double>(),
+                                 term.at("weight").get<std::array<double, 3>>()});
+    }
+    return set;
 }
 
 }  // namespace subscan

@@ -3,6 +3,8 @@
 #include <array>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 namespace subscan {
 
 /// One term of a diffusion profile R(r) ≈ Σ wᵢ G(vᵢ, r), G(v, r) = exp(−r²/2v) / (2πv), r in mm.
@@ -25,5 +27,11 @@ struct GaussianSet {
     std::array<double, 3> weightSums() const;
     double largestVarianceMm2() const;
 };
+
+/// The terms as `subscan fit-profile --json` and `materials --json` list them:
+/// [{"variance_mm2": v, "weight": [R, G, B]}, ...].
+nlohmann::json gaussiansJson(const GaussianSet& set);
+/// The terms of such a list (throws nlohmann::json's errors when a field is missing).
+GaussianSet gaussiansFromJson(const nlohmann::json& terms);
 
 }  // namespace subscan

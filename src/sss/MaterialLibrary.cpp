@@ -25,13 +25,7 @@ GaussianSet storedFit(std::string_view material) {
         if (stored.material != material) {
             continue;
         }
-        const nlohmann::json fit = nlohmann::json::parse(stored.json);
-        GaussianSet set;
-        for (const nlohmann::json& term : fit.at("gaussians")) {
-            set.gaussians.push_back({term.at("variance_mm2").get<double>(),
-                                     term.at("weight").get<std::array<double, 3>>()});
-        }
-        return set;
+        return gaussiansFromJson(nlohmann::json::parse(stored.json).at("gaussians"));
     }
     return {};
 }
@@ -149,6 +143,22 @@ const Material& measuredMaterial(std::string_view name) {
         "the material '{}' is a Gaussian set without measured σs′ and σa, so single scattering "
         "cannot take its coefficients; choose one of {} or coefficients 'color'",
         name, measured));
+}
+
+nlohmann::json materialJson(const Material& material) {
+    const auto optionalRgb = [](const std::optional<Rgb>& value) {
+        return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+    };
+    return {
+        {"name", material.name},
+        {"description", material.description},
+        {"eta", material.eta},
+        {"sigma_s_prime", optionalRgb(material.sigmaSPrime)},
+        {"sigma_a", optionalRgb(material.sigmaA)},
+        {"rd", optionalRgb(material.rd)},
+        {"cumulative", material.gaussians.cumulative},
+        {"gaussians", gaussiansJson(material.gaussians)},
+    };
 }
 
 }  // namespace subscan

@@ -6,6 +6,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "sss/GaussianSet.h"
 
 namespace subscan {
@@ -33,5 +35,8 @@ const Material& findMaterial(std::string_view name);
 /// The material called `name` when it has measured σs′ and σa (single scattering needs them);
 /// throws Error naming the materials that do when it has none.
 const Material& measuredMaterial(std::string_view name);
+
+/// One entry of `subscan materials --json` (missing measurements are null).
+nlohmann::json materialJson(const Material& material);
 
 }  // namespace subscan

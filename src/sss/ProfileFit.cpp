@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 #include <Eigen/Dense>
+#include <nlohmann/json.hpp>
 
 #include "core/Error.h"
 #include "sss/Burley.h"
@@ -572,6 +573,15 @@ RadialProfile diffusionProfile(const Material& material, ProfileModel model) {
     }
     const BurleyProfile burley(dipole.totalReflectance(), meanFreePath);
     return [burley](double radiusMm) { return burley.reflectance(radiusMm); };
+}
+
+nlohmann::json profileFitJson(const Material& material, const ProfileFit& fit) {
+    return {
+        {"material", material.name},
+        {"gaussians", gaussiansJson(fit.gaussians)},
+        {"fit_error", fit.quality.fitError},
+        {"r_max_mm", fit.quality.rMaxMm},
+    };
 }
 
 }  // namespace subscan

@@ -46,6 +46,9 @@ struct ProfileFit {
 /// and spends Gaussians with tiny variances on the singularity.
 ProfileFit fitGaussians(const RadialProfile& profile, int gaussianCount);
 
+/// `subscan fit-profile --json`: the material, the Gaussians, fit_error and r_max_mm.
+nlohmann::json profileFitJson(const Material& material, const ProfileFit& fit);
+
 /// The quality of `set` (weights per channel summing to 1) against the normalised profile.
 FitQuality measureFit(const RadialProfile& profile, const GaussianSet& set);
 

@@ -27,17 +27,7 @@ int runFitProfile(const FitProfileOptions& options) {
     const Rgb& error = fit.quality.fitError;
 
     if (options.json) {
-        nlohmann::json gaussians = nlohmann::json::array();
-        for (const Gaussian& term : fit.gaussians.gaussians) {
-            gaussians.push_back({{"variance_mm2", term.varianceMm2}, {"weight", term.weight}});
-        }
-        const nlohmann::json result = {
-            {"material", material.name},
-            {"gaussians", gaussians},
-            {"fit_error", error},
-            {"r_max_mm", fit.quality.rMaxMm},
-        };
-        fmt::print("{}\n", result.dump(2));
+        fmt::print("{}\n", profileFitJson(material, fit).dump(2));
         return 0;
     }
     fmt::print("{}: {} Gaussians fitted to the {} profile, normalised to unit energy per channel\n",

@@ -17,27 +17,6 @@ struct MaterialsOptions {
     bool json = false;
 };
 
-nlohmann::json optionalRgb(const std::optional<Rgb>& value) {
-    return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-}
-
-nlohmann::json materialJson(const Material& material) {
-    nlohmann::json gaussians = nlohmann::json::array();
-    for (const Gaussian& term : material.gaussians.gaussians) {
-        gaussians.push_back({{"variance_mm2", term.varianceMm2}, {"weight", term.weight}});
-    }
-    return {
-        {"name", material.name},
-        {"description", material.description},
-        {"eta", material.eta},
-        {"sigma_s_prime", optionalRgb(material.sigmaSPrime)},
-        {"sigma_a", optionalRgb(material.sigmaA)},
-        {"rd", optionalRgb(material.rd)},
-        {"cumulative", material.gaussians.cumulative},
-        {"gaussians", gaussians},
-    };
-}
-
 std::string rgbColumn(const std::optional<Rgb>& value) {
     return value ? fmt::format("{:g} {:g} {:g}", (*value)[0], (*value)[1], (*value)[2]) : "-";
 }
