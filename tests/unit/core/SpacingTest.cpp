@@ -1,8 +1,11 @@
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <glm/glm.hpp>
 
 #include "core/PointCloud.h"
 #include "core/Spacing.h"
@@ -61,6 +64,107 @@ TEST(SpacingTest, SampledEstimateMatchesTheFullMedianOnJitteredPoints) {
 TEST(SpacingTest, DegenerateCloudsGiveZero) {
     EXPECT_EQ(estimateSpacing(gridPlane(1, 1.0)), 0.0);
     EXPECT_EQ(estimateSpacing(gridPlane(1, 1.0, 5)), 0.0);  // five copies of one point
+}
+
+/// The nearest non-coincident distance of each query point i·n/samples, by brute force in
+/// double (infinity where there is none): the definition the header states, independently of
+/// the search structures.
+std::vector<double> bruteForceNearest(const PointCloud& cloud, std::size_t samples) {
+    std::vector<double> nearest;
+    for (std::size_t s = 0; s < samples; ++s) {
+        const glm::dvec3 query(cloud.positions[s * cloud.size() / samples]);
+        double best = std::numeric_limits<double>::infinity();
+        for (const glm::vec3& point : cloud.positions) {
+            const glm::dvec3 d = glm::dvec3(point) - query;
+            const double squared = glm::dot(d, d);
+            if (squared > 0.0) {
+                best = std::min(best, squared);
+            }
+        }
+        nearest.push_back(std::sqrt(best));
+    }
+    return nearest;
+}
+
+PointCloud cloudOf(const std::vector<glm::dvec3>& positions) {
+    PointCloudBuilder builder({}, positions.size());
+    for (const glm::dvec3& position : positions) {
+        PointRecord record;
+        record.position = position;
+        builder.add(record);
+    }
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
+TEST(SpacingTest, SampledQueriesFindTheirExactNearestNeighbourInTheWholeCloud) {
+    // Shapes that stress the grid search's cell size: a volume, a surface, a line (whose queries
+    // lie hundreds of spacings apart), a dense cluster with isolated points (which need the
+    // larger cells of later passes), with points farther still, and repeated points.
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const auto generate = [&](std::size_t count, auto&& position) {
+        std::vector<glm::dvec3> positions;
+        for (std::size_t i = 0; i < count; ++i) {
+            positions.push_back(position(i));
+        }
+        return cloudOf(positions);
+    };
+    const std::vector<std::pair<const char*, PointCloud>> clouds = {
+        {"volume", generate(60000,
+                            [&](std::size_t) {
+                                return glm::dvec3(unit(random), unit(random), unit(random)) * 10.0;
+                            })},
+        {"surface", generate(60000,
+                             [&](std::size_t) {
+                                 const double x = unit(random) * 4.0, y = unit(random) * 4.0;
+                                 return glm::dvec3(x, y,
+                                                   0.3 * std::sin(3.0 * x) * std::cos(2.0 * y));
+                             })},
+        {"line", generate(60000,
+                          [&](std::size_t i) {
+                              return glm::dvec3(i * 0.001 + unit(random) * 1e-4, 0.0, 0.0);
+                          })},
+        {"cluster with outliers",
+         generate(60000,
+                  [&](std::size_t i) {
+                      const glm::dvec3 inCluster(unit(random), unit(random), unit(random));
+                      return i % 50 == 0 ? inCluster * 1000.0 : inCluster * 0.5;
+                  })},
+        {"far outliers", generate(60000,
+                                  [&](std::size_t i) {
+                                      // Beyond the cells' growth over the passes: the k-d tree's
+                                      // turn.
+                                      const glm::dvec3 inCluster(unit(random), unit(random),
+                                                                 unit(random));
+                                      return i % 5000 == 0 ? inCluster * 10000.0 : inCluster * 0.5;
+                                  })},
+        {"every point four times",
+         generate(60000,
+                  [&](std::size_t i) {
+                      // Overlapping range images: each position again 15000 points later.
+                      const std::size_t original = i % 15000;
+                      return glm::dvec3(original % 120, original / 120, (original * 7) % 3) * 0.01;
+                  })},
+    };
+    for (const auto& [name, cloud] : clouds) {
+        constexpr std::size_t kSamples = 700;
+        const std::vector<double> expected = bruteForceNearest(cloud, kSamples);
+        const std::vector<float> found = sampledNearestDistances(cloud, kSamples);
+        ASSERT_EQ(found.size(), kSamples) << name;
+        int wrong = 0;
+        for (std::size_t q = 0; q < kSamples; ++q) {
+            // Positions are floats about the centre and the search works in float: 1e-6
+            // relative is a few float roundings of one distance.
+            wrong += std::abs(found[q] - expected[q]) > 1e-6 * expected[q] ? 1 : 0;
+        }
+        EXPECT_EQ(wrong, 0) << name;
+        std::vector<double> finite = expected;
+        std::nth_element(finite.begin(), finite.begin() + kSamples / 2, finite.end());
+        EXPECT_NEAR(estimateSpacing(cloud, kSamples), finite[kSamples / 2],
+                    1e-6 * finite[kSamples / 2])
+            << name;
+    }
 }
 
 }  // namespace
