@@ -54,7 +54,15 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
     if (chunkPoints == 0) {
         throw Error("the OpenGL driver reports no room for buffer textures");
     }
-    const std::vector<std::uint32_t> colors = displayColors(cloud);
+    // The scan's own colours are uploaded as they are (an RGBA8 byte quadruple is the packed
+    // uint32 on a little-endian machine): a copy of 40 MB for 10 M points saved.
+    static_assert(std::endian::native == std::endian::little);
+    std::vector<std::uint32_t> converted;
+    if (!cloud.hasColors()) {
+        converted = displayColors(cloud);
+    }
+    const void* colors = cloud.hasColors() ? static_cast<const void*>(cloud.colors.data())
+                                           : static_cast<const void*>(converted.data());
     for (std::size_t first = 0; first < size_; first += chunkPoints) {
         Chunk chunk;
         chunk.firstPoint = static_cast<std::uint32_t>(first);
@@ -63,7 +71,9 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
             chunk.positions = Buffer(chunk.pointCount * 3 * sizeof(float), &cloud.positions[first],
                                      "points.positions");
             chunk.colors =
-                Buffer(chunk.pointCount * sizeof(std::uint32_t), &colors[first], "points.colors");
+                Buffer(chunk.pointCount * sizeof(std::uint32_t),
+                       static_cast<const std::byte*>(colors) + first * sizeof(std::uint32_t),
+                       "points.colors");
         } catch (const Error& error) {
             throw Error(fmt::format("the GPU cannot hold the {} points ({:.0f} MB): {}", size_,
                                     static_cast<double>(bytes()) / 1e6, error.what()));
