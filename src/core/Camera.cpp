@@ -23,12 +23,13 @@ glm::dmat4 Camera::projection() const {
                                       static_cast<double>(width) / static_cast<double>(height),
                                       nearPlane, farPlane);
     }
-    if (jitterPixels == glm::dvec2(0.0)) {
+    const glm::dvec2 shiftPixels = pictureShiftPixels();
+    if (shiftPixels == glm::dvec2(0.0)) {
         return projection;
     }
     // A shift in normalized device coordinates (2 / size per pixel; window y runs down): as a
     // translation of clip space it scales with w, so it moves every depth alike.
-    const glm::dvec3 shift(2.0 * jitterPixels.x / width, -2.0 * jitterPixels.y / height, 0.0);
+    const glm::dvec3 shift(2.0 * shiftPixels.x / width, -2.0 * shiftPixels.y / height, 0.0);
     return glm::translate(glm::dmat4(1.0), shift) * projection;
 }
 

@@ -28,6 +28,12 @@ struct Camera {
     /// of the pipeline's camera. projection() and the shaders' viewPositionAt() include it; the
     /// viewer's picking ignores it (half a pixel at most).
     glm::dvec2 jitterPixels{0.0};
+    /// Where the optical axis meets the picture, in pixels from its middle (x right, y down):
+    /// a real sensor's principal point is rarely the exact centre. Shifts the picture as the
+    /// jitter does (projection() and the shaders include both); kept by the temporal filter.
+    glm::dvec2 principalOffsetPixels{0.0};
+    /// The picture's whole sub-pixel and principal shift.
+    glm::dvec2 pictureShiftPixels() const { return jitterPixels + principalOffsetPixels; }
 
     bool orthographic() const { return orthographicHeight > 0.0; }
     glm::dmat4 projection() const;

@@ -35,6 +35,24 @@ T required(const nlohmann::json& json, const char* key) {
     }
 }
 
+/// An optional [x, y] pixel offset; (0, 0) when absent.
+glm::dvec2 optionalPixels(const nlohmann::json& json, const char* name) {
+    const auto entry = json.find(name);
+    if (entry == json.end()) {
+        return glm::dvec2(0.0);
+    }
+    std::array<double, 2> pixels{};
+    try {
+        pixels = entry->get<std::array<double, 2>>();
+    } catch (const nlohmann::json::exception&) {
+        throw Error(fmt::format("the camera's '{}' needs 2 numbers", name));
+    }
+    if (!std::isfinite(pixels[0]) || !std::isfinite(pixels[1])) {
+        throw Error(fmt::format("the camera's '{}' holds a non-finite number", name));
+    }
+    return {pixels[0], pixels[1]};
+}
+
 }  // namespace
 
 nlohmann::json cameraToJson(const Camera& camera) {
@@ -49,6 +67,10 @@ nlohmann::json cameraToJson(const Camera& camera) {
     };
     if (camera.jitterPixels != glm::dvec2(0.0)) {
         json["jitter_pixels"] = {camera.jitterPixels.x, camera.jitterPixels.y};
+    }
+    if (camera.principalOffsetPixels != glm::dvec2(0.0)) {
+        json["principal_offset_pixels"] = {camera.principalOffsetPixels.x,
+                                           camera.principalOffsetPixels.y};
     }
     return json;
 }
@@ -92,18 +114,8 @@ Camera cameraFromJson(const nlohmann::json& json) {
             camera.view[column][row] = value;
         }
     }
-    if (const auto jitter = json.find("jitter_pixels"); jitter != json.end()) {
-        std::array<double, 2> pixels{};
-        try {
-            pixels = jitter->get<std::array<double, 2>>();
-        } catch (const nlohmann::json::exception&) {
-            throw Error("the camera's 'jitter_pixels' needs 2 numbers");
-        }
-        if (!std::isfinite(pixels[0]) || !std::isfinite(pixels[1])) {
-            throw Error("the camera's 'jitter_pixels' holds a non-finite number");
-        }
-        camera.jitterPixels = {pixels[0], pixels[1]};
-    }
+    camera.jitterPixels = optionalPixels(json, "jitter_pixels");
+    camera.principalOffsetPixels = optionalPixels(json, "principal_offset_pixels");
     return camera;
 }
 

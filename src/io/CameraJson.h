@@ -11,7 +11,8 @@ namespace subscan {
 /// camera.json (DESIGN.md §4): width, height, fovy_deg, near, far, `view` (file coordinates ->
 /// view space) and `projection` (view -> clip), both as 4 rows of 4 numbers (row-major); a
 /// camera the temporal filter shifted also has `jitter_pixels` [x, y] (Camera::jitterPixels,
-/// in `projection` too), absent when zero.
+/// in `projection` too), and a sensor's camera `principal_offset_pixels` [x, y]
+/// (Camera::principalOffsetPixels), each absent when zero.
 nlohmann::json cameraToJson(const Camera& camera);
 /// Validates every field; `projection` is not read back (it follows from fovy, near, far, the
 /// image size and the jitter). Throws subscan::Error naming the field.

@@ -614,6 +614,12 @@ ScanLayout parseScan(const pugi::xml_node& node, int number, ReadContext& contex
             number));
     }
     scan.pose = parsePose(node, number);
+    if (!context.sensor) {
+        // A scan's own frame is centred on the scanner; its pose places it in the file's frame.
+        context.sensor =
+            SensorPose{scan.pose.translation, fmt::format("the origin of E57 scan {}{}", number,
+                                                          node.child("pose") ? " (its pose)" : "")};
+    }
     return scan;
 }
 

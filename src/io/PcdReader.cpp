@@ -63,6 +63,8 @@ struct PcdHeader {
     std::size_t headerLines = 0;       // so ascii errors can name the line in the whole file
     std::uint64_t stride = 0;          // Σ SIZE × COUNT: bytes per point in binary data
     std::uint64_t valuesPerPoint = 0;  // Σ COUNT: numbers per line in ascii data
+    glm::dvec3 viewpoint{0.0};         // the sensor's position (VIEWPOINT; the default is 0 0 0)
+    bool viewpointGiven = false;
 };
 
 /// Bytes and numbers per point are capped far above any real layout, so that every product of
@@ -124,7 +126,8 @@ struct HeaderLine {
 
 /// The header as written, before its lines are checked against each other.
 struct RawHeader {
-    std::optional<HeaderLine> version, fields, sizes, types, counts, width, height, points;
+    std::optional<HeaderLine> version, fields, sizes, types, counts, width, height, points,
+        viewpoint;
 };
 
 /// Far longer than any real header line (FIELDS of a few hundred names).
@@ -198,7 +201,9 @@ RawHeader readHeaderLines(std::string_view file, PcdHeader& header) {
             store(raw.height);
         } else if (keyword == "POINTS") {
             store(raw.points);
-        } else if (keyword != "VIEWPOINT") {  // the sensor pose does not move the points
+        } else if (keyword == "VIEWPOINT") {
+            store(raw.viewpoint);
+        } else {
             failLine(line, "is not a PCD header keyword");
         }
     }
@@ -315,6 +320,25 @@ PcdHeader parseHeader(std::string_view file) {
         header.valuesPerPoint += field.count;
     }
 
+    if (raw.viewpoint) {
+        // VIEWPOINT tx ty tz qw qx qy qz: the sensor's position and orientation. The points are
+        // not moved by it (PCL keeps them as stored); only the position is used, for the
+        // sensor view (an organised cloud's own grid gives its orientation more reliably).
+        const HeaderLine& line = *raw.viewpoint;
+        std::array<double, 7> values{};
+        bool valid = line.words.size() == 8;
+        for (std::size_t i = 0; valid && i < values.size(); ++i) {
+            const std::string_view word = line.words[i + 1];
+            valid = parseNumber(word.data(), word.data() + word.size(), values[i]) ==
+                        word.data() + word.size() &&
+                    std::isfinite(values[i]);
+        }
+        if (!valid) {
+            failLine(line, "should read 'VIEWPOINT tx ty tz qw qx qy qz' with finite numbers");
+        }
+        header.viewpoint = {values[0], values[1], values[2]};
+        header.viewpointGiven = true;
+    }
     const auto width = readCount(raw.width);
     const auto height = readCount(raw.height);
     const auto points = readCount(raw.points);
@@ -579,7 +603,8 @@ class PointSink {
         : layout_(layout),
           builder_(PointAttributes{layout.packedColor || layout.colorChannels,
                                    layout.normal.has_value(), layout.intensity.has_value()},
-                   expectedPoints) {
+                   expectedPoints),
+          organised_(header.height > 1) {
         if (layout.colorChannels) {
             channelColors_.emplace(header, layout);
         }
@@ -603,13 +628,16 @@ class PointSink {
         if (layout_.intensity) {
             record.intensity = saturateToFloat(valueOf(*layout_.intensity));
         }
-        if (!channelColors_) {
-            builder_.add(record);
-            return;
-        }
         const std::size_t keptBefore = builder_.validPoints();
         builder_.add(record);
-        if (builder_.validPoints() > keptBefore) {
+        const std::uint32_t recordNumber = records_++;
+        if (builder_.validPoints() == keptBefore) {
+            return;
+        }
+        if (organised_) {
+            cellOfPoint_.push_back(recordNumber);
+        }
+        if (channelColors_) {
             const auto& c = *layout_.colorChannels;
             channelColors_->add({valueOf(c[0]), valueOf(c[1]), valueOf(c[2]),
                                  layout_.alphaChannel ? valueOf(*layout_.alphaChannel) : 255.0});
@@ -624,10 +652,16 @@ class PointSink {
         return cloud;
     }
 
+    /// For an organised cloud, the grid cell (record number) of each point kept.
+    std::vector<std::uint32_t> takeCellOfPoint() { return std::move(cellOfPoint_); }
+
   private:
     const FieldLayout& layout_;
     PointCloudBuilder builder_;
     std::optional<ChannelColors> channelColors_;
+    bool organised_ = false;
+    std::uint32_t records_ = 0;  // PCD point counts fit 32 bits (kMaxPoints)
+    std::vector<std::uint32_t> cellOfPoint_;
 };
 
 constexpr std::uint64_t kProgressEvery = 1 << 16;
@@ -899,7 +933,15 @@ PointCloud readPcd(std::span<const std::byte> file, ReadContext& context) {
             break;
     }
     context.reportProgress(header.points, header.points);
-    return sink.finish(context.warnings);
+    PointCloud cloud = sink.finish(context.warnings);
+    context.sensor = SensorPose{header.viewpoint, header.viewpointGiven
+                                                      ? "the PCD VIEWPOINT"
+                                                      : "the PCD default VIEWPOINT (none given)"};
+    if (header.height > 1) {
+        context.grid = {static_cast<int>(header.width), static_cast<int>(header.height),
+                        sink.takeCellOfPoint()};
+    }
+    return cloud;
 }
 
 }  // namespace subscan

@@ -2,8 +2,11 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "core/SensorView.h"
 
 namespace subscan {
 
@@ -15,6 +18,10 @@ struct ReadContext {
     std::vector<std::string> warnings;
     /// Filled by the reader, e.g. "PLY 1.0 binary_little_endian" or "LAS 1.4, point format 7".
     std::string formatDetail;
+    /// Where the sensor stood, when the file says (PCD VIEWPOINT, E57 pose).
+    std::optional<SensorPose> sensor;
+    /// The grid of an organised cloud (PCD HEIGHT > 1), with each kept point's cell.
+    OrganisedGrid grid;
     /// Threads for readers that decode independent blocks (LAZ chunks); 0: one per core.
     unsigned decodeThreads = 0;
 

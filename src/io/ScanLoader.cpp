@@ -159,6 +159,8 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
     }
     scan.formatDetail = std::move(context.formatDetail);
     scan.warnings = std::move(context.warnings);
+    scan.sensor = std::move(context.sensor);
+    scan.grid = std::move(context.grid);
     return scan;
 }
 

@@ -3,12 +3,14 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/PointCloud.h"
+#include "core/SensorView.h"
 
 namespace subscan {
 
@@ -22,7 +24,9 @@ struct LoadedScan {
     std::string format;        // "ply", "las", "pcd", "xyz", "e57" or "synthetic"
     std::string formatDetail;  // e.g. "PLY 1.0 binary_little_endian"
     std::vector<std::string> warnings;
-    double loadMilliseconds = 0.0;  // reading and decoding, nothing after
+    double loadMilliseconds = 0.0;     // reading and decoding, nothing after
+    std::optional<SensorPose> sensor;  // where the file says the sensor stood
+    OrganisedGrid grid;                // an organised cloud's grid (empty when unorganised)
 };
 
 /// Loads a scan file, or scans a built-in scene for "synthetic:NAME[?points=N][&noise=X]"

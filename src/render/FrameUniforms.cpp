@@ -20,8 +20,8 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
     const glm::vec3& background = settings.raster.backgroundSrgb;
     frame.background = {srgbToLinear(background.r), srgbToLinear(background.g),
                         srgbToLinear(background.b), 1.0f};
-    frame.jitter = {static_cast<float>(camera.jitterPixels.x),
-                    static_cast<float>(camera.jitterPixels.y), 0.0f, 0.0f};
+    const glm::dvec2 shift = camera.pictureShiftPixels();
+    frame.jitter = {static_cast<float>(shift.x), static_cast<float>(shift.y), 0.0f, 0.0f};
     frame_.set(frame);
     frame_.bind(SUBSCAN_UBO_FRAME);
 

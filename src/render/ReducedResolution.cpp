@@ -32,6 +32,7 @@ Camera reducedCamera(const Camera& output, int divisor) {
                                static_cast<double>(output.height);
     reduced.fovyDegrees = glm::degrees(2.0 * std::atan(halfTangent));
     reduced.jitterPixels = output.jitterPixels / static_cast<double>(divisor);
+    reduced.principalOffsetPixels = output.principalOffsetPixels / static_cast<double>(divisor);
     return reduced;
 }
 

@@ -31,7 +31,8 @@ double radicalInverse(unsigned index, unsigned base) {
 bool sameView(const Camera& a, const Camera& b) {
     return a.width == b.width && a.height == b.height && a.fovyDegrees == b.fovyDegrees &&
            a.nearPlane == b.nearPlane && a.farPlane == b.farPlane && a.view == b.view &&
-           a.orthographicHeight == b.orthographicHeight;
+           a.orthographicHeight == b.orthographicHeight &&
+           a.principalOffsetPixels == b.principalOffsetPixels;
 }
 
 Camera withoutJitter(const Camera& camera) {

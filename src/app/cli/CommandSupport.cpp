@@ -1,10 +1,13 @@
 #include "app/cli/CommandSupport.h"
 
 #include <filesystem>
+#include <limits>
 #include <sstream>
 #include <system_error>
 
 #include <fmt/format.h>
+#include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "app/ProgressBar.h"
 #include "core/Error.h"
@@ -29,15 +32,24 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
     return std::filesystem::equivalent(a, b, ignored);
 }
 
-std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text) {
-    glm::vec3 value;
+std::optional<glm::dvec3> parseCommaSeparatedTriple(const std::string& text) {
+    glm::dvec3 value;
     char comma1 = 0, comma2 = 0;
     std::istringstream stream(text);
-    stream >> value.r >> comma1 >> value.g >> comma2 >> value.b;
+    stream >> value.x >> comma1 >> value.y >> comma2 >> value.z;
     if (!stream || comma1 != ',' || comma2 != ',' || !stream.eof()) {
         return std::nullopt;
     }
     return value;
+}
+
+std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text) {
+    const std::optional<glm::dvec3> value = parseCommaSeparatedTriple(text);
+    constexpr double kLargestFloat = std::numeric_limits<float>::max();
+    if (!value || glm::any(glm::greaterThan(glm::abs(*value), glm::dvec3(kLargestFloat)))) {
+        return std::nullopt;
+    }
+    return glm::vec3(*value);
 }
 
 void addResolutionOption(CLI::App& command, std::string& resolution) {

@@ -23,6 +23,8 @@ bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b);
 
 /// "R,G,B": three numbers separated by commas (no spaces), or nullopt when `text` is not that.
 std::optional<glm::vec3> parseCommaSeparatedRgb(const std::string& text);
+/// "X,Y,Z" as three finite doubles (file coordinates keep their precision); nullopt otherwise.
+std::optional<glm::dvec3> parseCommaSeparatedTriple(const std::string& text);
 
 /// `--resolution full|half|auto` (RasterSettings::resolution), as render and bench take it.
 void addResolutionOption(CLI::App& command, std::string& resolution);

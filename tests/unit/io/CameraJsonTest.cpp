@@ -47,6 +47,26 @@ TEST(CameraJsonTest, RoundTripsAndWritesRowMajorMatrices) {
     nlohmann::json bad = jittered;
     bad["jitter_pixels"] = {0.1};
     EXPECT_THROW(cameraFromJson(bad), Error);
+
+    // A sensor's principal point off the middle: kept apart from the jitter, shifting the
+    // projection by both (y down in pixels is up in clip space).
+    camera.principalOffsetPixels = {4.0, -16.0};
+    const nlohmann::json sensor = cameraToJson(camera);
+    const Camera sensorBack = cameraFromJson(sensor);
+    EXPECT_EQ(sensorBack.principalOffsetPixels, camera.principalOffsetPixels);
+    EXPECT_EQ(sensorBack.jitterPixels, camera.jitterPixels);
+    EXPECT_NEAR(sensor["projection"][0][2].get<double>() - json["projection"][0][2].get<double>(),
+                -2.0 * (0.25 + 4.0) / 320, 1e-15);
+    EXPECT_NEAR(sensor["projection"][1][2].get<double>() - json["projection"][1][2].get<double>(),
+                2.0 * (-0.375 - 16.0) / 200, 1e-15);
+    bad = sensor;
+    bad["principal_offset_pixels"] = {1.0, "x"};
+    try {
+        cameraFromJson(bad);
+        FAIL() << "accepted a principal offset that is not 2 numbers";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), ::testing::HasSubstr("principal_offset_pixels"));
+    }
 }
 
 TEST(CameraJsonTest, InvalidFieldsAreNamed) {

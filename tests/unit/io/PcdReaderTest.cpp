@@ -267,6 +267,39 @@ TEST(PcdReaderTest, OrganisedCloudIsFlattenedAndNanPointsDropped) {
         EXPECT_NEAR(scan.cloud.fileCoordinates(i).z, 2 * kept[i], 1e-5);
     }
     EXPECT_THAT(scan.warnings, Contains(HasSubstr("dropped 5 of 12 points")));
+    // The grid and each kept point's cell, for the sensor view's camera fit.
+    EXPECT_EQ(scan.grid.width, 4);
+    EXPECT_EQ(scan.grid.height, 3);
+    EXPECT_EQ(scan.grid.cellOfPoint, (std::vector<std::uint32_t>{0, 3, 4, 6, 7, 8, 9}));
+}
+
+TEST(PcdReaderTest, ViewpointGivesTheSensorPosition) {
+    std::string header = pcdHeader(kFloatXyz, 2, 1, "ascii");
+    const std::string points = "1 2 3\n4 5 6\n";
+    header.replace(header.find("VIEWPOINT 0 0 0 1 0 0 0"), 23,
+                   "VIEWPOINT 512000.25 -7.5 1e2 0 1 0 0");
+    const LoadedScan scan = decode(header + points, "station.pcd");
+    ASSERT_TRUE(scan.sensor.has_value());
+    EXPECT_EQ(scan.sensor->position, glm::dvec3(512000.25, -7.5, 100.0));
+    EXPECT_THAT(scan.sensor->source, HasSubstr("VIEWPOINT"));
+    EXPECT_TRUE(scan.grid.empty());  // HEIGHT 1: unorganised
+
+    // Without the line, PCD's default: the origin.
+    std::string noViewpoint = pcdHeader(kFloatXyz, 2, 1, "ascii");
+    noViewpoint.erase(noViewpoint.find("VIEWPOINT"), 24);
+    const LoadedScan plain = decode(noViewpoint + points, "plain.pcd");
+    ASSERT_TRUE(plain.sensor.has_value());
+    EXPECT_EQ(plain.sensor->position, glm::dvec3(0.0));
+    EXPECT_THAT(plain.sensor->source, HasSubstr("default"));
+
+    for (const char* bad :
+         {"VIEWPOINT 0 0 0 1 0 0", "VIEWPOINT 0 0 nan 1 0 0 0", "VIEWPOINT 0 0 0 1 0 0 x"}) {
+        std::string broken = pcdHeader(kFloatXyz, 2, 1, "ascii");
+        broken.replace(broken.find("VIEWPOINT 0 0 0 1 0 0 0"), 23, bad);
+        EXPECT_THAT(decodeError(broken + points),
+                    HasSubstr("should read 'VIEWPOINT tx ty tz qw qx qy qz'"))
+            << bad;
+    }
 }
 
 TEST(PcdReaderTest, OldHeaderVariants) {

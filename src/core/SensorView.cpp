@@ -1,0 +1,210 @@
+#include "core/SensorView.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+
+namespace subscan {
+
+namespace {
+
+/// Near and far planes around points `nearest` to `farthest` deep: a margin either side, and
+/// near no closer than 1e-4 of far (the depth buffers' precision; as orbitCamera).
+void setDepthRange(Camera& camera, double nearest, double farthest) {
+    camera.farPlane = 1.02 * farthest;
+    camera.nearPlane = std::max(0.9 * nearest, 1e-4 * camera.farPlane);
+}
+
+/// A similarity moving `points` to their centroid and scaling their mean distance from it to
+/// sqrt(dimension): what keeps the DLT's equations well conditioned.
+template <int N>
+Eigen::Matrix<double, N + 1, N + 1> normalising(
+    const std::vector<Eigen::Matrix<double, N, 1>>& points) {
+    Eigen::Matrix<double, N, 1> centroid = Eigen::Matrix<double, N, 1>::Zero();
+    for (const auto& p : points) {
+        centroid += p;
+    }
+    centroid /= static_cast<double>(points.size());
+    double meanDistance = 0.0;
+    for (const auto& p : points) {
+        meanDistance += (p - centroid).norm();
+    }
+    meanDistance /= static_cast<double>(points.size());
+    const double scale = meanDistance > 0.0 ? std::sqrt(double(N)) / meanDistance : 1.0;
+    Eigen::Matrix<double, N + 1, N + 1> transform = Eigen::Matrix<double, N + 1, N + 1>::Identity();
+    transform.template topLeftCorner<N, N>() *= scale;
+    transform.template topRightCorner<N, 1>() = -scale * centroid;
+    return transform;
+}
+
+}  // namespace
+
+PinholeFit fitPinhole(const PointCloud& cloud, const OrganisedGrid& grid) {
+    const std::size_t count = std::min(cloud.size(), grid.cellOfPoint.size());
+    if (count < 6) {
+        throw Error(fmt::format("the organised grid has {} valid points; a camera needs at least 6",
+                                count));
+    }
+    std::vector<Eigen::Vector3d> points(count);
+    std::vector<Eigen::Vector2d> pixels(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const glm::vec3& p = cloud.positions[i];
+        points[i] = {p.x, p.y, p.z};
+        const std::uint32_t cell = grid.cellOfPoint[i];
+        // The middle of the cell, in pixels from the image's top-left corner.
+        pixels[i] = {cell % static_cast<std::uint32_t>(grid.width) + 0.5,
+                     cell / static_cast<std::uint32_t>(grid.width) + 0.5};
+    }
+    const Eigen::Matrix4d pointTransform = normalising<3>(points);
+    const Eigen::Matrix3d pixelTransform = normalising<2>(pixels);
+
+    // Each point gives two rows of A p = 0 for the 12 entries of the 3x4 projection; p is the
+    // eigenvector of AᵀA with the least eigenvalue (summed point by point: A is never held).
+    Eigen::Matrix<double, 12, 12> normal = Eigen::Matrix<double, 12, 12>::Zero();
+    for (std::size_t i = 0; i < count; ++i) {
+        const Eigen::Vector4d x = pointTransform * points[i].homogeneous();
+        const Eigen::Vector3d u = pixelTransform * pixels[i].homogeneous();
+        Eigen::Matrix<double, 12, 1> rowU = Eigen::Matrix<double, 12, 1>::Zero();
+        Eigen::Matrix<double, 12, 1> rowV = Eigen::Matrix<double, 12, 1>::Zero();
+        rowU.segment<4>(0) = x;
+        rowU.segment<4>(8) = -u.x() * x;
+        rowV.segment<4>(4) = x;
+        rowV.segment<4>(8) = -u.y() * x;
+        normal.selfadjointView<Eigen::Lower>().rankUpdate(rowU);
+        normal.selfadjointView<Eigen::Lower>().rankUpdate(rowV);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 12, 12>> solver(
+        normal.selfadjointView<Eigen::Lower>());
+    const Eigen::Matrix<double, 12, 1> p = solver.eigenvectors().col(0);
+    Eigen::Matrix<double, 3, 4> normalised;
+    normalised << p.segment<4>(0).transpose(), p.segment<4>(4).transpose(),
+        p.segment<4>(8).transpose();
+    Eigen::Matrix<double, 3, 4> projection = pixelTransform.inverse() * normalised * pointTransform;
+
+    // The sign that puts the points in front (positive homogeneous depth).
+    double depthSum = 0.0;
+    for (const Eigen::Vector3d& point : points) {
+        depthSum += projection.row(2).dot(point.homogeneous());
+    }
+    if (depthSum < 0.0) {
+        projection = -projection;
+    }
+    const Eigen::Matrix3d m = projection.leftCols<3>();
+    if (!(m.determinant() > 0.0)) {
+        throw Error(
+            "the organised grid is not the image of a pinhole camera (its projection "
+            "mirrors or is singular)");
+    }
+    // M = K R (K upper triangular, R a rotation) by a QR decomposition of M reversed: with J the
+    // row reversal, (J M)ᵀ = Q U gives M = (J Uᵀ J)(J Qᵀ).
+    Eigen::Matrix3d reverse = Eigen::Matrix3d::Zero();
+    reverse(0, 2) = reverse(1, 1) = reverse(2, 0) = 1.0;
+    const Eigen::HouseholderQR<Eigen::Matrix3d> qr((reverse * m).transpose());
+    const Eigen::Matrix3d upper = qr.matrixQR().triangularView<Eigen::Upper>();
+    Eigen::Matrix3d intrinsics = reverse * upper.transpose() * reverse;
+    Eigen::Matrix3d rotation = reverse * qr.householderQ().transpose();
+    const Eigen::Matrix3d signs = intrinsics.diagonal().cwiseSign().asDiagonal();
+    intrinsics = intrinsics * signs;
+    rotation = signs * rotation;
+    if (rotation.determinant() < 0.0) {
+        rotation = -rotation;  // M > 0 and K > 0 leave only an overall sign
+        intrinsics = -intrinsics;
+    }
+    const double scale = intrinsics(2, 2);
+    intrinsics /= scale;
+    const Eigen::Vector3d center = -m.inverse() * projection.col(3);
+
+    PinholeFit fit;
+    fit.focalX = intrinsics(0, 0);
+    fit.focalY = intrinsics(1, 1);
+    fit.principalPoint = {intrinsics(0, 2), intrinsics(1, 2)};
+    double squaredError = 0.0;
+    double nearest = std::numeric_limits<double>::infinity();
+    double farthest = 0.0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const Eigen::Vector3d projected = projection * points[i].homogeneous();
+        squaredError += (projected.hnormalized() - pixels[i]).squaredNorm();
+        const double depth = rotation.row(2).dot(points[i] - center);
+        nearest = std::min(nearest, depth);
+        farthest = std::max(farthest, depth);
+    }
+    fit.rmsErrorPixels = std::sqrt(squaredError / static_cast<double>(count));
+    if (!(nearest > 0.0) || !(fit.focalY > 0.0)) {
+        throw Error("the organised grid is not the image of a pinhole camera (points behind it)");
+    }
+
+    // The sensor's axes are x right, y down, z forward; the camera's view space has y up and
+    // looks down -z: rows 2 and 3 change sign.
+    Camera& camera = fit.camera;
+    camera.width = grid.width;
+    camera.height = grid.height;
+    camera.fovyDegrees = glm::degrees(2.0 * std::atan(0.5 * grid.height / fit.focalY));
+    camera.principalOffsetPixels = fit.principalPoint - 0.5 * glm::dvec2(grid.width, grid.height);
+    const glm::dvec3 eye = cloud.origin + glm::dvec3(center.x(), center.y(), center.z());
+    glm::dmat4 view(1.0);
+    for (int row = 0; row < 3; ++row) {
+        const double sign = row == 0 ? 1.0 : -1.0;
+        for (int column = 0; column < 3; ++column) {
+            view[column][row] = sign * rotation(row, column);
+        }
+    }
+    view = view * Camera::translation(-eye);
+    camera.view = view;
+    setDepthRange(camera, nearest, farthest);
+    return fit;
+}
+
+Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up, int width,
+                    int height, double fovyDegrees) {
+    const Bounds framed = framingBounds(cloud);
+    const glm::dvec3 target = framed.center();
+    const double diagonal = glm::length(cloud.bounds.extent());
+    const glm::dvec3 nearestInBox = glm::clamp(sensor.position, cloud.bounds.min, cloud.bounds.max);
+    if (glm::length(sensor.position - nearestInBox) > 20.0 * std::max(diagonal, 1e-9)) {
+        throw Error(
+            fmt::format("the sensor position ({:.6g}, {:.6g}, {:.6g}) from {} is more than 20 "
+                        "times the points' "
+                        "extent away from them; give the sensor with --sensor X,Y,Z",
+                        sensor.position.x, sensor.position.y, sensor.position.z, sensor.source));
+    }
+    Camera camera;
+    camera.width = width;
+    camera.height = height;
+    camera.fovyDegrees = fovyDegrees;
+    glm::dvec3 upVector = up == UpAxis::Y ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
+    glm::dvec3 direction = target - sensor.position;
+    if (glm::length(direction) <= 1e-9 * std::max(diagonal, 1.0)) {
+        // At the middle of the points (a scanner station inside its scene): look at the front.
+        direction = up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+    }
+    direction = glm::normalize(direction);
+    if (std::abs(glm::dot(direction, upVector)) > 0.9999) {
+        upVector = up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+    }
+    camera.view = glm::lookAt(sensor.position, sensor.position + direction, upVector);
+    double nearest = std::numeric_limits<double>::infinity();
+    double farthest = 0.0;
+    const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
+    for (const glm::vec3& position : cloud.positions) {
+        const double depth = -(viewFromCloud * glm::dvec4(glm::dvec3(position), 1.0)).z;
+        if (depth > 0.0) {
+            nearest = std::min(nearest, depth);
+            farthest = std::max(farthest, depth);
+        }
+    }
+    if (!(farthest > 0.0)) {
+        farthest = std::max(diagonal, 1e-9);
+        nearest = farthest;
+    }
+    setDepthRange(camera, nearest, farthest);
+    return camera;
+}
+
+}  // namespace subscan
