@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/Error.h"
 
@@ -16,8 +17,32 @@ namespace {
 constexpr std::pair<Coloring, std::string_view> kColorings[] = {
     {Coloring::Auto, "auto"},           {Coloring::Rgb, "rgb"},
     {Coloring::Intensity, "intensity"}, {Coloring::Height, "height"},
-    {Coloring::Uniform, "uniform"},
+    {Coloring::Uniform, "uniform"},     {Coloring::Classification, "classification"},
 };
+
+/// classificationColor's table, indexed by class code 0-18.
+constexpr std::array<Rgba8, 19> kClassColors{{
+    {160, 160, 160, 255},  // 0 created, never classified
+    {215, 215, 215, 255},  // 1 unclassified
+    {150, 95, 50, 255},    // 2 ground
+    {150, 225, 100, 255},  // 3 low vegetation
+    {60, 170, 60, 255},    // 4 medium vegetation
+    {20, 100, 35, 255},    // 5 high vegetation
+    {235, 110, 35, 255},   // 6 building
+    {230, 0, 230, 255},    // 7 low point (noise)
+    {255, 225, 0, 255},    // 8 model key-point (LAS 1.0-1.3), reserved (1.4)
+    {30, 100, 230, 255},   // 9 water
+    {120, 70, 170, 255},   // 10 rail
+    {70, 70, 85, 255},     // 11 road surface
+    {255, 255, 160, 255},  // 12 overlap (LAS 1.0-1.3), reserved (1.4)
+    {255, 170, 200, 255},  // 13 wire guard (shield)
+    {0, 210, 210, 255},    // 14 wire conductor (phase)
+    {160, 30, 30, 255},    // 15 transmission tower
+    {0, 110, 130, 255},    // 16 wire-structure connector (insulator)
+    {205, 175, 130, 255},  // 17 bridge deck
+    {255, 40, 40, 255},    // 18 high noise
+}};
+constexpr Rgba8 kOtherClassColor{128, 128, 128, 255};
 
 constexpr Rgba8 kUniform{200, 200, 200, 255};
 
@@ -66,7 +91,19 @@ Coloring parseColoring(std::string_view text) {
         }
     }
     throw Error(
-        fmt::format("there is no colouring '{}' (auto, rgb, intensity, height, uniform)", text));
+        fmt::format("there is no colouring '{}' ({})", text, fmt::join(coloringNames(), ", ")));
+}
+
+std::vector<std::string> coloringNames() {
+    std::vector<std::string> names;
+    for (const auto& [value, name] : kColorings) {
+        names.emplace_back(name);
+    }
+    return names;
+}
+
+Rgba8 classificationColor(std::uint8_t code) {
+    return code < kClassColors.size() ? kClassColors[code] : kOtherClassColor;
 }
 
 std::vector<std::uint8_t> intensityGreys(const PointCloud& cloud) {
@@ -119,6 +156,19 @@ std::vector<Rgba8> pointColors(const PointCloud& cloud, Coloring coloring, UpAxi
             const float range = high > low ? high - low : 1.0f;
             for (const glm::vec3& position : cloud.positions) {
                 colors.push_back(viridis((position[axis] - low) / range));
+            }
+            return colors;
+        }
+        case Coloring::Classification: {
+            if (!cloud.hasClassifications()) {
+                throw Error(
+                    "the scan has no classification to show (only LAS, LAZ and COPC files carry "
+                    "one; try --color height or rgb)");
+            }
+            std::vector<Rgba8> colors;
+            colors.reserve(cloud.size());
+            for (const std::uint8_t code : cloud.classifications) {
+                colors.push_back(classificationColor(code));
             }
             return colors;
         }

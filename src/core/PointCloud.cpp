@@ -22,6 +22,9 @@ PointCloudBuilder::PointCloudBuilder(PointAttributes attributes, std::size_t exp
     if (attributes_.intensity) {
         cloud_.intensities.reserve(expectedPoints);
     }
+    if (attributes_.classification) {
+        cloud_.classifications.reserve(expectedPoints);
+    }
 }
 
 void PointCloudBuilder::dropVertex() {

@@ -53,16 +53,18 @@ struct Bounds {
 struct PointCloud {
     glm::dvec3 origin{0.0};
     std::vector<glm::vec3> positions;
-    std::vector<Rgba8> colors;        // sRGB-encoded
-    std::vector<glm::vec3> normals;   // unit length where the file had them
-    std::vector<float> intensities;   // as stored in the file (no normalisation)
-    std::vector<Triangle> triangles;  // vertex indices; ground-truth meshes only
-    Bounds bounds;                    // exact, in file coordinates
+    std::vector<Rgba8> colors;                  // sRGB-encoded
+    std::vector<glm::vec3> normals;             // unit length where the file had them
+    std::vector<float> intensities;             // as stored in the file (no normalisation)
+    std::vector<std::uint8_t> classifications;  // ASPRS LAS class codes (LAS files only)
+    std::vector<Triangle> triangles;            // vertex indices; ground-truth meshes only
+    Bounds bounds;                              // exact, in file coordinates
 
     std::size_t size() const { return positions.size(); }
     bool hasColors() const { return !colors.empty(); }
     bool hasNormals() const { return !normals.empty(); }
     bool hasIntensities() const { return !intensities.empty(); }
+    bool hasClassifications() const { return !classifications.empty(); }
     glm::dvec3 fileCoordinates(std::size_t i) const { return origin + glm::dvec3(positions[i]); }
 };
 
@@ -71,6 +73,7 @@ struct PointAttributes {
     bool color = false;
     bool normal = false;
     bool intensity = false;
+    bool classification = false;
 };
 
 /// double -> float for attribute values from files: out-of-range values saturate (a plain cast
@@ -94,6 +97,7 @@ struct PointRecord {
     Rgba8 color;
     glm::vec3 normal{0.0f};
     float intensity = 0.0f;
+    std::uint8_t classification = 0;
 };
 
 /// Collects points from a reader: drops points with NaN, infinite or absurd (beyond
@@ -130,6 +134,9 @@ class PointCloudBuilder {
         }
         if (attributes_.intensity) {
             cloud_.intensities.push_back(point.intensity);
+        }
+        if (attributes_.classification) {
+            cloud_.classifications.push_back(point.classification);
         }
     }
 

@@ -1,12 +1,15 @@
 #include "io/Image.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstring>
 #include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -22,6 +25,7 @@
 #include "io/AtomicFile.h"
 #include "io/ByteOrder.h"
 #include "io/MappedFile.h"
+#include "io/WriterSupport.h"
 
 namespace subscan {
 
@@ -42,20 +46,54 @@ void appendTo(void* context, void* data, int size) {
                                                static_cast<std::size_t>(size));
 }
 
-enum class PictureFormat { Png, Jpeg };
+struct PictureExtension {
+    std::string_view extension;  // lowercase
+    PictureFormat format;
+};
 
-/// The format `path`'s extension names, or nullopt.
-std::optional<PictureFormat> pictureFormat(const std::filesystem::path& path) {
+constexpr std::array<PictureExtension, 5> kPictureExtensions{{
+    {".png", PictureFormat::Png},
+    {".jpg", PictureFormat::Jpeg},
+    {".jpeg", PictureFormat::Jpeg},
+    {".pfm", PictureFormat::Pfm},
+    {".exr", PictureFormat::Exr},
+}};
+
+std::optional<PictureFormat> formatOfExtension(const std::filesystem::path& path) {
     std::string extension = path.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (extension == ".png") {
-        return PictureFormat::Png;
-    }
-    if (extension == ".jpg" || extension == ".jpeg") {
-        return PictureFormat::Jpeg;
+    for (const PictureExtension& candidate : kPictureExtensions) {
+        if (candidate.extension == extension) {
+            return candidate.format;
+        }
     }
     return std::nullopt;
+}
+
+bool hasConsistentSize(const ImageF& image) {
+    return image.width > 0 && image.height > 0 &&
+           image.values.size() == static_cast<std::size_t>(image.width) *
+                                      static_cast<std::size_t>(image.height) *
+                                      static_cast<std::size_t>(image.channels);
+}
+
+/// OpenEXR attribute: name, type name (both NUL-terminated), int32 size, value.
+void appendExrAttribute(std::string& out, std::string_view name, std::string_view type,
+                        std::string_view value) {
+    out.append(name);
+    out.push_back('\0');
+    out.append(type);
+    out.push_back('\0');
+    appendLittleEndian(out, static_cast<std::int32_t>(value.size()));
+    out.append(value);
+}
+
+template <class... Values>
+std::string exrValue(Values... values) {
+    std::string bytes;
+    (appendLittleEndian(bytes, values), ...);
+    return bytes;
 }
 
 }  // namespace
@@ -70,18 +108,29 @@ void writePng(const std::filesystem::path& path, const Image8& image) {
     writeFileAtomically(path, encoded);
 }
 
-void checkPictureExtension(const std::filesystem::path& path) {
-    if (!pictureFormat(path)) {
-        throw Error(fmt::format(
-            "{}: pictures are written as .png or .jpg/.jpeg (the extension picks the format); "
-            "the linear radiance is radiance.pfm of --export-buffers",
-            path.string()));
+PictureFormat pictureFormat(const std::filesystem::path& path) {
+    if (const std::optional<PictureFormat> format = formatOfExtension(path)) {
+        return *format;
     }
+    throw Error(fmt::format(
+        "{}: pictures are written as .png or .jpg/.jpeg (sRGB) or as .pfm or .exr (linear "
+        "radiance, 32-bit float); the extension picks the format",
+        path.string()));
+}
+
+bool holdsLinearRadiance(PictureFormat format) {
+    return format == PictureFormat::Pfm || format == PictureFormat::Exr;
 }
 
 void writePicture(const std::filesystem::path& path, const Image8& image) {
-    checkPictureExtension(path);
-    if (*pictureFormat(path) == PictureFormat::Png) {
+    const PictureFormat format = pictureFormat(path);
+    if (holdsLinearRadiance(format)) {
+        throw Error(
+            fmt::format("{}: a .pfm or .exr picture holds linear radiance, not 8-bit "
+                        "colour",
+                        path.string()));
+    }
+    if (format == PictureFormat::Png) {
         writePng(path, image);
         return;
     }
@@ -93,6 +142,81 @@ void writePicture(const std::filesystem::path& path, const Image8& image) {
         throw Error(fmt::format("{}: JPEG encoding failed", path.string()));
     }
     writeFileAtomically(path, encoded);
+}
+
+void writeLinearPicture(const std::filesystem::path& path, const ImageF& image) {
+    switch (pictureFormat(path)) {
+        case PictureFormat::Pfm:
+            writePfm(path, image);
+            return;
+        case PictureFormat::Exr:
+            writeExr(path, image);
+            return;
+        case PictureFormat::Png:
+        case PictureFormat::Jpeg:
+            break;
+    }
+    throw Error(fmt::format("{}: a .png or .jpg picture holds 8-bit sRGB, not linear radiance",
+                            path.string()));
+}
+
+void writeExr(const std::filesystem::path& path, const ImageF& image) {
+    if (image.channels != 3 || !hasConsistentSize(image)) {
+        throw Error(
+            fmt::format("{}: EXR pictures hold 3 channels of a consistent size", path.string()));
+    }
+    // The channel list names the channels in alphabetical order, and each scanline holds them
+    // in that order: B, G, R, i.e. our channels 2, 1, 0.
+    constexpr std::array<std::pair<char, std::size_t>, 3> kChannels{{{'B', 2}, {'G', 1}, {'R', 0}}};
+    constexpr std::int32_t kFloatPixels = 2;  // UINT 0, HALF 1, FLOAT 2
+    std::string channels;
+    for (const auto& [name, index] : kChannels) {
+        channels.push_back(name);
+        channels.push_back('\0');
+        appendLittleEndian(channels, kFloatPixels);
+        channels.append(4, '\0');                       // pLinear, then 3 reserved bytes
+        appendLittleEndian(channels, std::int32_t{1});  // x sampling
+        appendLittleEndian(channels, std::int32_t{1});  // y sampling
+    }
+    channels.push_back('\0');
+    const std::int32_t xMax = image.width - 1;
+    const std::int32_t yMax = image.height - 1;
+    const std::string window = exrValue(std::int32_t{0}, std::int32_t{0}, xMax, yMax);
+
+    std::string out;
+    appendLittleEndian(out, std::uint32_t{20000630});  // the magic number: 76 2f 31 01
+    appendLittleEndian(out, std::uint32_t{2});         // version 2, single-part scanline
+    appendExrAttribute(out, "channels", "chlist", channels);
+    appendExrAttribute(out, "compression", "compression", std::string(1, '\0'));  // NO_COMPRESSION
+    appendExrAttribute(out, "dataWindow", "box2i", window);
+    appendExrAttribute(out, "displayWindow", "box2i", window);
+    appendExrAttribute(out, "lineOrder", "lineOrder", std::string(1, '\0'));  // INCREASING_Y
+    appendExrAttribute(out, "pixelAspectRatio", "float", exrValue(1.0f));
+    appendExrAttribute(out, "screenWindowCenter", "v2f", exrValue(0.0f, 0.0f));
+    appendExrAttribute(out, "screenWindowWidth", "float", exrValue(1.0f));
+    out.push_back('\0');  // end of the header
+
+    const auto width = static_cast<std::size_t>(image.width);
+    const std::size_t lineBytes = width * kChannels.size() * sizeof(float);
+    const std::size_t blockBytes = 2 * sizeof(std::int32_t) + lineBytes;
+    const std::size_t firstBlock =
+        out.size() + static_cast<std::size_t>(image.height) * sizeof(std::uint64_t);
+    for (int y = 0; y < image.height; ++y) {
+        appendLittleEndian(
+            out, static_cast<std::uint64_t>(firstBlock + static_cast<std::size_t>(y) * blockBytes));
+    }
+    out.reserve(firstBlock + static_cast<std::size_t>(image.height) * blockBytes);
+    for (int y = 0; y < image.height; ++y) {
+        appendLittleEndian(out, static_cast<std::int32_t>(y));
+        appendLittleEndian(out, static_cast<std::int32_t>(lineBytes));
+        const float* row = image.values.data() + static_cast<std::size_t>(y) * width * 3;
+        for (const auto& [name, index] : kChannels) {
+            for (std::size_t x = 0; x < width; ++x) {
+                appendLittleEndian(out, row[3 * x + index]);
+            }
+        }
+    }
+    writeFileAtomically(path, out);
 }
 
 Image8 readPng(const std::filesystem::path& path) {

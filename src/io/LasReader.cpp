@@ -60,6 +60,21 @@ constexpr std::uint16_t kCopcInfoRecordId = 1;
 
 constexpr std::size_t kIntensityOffset = 12;  // in every point format
 
+/// Where the class code sits (LAS 1.4 R15, tables 7 and 13): formats 0-5 keep it in the low 5
+/// bits of byte 15, the upper 3 being the synthetic, key-point and withheld flags; formats
+/// 6-10 moved those flags into byte 15 and give the code all 8 bits of byte 16.
+struct ClassificationField {
+    std::size_t offset;
+    std::uint8_t mask;
+};
+constexpr ClassificationField kLegacyClassification{15, 0x1F};
+constexpr ClassificationField kExtendedClassification{16, 0xFF};
+constexpr int kFirstExtendedFormat = 6;
+
+ClassificationField classificationField(int pointFormat) {
+    return pointFormat < kFirstExtendedFormat ? kLegacyClassification : kExtendedClassification;
+}
+
 struct PointFormatLayout {
     std::size_t recordSize;
     std::optional<std::size_t> colorOffset;  // three uint16 (R, G, B) where the format has them
@@ -296,6 +311,7 @@ void decodePoints(const std::byte* points, std::size_t count, const LasHeader& h
                   std::size_t colorOffset, PointCloudBuilder& builder, const ReadContext& context) {
     constexpr std::size_t kProgressEvery = 1 << 16;
     const std::size_t stride = header.recordLength;
+    const ClassificationField classification = classificationField(header.pointFormat);
     PointRecord record;
     for (std::size_t i = 0; i < count; ++i) {
         const std::byte* p = points + i * stride;
@@ -304,6 +320,8 @@ void decodePoints(const std::byte* points, std::size_t count, const LasHeader& h
                                 loadLittleEndian<std::int32_t>(p + 8)};
         record.position = stored * header.scale + header.offset;
         record.intensity = loadLittleEndian<std::uint16_t>(p + kIntensityOffset);
+        record.classification = static_cast<std::uint8_t>(
+            std::to_integer<std::uint8_t>(p[classification.offset]) & classification.mask);
         if constexpr (depth != ColorDepth::None) {
             const std::byte* rgb = p + colorOffset;
             record.color = {toColorChannel<depth>(rgb), toColorChannel<depth>(rgb + 2),
@@ -454,6 +472,7 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
     PointAttributes attributes;
     attributes.color = colorOffset.has_value();
     attributes.intensity = true;
+    attributes.classification = true;
     PointCloudBuilder builder(attributes, count);
     // Decompression already reported the progress of a LAZ file; the record pass is quick.
     const ReadContext silent;

@@ -11,12 +11,14 @@ namespace subscan {
 
 /// Reads a LAS file (versions 1.0-1.4, point formats 0-10) held in memory, also compressed as
 /// LAZ (point formats 0-3 and 6-8, see io/laz) or COPC: coordinates with scale and offset
-/// applied in double, intensity, and RGB where the point format has it (16-bit reduced to 8-bit;
-/// files that store 8-bit values in the 16-bit fields are detected). Throws subscan::Error.
+/// applied in double, intensity, the classification (the 5-bit class code of formats 0-5, the
+/// 8-bit one of formats 6-10, without the flags) and RGB where the point format has it (16-bit
+/// reduced to 8-bit; files that store 8-bit values in the 16-bit fields are detected). Throws
+/// subscan::Error.
 PointCloud readLas(std::span<const std::byte> file, ReadContext& context);
 
 /// A LAS file's point records exactly as an uncompressed file stores them (LAZ and COPC
-/// decompressed), for the fields the cloud does not keep (classification, returns, GPS time).
+/// decompressed), for the fields the cloud does not keep (returns, flags, GPS time).
 struct LasRecords {
     int pointFormat = 0;
     std::size_t recordLength = 0;

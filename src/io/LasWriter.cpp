@@ -124,6 +124,16 @@ std::string header(const PointCloud& cloud, const LasScaling& scaling, const Bou
 
 }  // namespace
 
+std::uint8_t lasClassification(std::uint8_t code) {
+    return code <= kLargestLegacyClass ? code : kUnclassified;
+}
+
+std::size_t countUnwritableClasses(const PointCloud& cloud) {
+    return static_cast<std::size_t>(
+        std::count_if(cloud.classifications.begin(), cloud.classifications.end(),
+                      [](std::uint8_t code) { return code > kLargestLegacyClass; }));
+}
+
 LasScaling chooseLasScaling(const Bounds& bounds) {
     LasScaling scaling;
     if (bounds.empty()) {
@@ -183,10 +193,11 @@ void writeLas(const std::filesystem::path& path, const PointCloud& cloud) {
             out.append(cloud.hasIntensities() ? toIntensity(cloud.intensities[i])
                                               : std::uint16_t{0});
             out.append(kFirstOfOneReturn);
-            out.append(std::uint8_t{0});   // classification: never classified
-            out.append(std::int8_t{0});    // scan angle rank
-            out.append(std::uint8_t{0});   // user data
-            out.append(std::uint16_t{0});  // point source id
+            out.append(cloud.hasClassifications() ? lasClassification(cloud.classifications[i])
+                                                  : std::uint8_t{0});  // never classified
+            out.append(std::int8_t{0});                                // scan angle rank
+            out.append(std::uint8_t{0});                               // user data
+            out.append(std::uint16_t{0});                              // point source id
             if (cloud.hasColors()) {
                 // 8-bit c as 16-bit c * 257 spans 0..65535 and maps back to c exactly.
                 const Rgba8& color = cloud.colors[i];

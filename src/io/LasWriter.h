@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 
 #include <glm/vec3.hpp>
@@ -7,6 +9,17 @@
 #include "core/PointCloud.h"
 
 namespace subscan {
+
+/// LAS 1.2 holds a class code in 5 bits (the byte's upper 3 are flags).
+inline constexpr std::uint8_t kLargestLegacyClass = 31;
+/// ASPRS class 1, "unclassified": what a code LAS 1.2 cannot hold is written as.
+inline constexpr std::uint8_t kUnclassified = 1;
+
+/// The classification byte writeLas stores for `code`: the code itself up to 31 (flags clear),
+/// else kUnclassified.
+std::uint8_t lasClassification(std::uint8_t code);
+/// How many of the cloud's class codes LAS 1.2 cannot hold (above 31, from LAS 1.4 formats 6-10).
+std::size_t countUnwritableClasses(const PointCloud& cloud);
 
 /// How a LAS file stores coordinates, per axis: file coordinate = int32 * scale + offset.
 struct LasScaling {
@@ -27,7 +40,8 @@ LasScaling chooseLasScaling(const Bounds& bounds);
 /// Writes `cloud` as LAS 1.2, atomically (see writeFileAtomically): point format 2 (with 16-bit
 /// RGB, each 8-bit channel times 257) when the cloud has colours, else 0. Coordinates use
 /// chooseLasScaling on the file coordinates' bounds; intensity is rounded and clamped to
-/// 0..65535 (0 without intensities); every point is return 1 of 1, never classified. The header
+/// 0..65535 (0 without intensities); every point is return 1 of 1, its class code as
+/// lasClassification() gives it (0, never classified, without classifications). The header
 /// names subscan as system and software and holds the bounds of the stored coordinates. LAS 1.2
 /// has no normals, alpha or faces; they are not written. Throws subscan::Error naming the file
 /// when it cannot be written.

@@ -651,6 +651,19 @@ Bad arrays (wrong shape, empty, NaN or infinite values, wrong types) raise Value
             },
             "N float32 intensities as the file stored them, or None: a read-only view.")
         .def_property_readonly(
+            "classification",
+            [](const py::object& self) -> py::object {
+                const PointCloud& cloud = self.cast<const CloudData&>().cloud();
+                if (!cloud.hasClassifications()) {
+                    return py::none();
+                }
+                return viewOf(cloud.classifications.data(), cloud.size(), 1, sizeof(std::uint8_t),
+                              self);
+            },
+            "N uint8 ASPRS class codes (LAS, LAZ and COPC files: the 5-bit code of point "
+            "formats 0-5, the 8-bit one of formats 6-10, without the flags), or None: a "
+            "read-only view.")
+        .def_property_readonly(
             "normals",
             [](const py::object& self) -> py::object {
                 const PointCloud& cloud = self.cast<const CloudData&>().cloud();
@@ -700,10 +713,12 @@ Bad arrays (wrong shape, empty, NaN or infinite values, wrong types) raise Value
         .def("__repr__", [](const CloudData& self) {
             const PointCloud& cloud = self.cloud();
             std::string attributes;
-            for (const auto& [present, name] : {std::pair{cloud.hasColors(), "colors"},
-                                                std::pair{cloud.hasIntensities(), "intensity"},
-                                                std::pair{cloud.hasNormals(), "normals"},
-                                                std::pair{!cloud.triangles.empty(), "triangles"}}) {
+            for (const auto& [present, name] :
+                 {std::pair{cloud.hasColors(), "colors"},
+                  std::pair{cloud.hasIntensities(), "intensity"},
+                  std::pair{cloud.hasClassifications(), "classification"},
+                  std::pair{cloud.hasNormals(), "normals"},
+                  std::pair{!cloud.triangles.empty(), "triangles"}}) {
                 if (present) {
                     attributes += fmt::format(", {}", name);
                 }

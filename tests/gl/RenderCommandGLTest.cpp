@@ -1,6 +1,7 @@
 // `subscan render` end to end: the exported buffers can be reproduced from the scan and
 // camera.json alone, far-from-origin clouds render without quantisation, and bad requests fail
 // with one sentence and no output file.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -515,6 +516,51 @@ TEST(RenderCommandGLTest, SavedSettingsHoldTheOptionsAndReproduceThePicture) {
     EXPECT_NE(test::fileBytes(dir / "plain.png"), test::fileBytes(dir / "flags.png"));
 }
 
+TEST(RenderCommandGLTest, LinearPicturesAreTheExportedRadiance) {
+    // -o .pfm and .exr write the radiance before the display transform: exactly the floats of
+    // --export-buffers' radiance.pfm of the same render (one process each; the pipeline is
+    // deterministic for one scan, camera and settings).
+    const test::TempDir dir;
+    const auto cameraFile = sphereCameraFile(dir);
+    for (const char* mode : {"surface", "sss"}) {
+        SCOPED_TRACE(mode);
+        const std::vector<std::string> scene{"synthetic:sphere?points=20000", "--mode", mode,
+                                             "--camera", cameraFile.string()};
+        const auto render = [&](const std::filesystem::path& output, bool exportBuffers) {
+            std::vector<std::string> arguments{"render", "-o", output.string()};
+            arguments.insert(arguments.begin() + 1, scene.begin(), scene.end());
+            if (exportBuffers) {
+                arguments.push_back("--export-buffers");
+                arguments.push_back((dir / mode).string());
+            }
+            const auto result = runSubscan(arguments);
+            EXPECT_EQ(result.exitCode, 0) << result.err;
+        };
+        const auto pfm = dir / (std::string(mode) + ".pfm");
+        const auto exr = dir / (std::string(mode) + ".EXR");
+        render(pfm, true);
+        render(exr, false);
+        const ImageF radiance = readPfm(dir / mode / "radiance.pfm");
+        ASSERT_EQ(radiance.width, kWidth);
+        ASSERT_EQ(radiance.height, kHeight);
+        const ImageF picture = readPfm(pfm);
+        EXPECT_EQ(picture.channels, 3);
+        EXPECT_EQ(picture.width, kWidth);
+        EXPECT_EQ(picture.values, radiance.values);
+        // Both PFM files store rows bottom to top: the same bytes, header included.
+        EXPECT_EQ(test::fileBytes(pfm), test::fileBytes(dir / mode / "radiance.pfm"));
+        const test::ExrFile file = test::readExr(exr);
+        EXPECT_EQ(file.magic, 20000630u);
+        EXPECT_EQ(file.image.width, kWidth);
+        EXPECT_EQ(file.image.height, kHeight);
+        EXPECT_EQ(file.image.values, radiance.values);
+        // Not an empty frame that would match trivially: the lit sphere covers about half of it.
+        const auto lit = std::count_if(radiance.values.begin(), radiance.values.end(),
+                                       [](float value) { return value > 0.0f; });
+        EXPECT_GT(lit, kWidth * kHeight / 4);
+    }
+}
+
 TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
     const test::TempDir dir;
     const auto scan = dir.write("scan.ply", asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
@@ -540,10 +586,30 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
          {},
          1,
          "outside what the GPU can render"},
+        {{"render", scan.string(), "-o", (dir / "out.bmp").string()},
+         {},
+         1,
+         "pictures are written as .png or .jpg/.jpeg (sRGB) or as .pfm or .exr"},
         {{"render", scan.string(), "-o", (dir / "out.exr").string()},
          {},
          1,
-         "pictures are written as .png or .jpg/.jpeg"},
+         "out.exr: a .pfm or .exr picture is the linear radiance of the shaded surface; it "
+         "needs --mode surface or sss"},
+        {{"render", scan.string(), "-o", (dir / "out.exr").string(), "--mode", "surface", "--stage",
+          "depth"},
+         {},
+         1,
+         "a --stage view has none (write it as .png)"},
+        {{"render", scan.string(), "-o", (dir / "out.exr").string(), "--mode", "sss", "--samples",
+          "4"},
+         {},
+         1,
+         "it is one frame's, so it needs --samples 1"},
+        {{"render", scan.string(), "-o", (dir / "out.exr").string(), "--mode", "surface",
+          "--resolution", "half"},
+         {},
+         1,
+         "it needs --resolution full"},
         {{"render", scan.string(), "-o", out.string(), "--width", "0"}, {}, 2, ""},
         {{"render", scan.string(), "-o", out.string(), "--mode", "voxels"}, {}, 2, ""},
         {{"render", scan.string(), "-o", out.string(), "--mode", "sss", "--material", "jade"},
@@ -593,6 +659,7 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
         }
         EXPECT_FALSE(std::filesystem::exists(out));
         EXPECT_FALSE(std::filesystem::exists(dir / "out.exr"));
+        EXPECT_FALSE(std::filesystem::exists(dir / "out.bmp"));
     }
     // The refused overwrite left the input intact.
     EXPECT_EQ(test::fileBytes(scan), asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));

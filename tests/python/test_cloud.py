@@ -190,6 +190,21 @@ def test_load_reads_files_like_the_cli(cli, data_dir):
     assert las.format == "las" and las.intensity is not None and las.colors is not None
 
 
+def test_classification_is_the_las_class_codes(data_dir):
+    # simple.las: 789 unclassified (1) and 276 ground (2) points, counted from its bytes by a
+    # separate script; .las and .laz of Autzen give the same codes in the same order.
+    las = subscan.load(data_dir / "simple.las")
+    codes = las.classification
+    assert codes.dtype == np.uint8 and codes.shape == (len(las),)
+    assert not codes.flags.writeable
+    assert np.count_nonzero(codes == 2) == 276 and np.count_nonzero(codes == 1) == 789
+    autzen_las = subscan.load(data_dir / "autzen_trim.las").classification
+    np.testing.assert_array_equal(autzen_las, subscan.load(data_dir / "autzen_trim.laz").classification)
+    assert "classification" in repr(las)
+    # Only LAS files carry one.
+    assert subscan.load("synthetic:sphere?points=100").classification is None
+
+
 def test_load_errors_carry_the_cli_sentence(cli, tmp_path):
     for source in (tmp_path / "missing.ply", "synthetic:teapot"):
         with pytest.raises(subscan.Error) as error:

@@ -3,9 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -204,6 +208,124 @@ std::optional<std::filesystem::path> testDataDirectory() {
         return std::nullopt;
     }
     return directory;
+}
+
+namespace {
+
+/// Reads little-endian values and NUL-terminated strings from a file's bytes, in order.
+class ExrCursor {
+  public:
+    explicit ExrCursor(std::string bytes) : bytes_(std::move(bytes)) {}
+
+    template <class T>
+    T value() {
+        T result{};
+        need(sizeof(T));
+        std::memcpy(&result, bytes_.data() + position_, sizeof(T));
+        position_ += sizeof(T);
+        return result;
+    }
+    std::string text() {
+        const std::size_t end = bytes_.find('\0', position_);
+        if (end == std::string::npos) {
+            throw std::runtime_error("an unterminated name");
+        }
+        std::string result = bytes_.substr(position_, end - position_);
+        position_ = end + 1;
+        return result;
+    }
+    std::string bytes(std::size_t count) {
+        need(count);
+        std::string result = bytes_.substr(position_, count);
+        position_ += count;
+        return result;
+    }
+    void seek(std::uint64_t position) {
+        if (position > bytes_.size()) {
+            throw std::runtime_error("an offset beyond the end of the file");
+        }
+        position_ = static_cast<std::size_t>(position);
+    }
+
+  private:
+    void need(std::size_t count) const {
+        if (bytes_.size() - position_ < count) {
+            throw std::runtime_error("the file ends early");
+        }
+    }
+
+    std::string bytes_;
+    std::size_t position_ = 0;
+};
+
+}  // namespace
+
+ExrFile readExr(const std::filesystem::path& path) {
+    ExrCursor cursor(fileBytes(path));
+    ExrFile file;
+    file.magic = cursor.value<std::uint32_t>();
+    file.version = cursor.value<std::uint32_t>();
+    for (std::string name = cursor.text(); !name.empty(); name = cursor.text()) {
+        ExrAttribute attribute{name, cursor.text(), {}};
+        attribute.value = cursor.bytes(static_cast<std::size_t>(cursor.value<std::int32_t>()));
+        file.attributes.push_back(std::move(attribute));
+    }
+    const auto find = [&](std::string_view name) -> const std::string& {
+        for (const ExrAttribute& attribute : file.attributes) {
+            if (attribute.name == name) {
+                return attribute.value;
+            }
+        }
+        throw std::runtime_error("no " + std::string(name) + " attribute");
+    };
+    if (find("compression") != std::string(1, '\0')) {
+        throw std::runtime_error("compressed");
+    }
+    ExrCursor window(find("dataWindow"));
+    const auto xMin = window.value<std::int32_t>();
+    const auto yMin = window.value<std::int32_t>();
+    const auto xMax = window.value<std::int32_t>();
+    const auto yMax = window.value<std::int32_t>();
+    file.image = {xMax - xMin + 1, yMax - yMin + 1, 3, {}};
+    const auto width = static_cast<std::size_t>(file.image.width);
+    file.image.values.resize(width * static_cast<std::size_t>(file.image.height) * 3);
+
+    std::vector<std::size_t> channelIndices;  // R, G, B -> 0, 1, 2, in the list's order
+    ExrCursor channels(find("channels"));
+    for (std::string name = channels.text(); !name.empty(); name = channels.text()) {
+        const auto type = channels.value<std::int32_t>();
+        channels.bytes(4);  // pLinear and reserved
+        const auto xSampling = channels.value<std::int32_t>();
+        const auto ySampling = channels.value<std::int32_t>();
+        const std::size_t index = std::string_view("RGB").find(name);
+        if (type != 2 || xSampling != 1 || ySampling != 1 || name.size() != 1 ||
+            index == std::string_view::npos) {
+            throw std::runtime_error("channel " + name + " is not a FLOAT R, G or B");
+        }
+        channelIndices.push_back(index);
+    }
+
+    for (int block = 0; block < file.image.height; ++block) {
+        file.offsets.push_back(cursor.value<std::uint64_t>());
+    }
+    for (const std::uint64_t offset : file.offsets) {
+        cursor.seek(offset);
+        const auto y = cursor.value<std::int32_t>();
+        const auto size = cursor.value<std::int32_t>();
+        file.blockRows.push_back(y);
+        if (y < yMin || y > yMax ||
+            static_cast<std::size_t>(size) != width * channelIndices.size() * sizeof(float)) {
+            throw std::runtime_error("a block of row " + std::to_string(y) + " and " +
+                                     std::to_string(size) + " bytes");
+        }
+        float* row = file.image.values.data() + static_cast<std::size_t>(y - yMin) * width * 3;
+        for (const std::size_t channel : channelIndices) {
+            for (std::size_t x = 0; x < width; ++x) {
+                row[3 * x + channel] = cursor.value<float>();
+            }
+        }
+    }
+    return file;
 }
 
 }  // namespace subscan::test

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "core/PointCloud.h"
+#include "io/Image.h"
 #include "io/ScanLoader.h"
 
 namespace subscan::test {
@@ -81,6 +83,28 @@ void expectPositionsNear(const PointCloud& actual, const PointCloud& expected, d
 /// exact and the file coordinates known to the last bit. Intensities include a fraction, a
 /// value above 65535 and a negative one (what LAS must round or clamp).
 PointCloud utmCloudWithEveryAttribute();
+
+/// One header attribute of an OpenEXR file: its name, type name and value bytes.
+struct ExrAttribute {
+    std::string name;
+    std::string type;
+    std::string value;
+};
+
+/// An OpenEXR file read back by the tests' own small reader (OpenEXR file layout: magic, version,
+/// header attributes, offset table, uncompressed scanline blocks), independent of the writer.
+struct ExrFile {
+    std::uint32_t magic = 0;
+    std::uint32_t version = 0;
+    std::vector<ExrAttribute> attributes;  // in file order
+    std::vector<std::uint64_t> offsets;    // one per scanline block
+    std::vector<std::int32_t> blockRows;   // the y each block says it holds
+    ImageF image;                          // channels R, G, B (3 floats a pixel), rows top first
+};
+
+/// Throws std::runtime_error naming what is malformed, or not what it reads: FLOAT channels
+/// R, G, B only, no compression, one scanline per block.
+ExrFile readExr(const std::filesystem::path& path);
 
 /// Appends the bytes of `value` in little- or big-endian order.
 template <class T>

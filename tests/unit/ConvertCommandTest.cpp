@@ -77,7 +77,32 @@ TEST(ConvertCommandTest, RealLasToEveryFormatKeepsPointsAndColours) {
         test::expectPositionsNear(read.cloud, original.cloud, 0.005);
         EXPECT_EQ(read.cloud.colors, original.cloud.colors);
         EXPECT_EQ(read.cloud.intensities, original.cloud.intensities);
+        if (name.ends_with(".las")) {
+            EXPECT_EQ(read.cloud.classifications, original.cloud.classifications);
+        } else {
+            EXPECT_FALSE(read.cloud.hasClassifications());
+        }
     }
+}
+
+TEST(ConvertCommandTest, ClassificationSurvivesLasToLasAndIsNamedWhereItCannot) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    // LAS 1.4 point format 7 (8-bit codes) to LAS 1.2 (5-bit codes): autzen's codes are 1 and 2.
+    const auto source = data / "autzen_trim_las14_pf7.las";
+    const LoadedScan original = loadScan(source.string());
+    ASSERT_TRUE(original.cloud.hasClassifications());
+    const test::TempDir dir;
+    const test::CommandResult las =
+        runSubscan({"convert", source.string(), "-o", (dir / "a.las").string()});
+    ASSERT_EQ(las.exitCode, 0) << las.err;
+    EXPECT_TRUE(las.err.empty()) << las.err;
+    EXPECT_EQ(loadScan((dir / "a.las").string()).cloud.classifications,
+              original.cloud.classifications);
+    const test::CommandResult ply =
+        runSubscan({"convert", source.string(), "-o", (dir / "a.ply").string()});
+    ASSERT_EQ(ply.exitCode, 0) << ply.err;
+    EXPECT_THAT(ply.err, HasSubstr("warning: " + (dir / "a.ply").string() +
+                                   ": PLY cannot hold classification codes; they are not written"));
 }
 
 TEST(ConvertCommandTest, UnknownExtensionIsAUsageError) {

@@ -27,20 +27,22 @@ struct ConvertOptions {
 };
 
 /// A format convert writes, and what of a cloud it can hold besides positions, colour and
-/// intensity (which all of them hold): whatever else the cloud has is reported as not written.
+/// intensity (which all of them hold; LAS alone holds classification): whatever else the cloud has
+/// is reported as not written.
 struct OutputFormat {
     std::string_view extension;  // lowercase
     std::string_view name;
     void (*write)(const std::filesystem::path&, const PointCloud&);
     bool normals;
     bool alphaAndFaces;
+    bool classification;
 };
 
 constexpr std::array<OutputFormat, 4> kOutputFormats{{
-    {".ply", "PLY", writePly, true, true},
-    {".las", "LAS 1.2", writeLas, false, false},
-    {".pcd", "PCD", writePcd, true, false},
-    {".xyz", "XYZ text", writeXyz, true, false},
+    {".ply", "PLY", writePly, true, true, false},
+    {".las", "LAS 1.2", writeLas, false, false, true},
+    {".pcd", "PCD", writePcd, true, false, false},
+    {".xyz", "XYZ text", writeXyz, true, false, false},
 }};
 
 /// The format named by the output's extension (any case), or nullptr.
@@ -72,6 +74,17 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
     };
     if (cloud.hasNormals() && !format.normals) {
         warn("normals");
+    }
+    if (cloud.hasClassifications() && !format.classification) {
+        warn("classification codes");
+    }
+    if (format.classification) {
+        if (const std::size_t unwritable = countUnwritableClasses(cloud); unwritable > 0) {
+            fmt::print(stderr,
+                       "subscan: warning: {}: {} cannot hold class codes above {}; {} points "
+                       "are written as class {} (unclassified)\n",
+                       output, format.name, kLargestLegacyClass, unwritable, kUnclassified);
+        }
     }
     if (!format.alphaAndFaces) {
         if (hasTranslucentColors(cloud)) {

@@ -81,8 +81,9 @@ void FrameOptions::add(CLI::App& command) {
     command
         .add_option("--color", color,
                     "What the points' colour shows: auto (rgb, else height for Z-up data, else "
-                    "uniform) | rgb | intensity | height | uniform")
-        ->check(CLI::IsMember({"auto", "rgb", "intensity", "height", "uniform"}));
+                    "uniform) | rgb | intensity | height | uniform | classification (ASPRS LAS "
+                    "class colours)")
+        ->check(CLI::IsMember(coloringNames()));
     command.add_option("--fovy", fovy, "Vertical field of view, degrees")
         ->check(CLI::Range(1.0, 170.0));
     command.add_option("--camera", cameraFile, "camera.json to render from")

@@ -29,6 +29,9 @@ std::vector<std::string> attributeNames(const PointCloud& cloud) {
     if (cloud.hasIntensities()) {
         names.emplace_back("intensity");
     }
+    if (cloud.hasClassifications()) {
+        names.emplace_back("classification");
+    }
     return names;
 }
 

@@ -4,6 +4,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -17,6 +19,7 @@
 #include "gpu/GlContext.h"
 #include "io/CameraJson.h"
 #include "io/Image.h"
+#include "render/FrameBuffers.h"
 #include "render/RenderSettings.h"
 #include "render/Renderer.h"
 
@@ -54,11 +57,50 @@ std::vector<PassTiming> medianTimings(Renderer& renderer, const Camera& camera,
     return medians;
 }
 
+/// A .pfm or .exr picture is the radiance buffer of --export-buffers (the shaded surface before
+/// the display transform): refused, before anything renders, where the picture is not that.
+void checkLinearPictureRequest(const std::filesystem::path& output, const RenderSettings& settings,
+                               int samples) {
+    const RasterSettings& raster = settings.raster;
+    const auto refuse = [&](std::string_view why) {
+        throw Error(
+            fmt::format("{}: a .pfm or .exr picture is the linear radiance of the shaded "
+                        "surface; {}",
+                        output.string(), why));
+    };
+    if (!reconstructsSurface(raster.mode)) {
+        refuse("it needs --mode surface or sss (the points modes shade nothing)");
+    }
+    if (raster.stage != Stage::Final) {
+        refuse("a --stage view has none (write it as .png)");
+    }
+    if (samples > 1) {
+        refuse(
+            "it is one frame's, so it needs --samples 1 (the temporal filter averages the "
+            "8-bit picture only)");
+    }
+    if (raster.resolution != Resolution::Full) {
+        refuse(
+            "it needs --resolution full (at reduced resolution the radiance is smaller than "
+            "the picture)");
+    }
+}
+
+/// The radiance buffer of the last frame (rendered with FrameOutputs::Everything).
+ImageF radianceOf(const Renderer& renderer, const RenderSettings& settings) {
+    for (FrameBuffer& buffer : readFrameBuffers(renderer, settings)) {
+        if (buffer.name == "radiance") {
+            return std::move(buffer.image);
+        }
+    }
+    throw Error("the frame has no radiance buffer (only the surface and sss modes shade)");
+}
+
 int runRender(const RenderOptions& options) {
     const FrameOptions& frame = options.frame;
     const std::filesystem::path output = options.output;
     frame.refuseToOverwriteInputs(output, "the image");
-    checkPictureExtension(output);
+    const bool linearPicture = holdsLinearRadiance(pictureFormat(output));
     frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     if (!options.exportDirectory.empty()) {
         frame.refuseToOverwriteInputs(
@@ -81,13 +123,18 @@ int runRender(const RenderOptions& options) {
         settings.temporal.enabled = true;
         settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, samples);
     }
+    if (linearPicture) {
+        checkLinearPictureRequest(output, settings, samples);
+    }
     LoadedScan scan = loadScanForCommand(frame.source);
     frame.applyColoring(scan);
     const Camera camera = frame.camera(scan);
     const std::unique_ptr<GlContext> context = frame.context();
     Renderer renderer(*context, scan.cloud);
-    const FrameOutputs outputs =
-        options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
+    // The radiance of a linear picture is one of the buffers the picture alone does not keep.
+    const FrameOutputs outputs = options.exportDirectory.empty() && !linearPicture
+                                     ? FrameOutputs::Picture
+                                     : FrameOutputs::Everything;
     if (options.timings) {
         // With --samples the frames timed are the ones averaged, so the picture stays theirs.
         const std::vector<PassTiming> timings =
@@ -105,13 +152,21 @@ int runRender(const RenderOptions& options) {
     }
 
     const Image8 picture{camera.width, camera.height, 4, renderer.readImage()};
+    ImageF radiance;
+    if (linearPicture) {
+        radiance = radianceOf(renderer, settings);
+    }
     context->throwOnErrors("while rendering");
     // Outputs only once the picture exists, so a failed render leaves none behind.
     if (!options.exportDirectory.empty()) {
         exportBuffers(options.exportDirectory, renderer, settings);
         context->throwOnErrors("while reading the buffers back");
     }
-    writePicture(output, picture);
+    if (linearPicture) {
+        writeLinearPicture(output, radiance);
+    } else {
+        writePicture(output, picture);
+    }
     frame.saveSettings(settings);
     return 0;
 }
@@ -122,7 +177,11 @@ Command addRenderCommand(CLI::App& parent) {
     auto options = std::make_shared<RenderOptions>();
     CLI::App* render = parent.add_subcommand("render", "Render one image headless (EGL)");
     options->frame.add(*render);
-    render->add_option("-o,--output", options->output, "Picture to write: .png, .jpg or .jpeg")
+    render
+        ->add_option("-o,--output", options->output,
+                     "Picture to write: .png, .jpg or .jpeg (sRGB), or .pfm or .exr (the linear "
+                     "radiance of the surface and sss modes, 32-bit float: radiance.pfm of "
+                     "--export-buffers)")
         ->required();
     render->add_option("--export-buffers", options->exportDirectory,
                        "Directory for camera.json, depth.pfm, color.png");

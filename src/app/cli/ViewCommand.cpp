@@ -12,6 +12,7 @@
 #include "app/cli/Commands.h"
 #include "app/viewer/Viewer.h"
 #include "app/viewer/ViewerScript.h"
+#include "core/Coloring.h"
 #include "core/Error.h"
 #include "render/RenderSettings.h"
 
@@ -104,8 +105,9 @@ Command addViewCommand(CLI::App& parent) {
     view->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));
     view->add_option("--color", options->color,
-                     "What the points' colour shows: auto | rgb | intensity | height | uniform")
-        ->check(CLI::IsMember({"auto", "rgb", "intensity", "height", "uniform"}));
+                     "What the points' colour shows: auto | rgb | intensity | height | uniform | "
+                     "classification")
+        ->check(CLI::IsMember(coloringNames()));
     view->add_option("--script", options->scriptFile,
                      "JSON list of timed camera actions (see README)")
         ->check(CLI::ExistingFile);

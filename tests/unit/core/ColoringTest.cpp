@@ -1,4 +1,5 @@
 // What --color shows: each colouring against its rule, Auto's choice, and the errors.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,15 +30,17 @@ PointCloud line(bool colors) {
 }
 
 TEST(ColoringTest, NamesRoundTripAndABadOneListsTheChoices) {
-    for (const Coloring coloring : {Coloring::Auto, Coloring::Rgb, Coloring::Intensity,
-                                    Coloring::Height, Coloring::Uniform}) {
+    for (const Coloring coloring :
+         {Coloring::Auto, Coloring::Rgb, Coloring::Intensity, Coloring::Height, Coloring::Uniform,
+          Coloring::Classification}) {
         EXPECT_EQ(parseColoring(toString(coloring)), coloring);
     }
     try {
         parseColoring("rainbow");
         FAIL() << "accepted 'rainbow'";
     } catch (const Error& error) {
-        EXPECT_THAT(error.what(), HasSubstr("auto, rgb, intensity, height, uniform"));
+        EXPECT_THAT(error.what(),
+                    HasSubstr("auto, rgb, intensity, height, uniform, classification"));
     }
 }
 
@@ -90,6 +93,84 @@ TEST(ColoringTest, WhatTheScanLacksIsNamed) {
     noIntensity.intensities.clear();
     EXPECT_THAT([&] { pointColors(noIntensity, Coloring::Intensity, UpAxis::Y); },
                 ::testing::ThrowsMessage<Error>(HasSubstr("the scan has no intensities")));
+    EXPECT_THAT([] { pointColors(line(true), Coloring::Classification, UpAxis::Z); },
+                ::testing::ThrowsMessage<Error>(HasSubstr(
+                    "the scan has no classification to show (only LAS, LAZ and COPC files "
+                    "carry one")));
+}
+
+/// The ASPRS table restated (LAS 1.4 R15, table 17): what each class must look like.
+struct ClassLook {
+    int code;
+    const char* meaning;
+    Rgba8 color;
+};
+
+TEST(ColoringTest, ClassificationColoursFollowTheAsprsClasses) {
+    const ClassLook table[] = {
+        {0, "never classified", {160, 160, 160, 255}},
+        {1, "unclassified", {215, 215, 215, 255}},
+        {2, "ground", {150, 95, 50, 255}},
+        {3, "low vegetation", {150, 225, 100, 255}},
+        {4, "medium vegetation", {60, 170, 60, 255}},
+        {5, "high vegetation", {20, 100, 35, 255}},
+        {6, "building", {235, 110, 35, 255}},
+        {7, "low point (noise)", {230, 0, 230, 255}},
+        {8, "model key-point / reserved", {255, 225, 0, 255}},
+        {9, "water", {30, 100, 230, 255}},
+        {10, "rail", {120, 70, 170, 255}},
+        {11, "road surface", {70, 70, 85, 255}},
+        {12, "overlap / reserved", {255, 255, 160, 255}},
+        {13, "wire guard", {255, 170, 200, 255}},
+        {14, "wire conductor", {0, 210, 210, 255}},
+        {15, "transmission tower", {160, 30, 30, 255}},
+        {16, "wire connector", {0, 110, 130, 255}},
+        {17, "bridge deck", {205, 175, 130, 255}},
+        {18, "high noise", {255, 40, 40, 255}},
+    };
+    for (const ClassLook& look : table) {
+        SCOPED_TRACE(look.meaning);
+        EXPECT_EQ(classificationColor(static_cast<std::uint8_t>(look.code)), look.color);
+    }
+    // The looks LiDAR users expect: ground brown (red over green over blue), vegetation green
+    // and darker as it grows, water blue.
+    const Rgba8 ground = classificationColor(2);
+    EXPECT_TRUE(ground.r > ground.g && ground.g > ground.b);
+    for (const int code : {3, 4, 5}) {
+        const Rgba8 green = classificationColor(static_cast<std::uint8_t>(code));
+        EXPECT_TRUE(green.g > green.r && green.g > green.b) << code;
+    }
+    EXPECT_GT(classificationColor(3).g, classificationColor(4).g);
+    EXPECT_GT(classificationColor(4).g, classificationColor(5).g);
+    const Rgba8 water = classificationColor(9);
+    EXPECT_TRUE(water.b > water.r && water.b > water.g);
+    // Every standard class its own colour, none the grey of the codes beyond them.
+    const Rgba8 other{128, 128, 128, 255};
+    for (int code = 0; code <= 18; ++code) {
+        EXPECT_NE(classificationColor(static_cast<std::uint8_t>(code)), other) << code;
+        for (int later = code + 1; later <= 18; ++later) {
+            EXPECT_NE(classificationColor(static_cast<std::uint8_t>(code)),
+                      classificationColor(static_cast<std::uint8_t>(later)))
+                << code << " and " << later;
+        }
+    }
+    for (const int code : {19, 31, 64, 255}) {
+        EXPECT_EQ(classificationColor(static_cast<std::uint8_t>(code)), other) << code;
+    }
+
+    // pointColors maps each point's code through the table.
+    PointCloud cloud = line(true);
+    cloud.classifications.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        cloud.classifications[i] = static_cast<std::uint8_t>(i % 256);
+    }
+    const std::vector<Rgba8> colors = pointColors(cloud, Coloring::Classification, UpAxis::Z);
+    ASSERT_EQ(colors.size(), cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        ASSERT_EQ(colors[i], classificationColor(cloud.classifications[i])) << i;
+    }
+    // Auto stays as it was: the scan's colour wins over its classification.
+    EXPECT_EQ(pointColors(cloud, Coloring::Auto, UpAxis::Z), cloud.colors);
 }
 
 }  // namespace

@@ -155,6 +155,31 @@ TEST(LasWriterTest, CloudWithoutColourIsPointFormat0) {
     test::expectPositionsNear(read.cloud, cloud, 0.5e-8);
 }
 
+TEST(LasWriterTest, ClassificationIsWrittenAndReadBack) {
+    const test::TempDir dir;
+    PointCloud cloud = test::utmCloudWithEveryAttribute();
+    ASSERT_EQ(cloud.size(), 5u);
+    // LAS 1.2 holds codes 0-31 (5 bits); 64 and 255 (from LAS 1.4 formats 6-10) become 1.
+    cloud.classifications = {0, 2, 31, 64, 255};
+    EXPECT_EQ(countUnwritableClasses(cloud), 2u);
+    const auto path = dir / "classes.las";
+    writeLas(path, cloud);
+    const std::string bytes = test::fileBytes(path);
+    constexpr std::size_t kHeader = 227;
+    constexpr std::size_t kRecord = 26;  // point format 2
+    const std::uint8_t expected[] = {0, 2, 31, 1, 1};
+    for (std::size_t i = 0; i < 5; ++i) {
+        // Byte 15: the code in the low 5 bits, the flags above it clear.
+        EXPECT_EQ(fieldAt<std::uint8_t>(bytes, kHeader + i * kRecord + 15), expected[i]) << i;
+    }
+    EXPECT_EQ(loadScan(path.string()).cloud.classifications,
+              (std::vector<std::uint8_t>{0, 2, 31, 1, 1}));
+    // Without classification every point is 0, never classified.
+    cloud.classifications.clear();
+    writeLas(path, cloud);
+    EXPECT_EQ(loadScan(path.string()).cloud.classifications, std::vector<std::uint8_t>(5, 0));
+}
+
 TEST(LasWriterTest, UnwritablePathIsAnErrorNamingIt) {
     test::expectUnwritablePathIsAnErrorNamingIt(
         [](const std::filesystem::path& path) {

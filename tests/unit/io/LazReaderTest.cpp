@@ -699,6 +699,7 @@ TEST(LazReaderTest, LayeredFormats7And8WithExtraBytesInVariableChunks) {
         ASSERT_TRUE(scan.cloud.hasColors());
         // Colour 39: red 257 * 49 is the 8-bit 49 stored in 16 bits.
         EXPECT_EQ(scan.cloud.colors[39].r, 49);
+        EXPECT_EQ(scan.cloud.classifications, std::vector<std::uint8_t>(40, 2));  // ground
         EXPECT_THAT(scan.formatDetail, HasSubstr("layered"));
     }
 }
@@ -785,8 +786,10 @@ TEST(LazReaderTest, CopcNodesAreReadThroughTheHierarchyPages) {
                                  expected.size()))
             << "point " << i;
     }
-    EXPECT_THAT(test::decode(copc.bytes, "x.copc.laz").formatDetail,
-                HasSubstr("octree of 2 levels, 2 nodes, root spacing 0.5"));
+    const LoadedScan scan = test::decode(copc.bytes, "x.copc.laz");
+    EXPECT_THAT(scan.formatDetail, HasSubstr("octree of 2 levels, 2 nodes, root spacing 0.5"));
+    // Every record says ground (class 2, byte 16 of POINT14): so must the cloud of both nodes.
+    EXPECT_EQ(scan.cloud.classifications, std::vector<std::uint8_t>(30, 2));
 }
 
 TEST(LazReaderTest, MalformedCopcHierarchiesAreRefused) {
