@@ -244,6 +244,14 @@ TEST(RealScansDataTest, TableSceneFromItsSensorDrawsWhatTheSensorSaw) {
             EXPECT_GT(coverage, 0.999);
         }
     }
+    // bench times the same still view: the sensor's image size, not its own default.
+    const auto bench = runSubscan({"bench", file.string(), "--view", "sensor", "--frames", "1",
+                                   "--warmup", "0", "--modes", "points", "--json"});
+    ASSERT_EQ(bench.exitCode, 0) << bench.err;
+    const nlohmann::json report = nlohmann::json::parse(bench.out);
+    EXPECT_EQ(report["view"], "sensor");
+    EXPECT_EQ(report["width"], 640);
+    EXPECT_EQ(report["height"], 480);
 }
 
 TEST(RealScansDataTest, EveryReadableFileRenders) {

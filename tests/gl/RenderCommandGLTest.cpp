@@ -561,6 +561,26 @@ TEST(RenderCommandGLTest, LinearPicturesAreTheExportedRadiance) {
     }
 }
 
+TEST(RenderCommandGLTest, SensorViewLooksFromTheGivenSensorAtThePoints) {
+    // A PLY has no sensor of its own: --sensor gives it, and camera.json shows the eye there,
+    // looking at the middle of the points, Y up (PLY's default), at the asked size.
+    const test::TempDir dir;
+    const auto result = runSubscan({"render", "synthetic:sphere", "-o", (dir / "out.png").string(),
+                                    "--view", "sensor", "--sensor", "0.5,0.2,3", "--width", "64",
+                                    "--height", "48", "--export-buffers", (dir / "b").string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const Camera camera = readCameraFile(dir / "b" / "camera.json");
+    // camera.json holds the view in doubles as printed by nlohmann (round-trip exact).
+    EXPECT_LT(glm::length(camera.eye() - glm::dvec3(0.5, 0.2, 3.0)), 1e-12);
+    EXPECT_EQ(camera.width, 64);
+    const glm::dvec4 middle = camera.view * glm::dvec4(glm::dvec3(0.0), 1.0);
+    // The sphere's framing box is centred on the origin up to its sampling: within 1 % of its
+    // radius of the line of sight.
+    EXPECT_LT(std::hypot(middle.x, middle.y), 0.01 * -middle.z);
+    const Image8 picture = readPng(dir / "out.png");
+    EXPECT_EQ(picture.width, 64);
+}
+
 TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
     const test::TempDir dir;
     const auto scan = dir.write("scan.ply", asciiPly({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
@@ -586,6 +606,20 @@ TEST(RenderCommandGLTest, BadRequestsFailWithOneSentenceAndNoOutput) {
          {},
          1,
          "outside what the GPU can render"},
+        {{"render", scan.string(), "-o", out.string(), "--view", "sensor"},
+         {},
+         1,
+         "records no sensor position (a PCD VIEWPOINT, an E57 pose or an organised grid); give "
+         "one with --sensor X,Y,Z"},
+        {{"render", scan.string(), "-o", out.string(), "--view", "sensor", "--sensor", "1e9,0,0"},
+         {},
+         1,
+         "the sensor position (1e+09, 0, 0) from --sensor is more than 20 times the points' "
+         "extent away from them"},
+        {{"render", scan.string(), "-o", out.string(), "--sensor", "1,2"},
+         {},
+         2,
+         "'1,2' is not X,Y,Z"},
         {{"render", scan.string(), "-o", (dir / "out.bmp").string()},
          {},
          1,

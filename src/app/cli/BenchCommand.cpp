@@ -39,6 +39,9 @@ struct BenchOptions {
     std::string settingsFile;
     std::string resolution;
     std::string up = "auto";
+    SensorViewOptions sensorView;
+    CLI::Option* widthOption = nullptr;
+    CLI::Option* heightOption = nullptr;
     bool json = false;
     bool software = false;
 };
@@ -226,8 +229,12 @@ nlohmann::json summary(const ModeRun& run, std::size_t points) {
 std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& scan,
                                        const RenderSettings& settings,
                                        const std::vector<BenchMode>& modes,
-                                       const BenchOptions& options, UpAxis up) {
+                                       const BenchOptions& options, UpAxis up,
+                                       const std::optional<Camera>& still) {
     auto cameraAt = [&](int frame) {
+        if (still) {
+            return *still;
+        }
         const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
         return cameraForPose(scan.cloud.bounds, benchmarkPose(t), up, options.width, options.height,
                              45.0);
@@ -286,13 +293,23 @@ int runBench(const BenchOptions& options) {
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();
+    // --view sensor: every frame from the sensor, a still camera instead of the path.
+    std::optional<Camera> still;
+    if (options.sensorView.wanted()) {
+        still = options.sensorView.camera(
+            scan, options.source, up, options.width, options.height,
+            options.widthOption->count() > 0 || options.heightOption->count() > 0, 45.0);
+    }
+    const int width = still ? still->width : options.width;
+    const int height = still ? still->height : options.height;
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
 
     nlohmann::json report = {
         {"renderer", context->capabilities().renderer},
         {"points", scan.cloud.size()},
-        {"width", options.width},
-        {"height", options.height},
+        {"width", width},
+        {"height", height},
+        {"view", options.sensorView.view},
         {"frames", options.frames},
         {"resolution", toString(settings.raster.resolution)},
         {"modes", nlohmann::json::object()},
@@ -302,7 +319,7 @@ int runBench(const BenchOptions& options) {
                    options.frames);
     }
     const std::vector<nlohmann::json> summaries =
-        benchModes(*context, scan, settings, modes, options, up);
+        benchModes(*context, scan, settings, modes, options, up, still);
     context->throwOnErrors("while benchmarking");
     for (std::size_t i = 0; i < modes.size(); ++i) {
         report["modes"][modes[i].name] = summaries[i];
@@ -312,7 +329,7 @@ int runBench(const BenchOptions& options) {
         return 0;
     }
     fmt::print("{} | {} points | {}x{} | {} frames\n", report["renderer"].get<std::string>(),
-               scan.cloud.size(), options.width, options.height, options.frames);
+               scan.cloud.size(), width, height, options.frames);
     fmt::print("{:<22} {:>9} {:>9} {:>11} {:>14} {:>8} {:>8} {:>10} {:>13} {:>13}\n", "mode",
                "avg fps", "1% low", "median ms", "points/s", "GPU MB", "reduced", "recon ms",
                "single/recon", "light map ms");
@@ -344,10 +361,12 @@ Command addBenchCommand(CLI::App& parent) {
         ->check(CLI::Range(1, 1000000));
     bench->add_option("--warmup", options->warmup, "Untimed frames before each mode (default 10)")
         ->check(CLI::Range(0, 100000));
-    bench->add_option("--width", options->width, "Image width (default 1920)")
-        ->check(CLI::Range(1, 65536));
-    bench->add_option("--height", options->height, "Image height (default 1080)")
-        ->check(CLI::Range(1, 65536));
+    options->widthOption =
+        bench->add_option("--width", options->width, "Image width (default 1920)")
+            ->check(CLI::Range(1, 65536));
+    options->heightOption =
+        bench->add_option("--height", options->height, "Image height (default 1080)")
+            ->check(CLI::Range(1, 65536));
     bench->add_option("--modes", options->modes,
                       "Comma-separated modes (default points-gl,points,surface,sss); "
                       "sss:gaussian, sss:single and sss:both run the sss mode with that "
@@ -358,6 +377,7 @@ Command addBenchCommand(CLI::App& parent) {
         ->check(CLI::ExistingFile);
     bench->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));
+    options->sensorView.add(*bench);
     options->scattering.add(*bench);
     bench->add_flag("--json", options->json, "Print the results as JSON");
     bench->add_flag("--software", options->software,

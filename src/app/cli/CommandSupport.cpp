@@ -11,6 +11,7 @@
 
 #include "app/ProgressBar.h"
 #include "core/Error.h"
+#include "core/SensorView.h"
 #include "sss/MaterialLibrary.h"
 
 namespace subscan::cli {
@@ -139,6 +140,74 @@ void ScatteringOptions::apply(ScatteringSettings& settings) const {
         settings.lightPath = parseLightPath(lightPath);
     }
     checkScatteringSettings(settings);
+}
+
+void SensorViewOptions::add(CLI::App& command) {
+    command
+        .add_option("--view", view,
+                    "orbit (default: --yaw, --pitch around the points) | sensor (from where the "
+                    "scan was taken: an organised cloud's own camera, the PCD VIEWPOINT, the E57 "
+                    "pose or --sensor)")
+        ->check(CLI::IsMember({"orbit", "sensor"}));
+    command.add_option_function<std::string>(
+        "--sensor",
+        [this](const std::string& text) {
+            const std::optional<glm::dvec3> position = parseCommaSeparatedTriple(text);
+            if (!position) {
+                throw CLI::ValidationError(
+                    "--sensor",
+                    fmt::format(
+                        "'{}' is not X,Y,Z (three finite numbers in the file's coordinates)",
+                        text));
+            }
+            sensor = position;
+        },
+        "The sensor's position X,Y,Z in the file's coordinates (for --view sensor)");
+}
+
+Camera SensorViewOptions::camera(const LoadedScan& scan, const std::string& source, UpAxis up,
+                                 int width, int height, bool sizeGiven, double fovyDegrees) const {
+    if (!sensor && !scan.grid.empty()) {
+        try {
+            const PinholeFit fit = fitPinhole(scan.cloud, scan.grid);
+            if (fit.rmsErrorPixels <= kPinholeToleranceRmsPixels) {
+                Camera camera = fit.camera;
+                if (sizeGiven) {
+                    // The same field of view over the rows; the principal point scales with it.
+                    camera.principalOffsetPixels *=
+                        static_cast<double>(height) / static_cast<double>(camera.height);
+                    camera.width = width;
+                    camera.height = height;
+                }
+                return camera;
+            }
+            fmt::print(stderr,
+                       "subscan: warning: {}: the organised grid is no pinhole camera's image "
+                       "(it misses by {:.3g} pixels RMS); the sensor view looks from its "
+                       "position at the points instead\n",
+                       source, fit.rmsErrorPixels);
+        } catch (const Error& error) {
+            fmt::print(stderr,
+                       "subscan: warning: {}: {}; the sensor view looks from its position "
+                       "at the points instead\n",
+                       source, error.what());
+        }
+    }
+    std::optional<SensorPose> pose = scan.sensor;
+    if (sensor) {
+        pose = SensorPose{*sensor, "--sensor"};
+    }
+    if (!pose) {
+        throw Error(fmt::format(
+            "{} records no sensor position (a PCD VIEWPOINT, an E57 pose or an organised grid); "
+            "give one with --sensor X,Y,Z",
+            source));
+    }
+    try {
+        return sensorCamera(scan.cloud, *pose, up, width, height, fovyDegrees);
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", source, error.what()));
+    }
 }
 
 }  // namespace subscan::cli

@@ -50,4 +50,20 @@ struct ScatteringOptions {
     void apply(ScatteringSettings& settings) const;
 };
 
+/// --view orbit|sensor and --sensor X,Y,Z, as render, turntable and bench take them.
+struct SensorViewOptions {
+    std::string view = "orbit";
+    std::optional<glm::dvec3> sensor;  // file coordinates
+
+    void add(CLI::App& command);
+    bool wanted() const { return view == "sensor"; }
+    /// The view from where the scan was taken: an organised cloud's own camera, fitted to its
+    /// grid (its size unless `sizeGiven`, then `width` x `height` with the same field of
+    /// view); else from --sensor, the PCD VIEWPOINT or the E57 pose towards the points, at
+    /// `width` x `height` and `fovyDegrees`. Throws subscan::Error naming `source` when the
+    /// scan records no sensor and --sensor is not given.
+    Camera camera(const LoadedScan& scan, const std::string& source, UpAxis up, int width,
+                  int height, bool sizeGiven, double fovyDegrees) const;
+};
+
 }  // namespace subscan::cli

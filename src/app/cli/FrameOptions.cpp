@@ -5,7 +5,6 @@
 
 #include "core/Coloring.h"
 #include "core/Error.h"
-#include "core/SensorView.h"
 #include "io/CameraJson.h"
 
 namespace subscan::cli {
@@ -59,25 +58,7 @@ void FrameOptions::add(CLI::App& command) {
         ->check(CLI::PositiveNumber);
     command.add_option("--up", up, "Up axis: auto (z for LAS, else y) | y | z")
         ->check(CLI::IsMember({"auto", "y", "z"}));
-    command
-        .add_option("--view", view,
-                    "orbit (default: --yaw, --pitch around the points) | sensor (from where the "
-                    "scan was taken: an organised cloud's own camera, the PCD VIEWPOINT, the E57 "
-                    "pose or --sensor)")
-        ->check(CLI::IsMember({"orbit", "sensor"}));
-    command.add_option_function<std::string>(
-        "--sensor",
-        [this](const std::string& text) {
-            const std::optional<glm::dvec3> position = parseCommaSeparatedTriple(text);
-            if (!position) {
-                throw CLI::ValidationError("--sensor",
-                                           fmt::format("'{}' is not X,Y,Z (three finite "
-                                                       "numbers in the file's coordinates)",
-                                                       text));
-            }
-            sensor = position;
-        },
-        "The sensor's position X,Y,Z in the file's coordinates (for --view sensor)");
+    sensorView.add(command);
     command
         .add_option("--color", color,
                     "What the points' colour shows: auto (rgb, else height for Z-up data, else "
@@ -147,8 +128,9 @@ Camera FrameOptions::camera(const LoadedScan& scan, Framing framing) const {
     if (!cameraFile.empty()) {
         return readCameraFile(cameraFile);
     }
-    if (view == "sensor") {
-        return sensorView(scan);
+    if (sensorView.wanted()) {
+        return sensorView.camera(scan, source, upAxis(scan), width, height,
+                                 widthOption->count() > 0 || heightOption->count() > 0, fovy);
     }
     OrbitView orbit;
     orbit.yawDegrees = yaw;
@@ -158,48 +140,6 @@ Camera FrameOptions::camera(const LoadedScan& scan, Framing framing) const {
     orbit.framing = framing;
     orbit.framed = framingBounds(scan.cloud);
     return orbitCamera(scan.cloud.bounds, orbit, width, height, fovy);
-}
-
-Camera FrameOptions::sensorView(const LoadedScan& scan) const {
-    const bool sizeGiven = widthOption->count() > 0 || heightOption->count() > 0;
-    if (!sensor && !scan.grid.empty()) {
-        try {
-            const PinholeFit fit = fitPinhole(scan.cloud, scan.grid);
-            if (fit.rmsErrorPixels <= kPinholeToleranceRmsPixels) {
-                Camera camera = fit.camera;
-                if (sizeGiven) {
-                    camera.width = width;
-                    camera.height = height;
-                }
-                return camera;
-            }
-            fmt::print(stderr,
-                       "subscan: warning: {}: the organised grid is no pinhole camera's image "
-                       "(it misses by {:.3g} pixels RMS); the sensor view looks from its "
-                       "position at the points instead\n",
-                       source, fit.rmsErrorPixels);
-        } catch (const Error& error) {
-            fmt::print(stderr,
-                       "subscan: warning: {}: {}; the sensor view looks from its position "
-                       "at the points instead\n",
-                       source, error.what());
-        }
-    }
-    std::optional<SensorPose> pose = scan.sensor;
-    if (sensor) {
-        pose = SensorPose{*sensor, "--sensor"};
-    }
-    if (!pose) {
-        throw Error(fmt::format(
-            "{} records no sensor position (a PCD VIEWPOINT, an E57 pose or an organised grid); "
-            "give one with --sensor X,Y,Z",
-            source));
-    }
-    try {
-        return sensorCamera(scan.cloud, *pose, upAxis(scan), width, height, fovy);
-    } catch (const Error& error) {
-        throw Error(fmt::format("{}: {}", source, error.what()));
-    }
 }
 
 std::unique_ptr<GlContext> FrameOptions::context() const {

@@ -28,8 +28,7 @@ struct FrameOptions {
     double pitch = 20.0;
     std::optional<double> distance;
     std::string up = "auto";
-    std::string view = "orbit";          // orbit | sensor
-    std::optional<glm::dvec3> sensor;    // --sensor X,Y,Z
+    SensorViewOptions sensorView;
     CLI::Option* widthOption = nullptr;  // to tell a given size from the default
     CLI::Option* heightOption = nullptr;
     double fovy = 45.0;
@@ -52,11 +51,6 @@ struct FrameOptions {
     /// --yaw, --pitch, --distance, --up and --fovy around the scan's bounds, framed by
     /// `framing` when --distance is not given.
     Camera camera(const LoadedScan& scan, Framing framing = Framing::Box) const;
-    /// The view from where the scan was taken: an organised cloud's own camera (fitted to its
-    /// grid; its size unless --width/--height are given); else from --sensor, the PCD
-    /// VIEWPOINT or the E57 pose towards the points. Throws subscan::Error when the scan
-    /// records no sensor and --sensor is not given.
-    Camera sensorView(const LoadedScan& scan) const;
     /// The up axis --up names for `scan` (auto: Z for LAS, else Y).
     UpAxis upAxis(const LoadedScan& scan) const;
     /// Replaces the scan's colours by what --color shows (core/Coloring.h); throws
