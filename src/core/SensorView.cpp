@@ -207,4 +207,38 @@ Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up
     return camera;
 }
 
+Camera viewFromSensor(const PointCloud& cloud, const OrganisedGrid& grid,
+                      const std::optional<SensorPose>& pose, UpAxis up, int width, int height,
+                      bool sizeGiven, double fovyDegrees, std::vector<std::string>& warnings) {
+    if (!grid.empty()) {
+        try {
+            const PinholeFit fit = fitPinhole(cloud, grid);
+            if (fit.rmsErrorPixels <= kPinholeToleranceRmsPixels) {
+                Camera camera = fit.camera;
+                if (sizeGiven) {
+                    // The same field of view over the rows; the principal point scales with it.
+                    camera.principalOffsetPixels *=
+                        static_cast<double>(height) / static_cast<double>(camera.height);
+                    camera.width = width;
+                    camera.height = height;
+                }
+                return camera;
+            }
+            warnings.push_back(fmt::format(
+                "the organised grid is no pinhole camera's image (it misses by {:.3g} pixels "
+                "RMS); the sensor view looks from its position at the points instead",
+                fit.rmsErrorPixels));
+        } catch (const Error& error) {
+            warnings.push_back(fmt::format(
+                "{}; the sensor view looks from its position at the points instead", error.what()));
+        }
+    }
+    if (!pose) {
+        throw Error(
+            "the scan records no sensor position (a PCD VIEWPOINT, an E57 pose or an organised "
+            "grid); give one with --sensor X,Y,Z");
+    }
+    return sensorCamera(cloud, *pose, up, width, height, fovyDegrees);
+}
+
 }  // namespace subscan

@@ -55,4 +55,12 @@ inline constexpr double kPinholeToleranceRmsPixels = 1.0;
 Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up, int width,
                     int height, double fovyDegrees);
 
+/// The view from where the scan was taken: an organised cloud's own camera, fitted to its grid
+/// (at the grid's size, or at `width` x `height` with the same field of view when `sizeGiven`);
+/// else, or when the grid is no pinhole image (a warning says so), sensorCamera() from `pose`.
+/// Throws subscan::Error when there is neither.
+Camera viewFromSensor(const PointCloud& cloud, const OrganisedGrid& grid,
+                      const std::optional<SensorPose>& pose, UpAxis up, int width, int height,
+                      bool sizeGiven, double fovyDegrees, std::vector<std::string>& warnings);
+
 }  // namespace subscan

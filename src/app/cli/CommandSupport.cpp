@@ -167,44 +167,18 @@ void SensorViewOptions::add(CLI::App& command) {
 
 Camera SensorViewOptions::camera(const LoadedScan& scan, const std::string& source, UpAxis up,
                                  int width, int height, bool sizeGiven, double fovyDegrees) const {
-    if (!sensor && !scan.grid.empty()) {
-        try {
-            const PinholeFit fit = fitPinhole(scan.cloud, scan.grid);
-            if (fit.rmsErrorPixels <= kPinholeToleranceRmsPixels) {
-                Camera camera = fit.camera;
-                if (sizeGiven) {
-                    // The same field of view over the rows; the principal point scales with it.
-                    camera.principalOffsetPixels *=
-                        static_cast<double>(height) / static_cast<double>(camera.height);
-                    camera.width = width;
-                    camera.height = height;
-                }
-                return camera;
-            }
-            fmt::print(stderr,
-                       "subscan: warning: {}: the organised grid is no pinhole camera's image "
-                       "(it misses by {:.3g} pixels RMS); the sensor view looks from its "
-                       "position at the points instead\n",
-                       source, fit.rmsErrorPixels);
-        } catch (const Error& error) {
-            fmt::print(stderr,
-                       "subscan: warning: {}: {}; the sensor view looks from its position "
-                       "at the points instead\n",
-                       source, error.what());
-        }
-    }
-    std::optional<SensorPose> pose = scan.sensor;
-    if (sensor) {
-        pose = SensorPose{*sensor, "--sensor"};
-    }
-    if (!pose) {
-        throw Error(fmt::format(
-            "{} records no sensor position (a PCD VIEWPOINT, an E57 pose or an organised grid); "
-            "give one with --sensor X,Y,Z",
-            source));
-    }
+    // --sensor overrides what the file says, the organised grid's camera included.
+    const OrganisedGrid noGrid;
+    std::vector<std::string> warnings;
     try {
-        return sensorCamera(scan.cloud, *pose, up, width, height, fovyDegrees);
+        const Camera camera = viewFromSensor(
+            scan.cloud, sensor ? noGrid : scan.grid,
+            sensor ? std::optional<SensorPose>(SensorPose{*sensor, "--sensor"}) : scan.sensor, up,
+            width, height, sizeGiven, fovyDegrees, warnings);
+        for (const std::string& warning : warnings) {
+            fmt::print(stderr, "subscan: warning: {}: {}\n", source, warning);
+        }
+        return camera;
     } catch (const Error& error) {
         throw Error(fmt::format("{}: {}", source, error.what()));
     }

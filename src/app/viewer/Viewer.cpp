@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "core/SensorView.h"
 #include "io/CameraJson.h"
 #include "io/Image.h"
 #include "render/ReducedResolution.h"
@@ -25,6 +26,25 @@
 namespace subscan::viewer {
 
 namespace {
+
+/// The eye and target of the scan's sensor view (viewFromSensor), the target at the depth of
+/// the points' middle; nothing when the scan records no sensor.
+std::optional<std::pair<glm::dvec3, glm::dvec3>> sensorLook(const LoadedScan& scan, UpAxis up) {
+    std::vector<std::string> warnings;
+    Camera camera;
+    try {
+        camera = viewFromSensor(scan.cloud, scan.grid, scan.sensor, up, 640, 480, false,
+                                ViewerCamera::kFovyDegrees, warnings);
+    } catch (const Error&) {
+        return std::nullopt;
+    }
+    const glm::dvec3 eye = camera.eye();
+    const glm::dvec3 forward =
+        glm::normalize(glm::dvec3(glm::inverse(camera.view) * glm::dvec4(0, 0, -1, 0)));
+    const glm::dvec3 middle = framingBounds(scan.cloud).center();
+    const double depth = glm::dot(middle - eye, forward);
+    return std::pair{eye, eye + forward * (depth > 0.0 ? depth : glm::length(middle - eye))};
+}
 
 // Two left presses this close in time and space are a double click.
 constexpr double kDoubleClickSeconds = 0.35;
@@ -286,6 +306,14 @@ void Viewer::handleKey(int key) {
         case GLFW_KEY_F:
             camera_.frameAll(size.x, size.y);
             break;
+        case GLFW_KEY_V:
+            if (sensorLook_) {
+                camera_.lookFrom(sensorLook_->first, sensorLook_->second);
+                notify("the view from the scan's sensor");
+            } else {
+                notify("this scan records no sensor position");
+            }
+            break;
         case GLFW_KEY_P:
             pendingScreenshots_.push_back(nextScreenshotPath());
             break;
@@ -394,6 +422,7 @@ void Viewer::finishLoading() {
         const glm::ivec2 size = viewportSize();
         camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
                                framingBounds(cloud));
+        sensorLook_ = sensorLook(prepared.scan, up);
         renderedCamera_.reset();
         renderedImage_ = false;
         glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());

@@ -147,6 +147,8 @@ class Viewer {
     PanelStatus status_;
     Bounds bounds_;
     ViewerCamera camera_;
+    /// Where `V` puts the eye and what it looks at: the scan's sensor, when it records one.
+    std::optional<std::pair<glm::dvec3, glm::dvec3>> sensorLook_;
     std::unique_ptr<ScanLoadJob> loading_;
     bool initialScanShown_ = false;
     std::optional<std::string> pendingOpen_;

@@ -120,18 +120,22 @@ void ViewerCamera::move(const glm::dvec3& rightUpBack) {
 }
 
 void ViewerCamera::setCentre(const glm::dvec3& point) {
-    const glm::dvec3 fromPoint = eye() - point;
-    const double length = glm::length(fromPoint);
+    lookFrom(eye(), point);
+}
+
+void ViewerCamera::lookFrom(const glm::dvec3& eye, const glm::dvec3& target) {
+    const glm::dvec3 fromTarget = eye - target;
+    const double length = glm::length(fromTarget);
     if (!(length > kMinDistanceRadii * sceneRadius_)) {
         return;
     }
-    const glm::dvec3 direction = fromPoint / length;
+    const glm::dvec3 direction = fromTarget / length;
     const double along = up_ == UpAxis::Y ? direction.y : direction.z;
     pitchDegrees_ = std::clamp(glm::degrees(std::asin(std::clamp(along, -1.0, 1.0))),
                                -kMaxPitchDegrees, kMaxPitchDegrees);
     yawDegrees_ = up_ == UpAxis::Y ? glm::degrees(std::atan2(direction.x, direction.z))
                                    : glm::degrees(std::atan2(direction.x, -direction.y));
-    centre_ = point;
+    centre_ = target;
     distance_ = length;
     clampDistance();
 }

@@ -52,6 +52,9 @@ class ViewerCamera {
     void move(const glm::dvec3& rightUpBack);
     /// Orbits around `point` from now on; the eye stays where it is and turns towards it.
     void setCentre(const glm::dvec3& point);
+    /// Puts the eye at `eye`, orbiting `target` (the sensor view, `V`); the pitch stays within
+    /// kMaxPitchDegrees of the horizon, as every view of this camera does.
+    void lookFrom(const glm::dvec3& eye, const glm::dvec3& target);
 
     /// A directional light's direction (towards the light, scene coordinates) after a drag of
     /// (dx, dy) pixels with `L` held. The light turns around the scene in the frame of this

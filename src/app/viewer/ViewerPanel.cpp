@@ -200,6 +200,7 @@ PanelRequests ViewerPanel::draw(RenderSettings& settings, Navigation& navigation
                 "L + left drag  turn light 1 around the\n"
                 "               scan (L adds one if none)\n"
                 "R / F          reset view / frame all\n"
+                "V              view from the scan's sensor\n"
                 "C              orbit <-> fly (WASD, Q/E,\n"
                 "               Shift faster)\n"
                 "P              screenshot + camera.json\n"

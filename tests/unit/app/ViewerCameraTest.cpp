@@ -207,6 +207,20 @@ TEST(ViewerCameraTest, SetCentreKeepsTheEyeAndTurnsTowardsThePoint) {
     }
 }
 
+TEST(ViewerCameraTest, LookFromPutsTheEyeThereAndTheTargetInTheMiddle) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+        ViewerCamera camera = movedCamera(up);
+        const glm::dvec3 eye(0.3, -0.2, 0.4);
+        const glm::dvec3 target(-0.1, 0.05, -0.2);
+        camera.lookFrom(eye, target);
+        expectNear(camera.eye(), eye, kTolerance);
+        expectNear(camera.centre(), target, kTolerance);
+        const Projected projected = project(camera.camera(kWidth, kHeight), target);
+        EXPECT_NEAR(projected.pixel.x, kWidth / 2.0, kPixelTolerance);
+        EXPECT_NEAR(projected.pixel.y, kHeight / 2.0, kPixelTolerance);
+    }
+}
+
 TEST(ViewerCameraTest, FlyLookTurnsAroundTheEyeAndMoveShiftsBoth) {
     ViewerCamera camera = movedCamera(UpAxis::Y);
     const glm::dvec3 eye = camera.eye();
