@@ -20,4 +20,21 @@ build/tools/subscan_figures materials "$scan" docs/images/materials-happy.png --
 build/tools/subscan_figures single "$scan" docs/images/single-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 320 420
 build/tools/subscan_figures shadows "$scan" docs/images/shadows-happy.png --yaw 0 --pitch 10 --distance 0.3 --size 300 460
 build/tools/subscan_figures backlit "$scan" docs/images/backlit-happy.png --yaw 0 --pitch 10 --distance 0.3 --size 300 460
+# The depth camera's table scene from render's default orbit and from its own sensor.
+table="$data/table_scene_mug_stereo_textured.pcd"
+if [[ -f "$table" ]]; then
+    tmp=$(mktemp -d)
+    build/src/subscan render "$table" --mode surface --width 480 --height 360 -o "$tmp/orbit.png" 2>/dev/null
+    build/src/subscan render "$table" --mode surface --view sensor --width 480 --height 360 -o "$tmp/sensor.png" 2>/dev/null
+    /usr/bin/python3 - "$tmp/orbit.png" "$tmp/sensor.png" docs/images/sensor-table.png <<'PY'
+import sys
+from PIL import Image
+left, right = Image.open(sys.argv[1]).convert("RGB"), Image.open(sys.argv[2]).convert("RGB")
+pair = Image.new("RGB", (left.width + 8 + right.width, left.height), (255, 255, 255))
+pair.paste(left, (0, 0))
+pair.paste(right, (left.width + 8, 0))
+pair.save(sys.argv[3])
+PY
+    rm -r "$tmp"
+fi
 ls -1 docs/images
