@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
@@ -157,9 +158,11 @@ void exportView(const std::filesystem::path& directory, int view, const Camera& 
     for (std::size_t i = 0; i < truth.depth.size(); ++i) {
         const bool inTruth = std::isfinite(truth.depth[i]);
         const bool inSurface = std::isfinite(surface.depth[i]);
+        const bool unsampled = inTruth && !truth.sampled.empty() && truth.sampled[i] == 0;
         const bool occluded =
             inTruth && inSurface && surface.depth[i] - truth.depth[i] > 3.0 * spacing;
-        const glm::u8vec3 color = occluded               ? glm::u8vec3(250, 220, 30)
+        const glm::u8vec3 color = unsampled              ? glm::u8vec3(60)
+                                  : occluded             ? glm::u8vec3(250, 220, 30)
                                   : inTruth && inSurface ? glm::u8vec3(160)
                                   : inTruth              ? glm::u8vec3(230, 40, 40)
                                   : inSurface            ? glm::u8vec3(40, 80, 230)
@@ -192,14 +195,20 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
     std::vector<QualityMetrics> pointViews, surfaceViews;
     std::vector<std::vector<QualityMetrics>> splatViews(
         static_cast<std::size_t>(settings.largestSplat - settings.smallestSplat + 1));
-    for (int view = 0; view < settings.views; ++view) {
+    const int views =
+        settings.viewpoints.empty() ? settings.views : static_cast<int>(settings.viewpoints.size());
+    for (int view = 0; view < views; ++view) {
         OrbitView orbit;
-        orbit.yawDegrees = 20.0 + 360.0 * view / settings.views;
-        orbit.pitchDegrees = view % 2 == 0 ? 25.0 : -15.0;
-        orbit.distance = settings.distance;
+        if (settings.viewpoints.empty()) {
+            orbit.yawDegrees = 20.0 + 360.0 * view / settings.views;
+            orbit.pitchDegrees = view % 2 == 0 ? 25.0 : -15.0;
+            orbit.distance = settings.distance;
+        } else {
+            orbit = settings.viewpoints[static_cast<std::size_t>(view)];
+        }
         const Camera camera = orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
                                           settings.fovyDegrees);
-        const GroundTruthImages groundTruth = renderGroundTruth(truth, camera);
+        const GroundTruthImages groundTruth = renderGroundTruth(truth, camera, settings.sampled);
         const std::vector<std::uint8_t> truthImage = shader.shade(
             camera, render, groundTruth.depth, groundTruth.normals, groundTruth.albedo);
         // The baselines: rasterized points, flat shaded.
@@ -235,7 +244,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         }
     }
 
-    report.views = settings.views;
+    report.views = views;
     report.width = settings.width;
     report.height = settings.height;
     report.points = points.size();
@@ -428,6 +437,59 @@ nlohmann::json toJson(const EvaluationReport& report) {
          {{"points", method(report.points1px)},
           {"splats", splats},
           {"surface", method(report.surface)}}},
+    };
+}
+
+namespace {
+
+/// The orbit that puts the eye at `eye` looking at `target`.
+OrbitView lookingAt(const glm::dvec3& eye, const glm::dvec3& target) {
+    const glm::dvec3 offset = eye - target;
+    const double distance = glm::length(offset);
+    OrbitView orbit;
+    orbit.center = target;
+    orbit.distance = distance;
+    orbit.yawDegrees = glm::degrees(std::atan2(offset.x, offset.z));
+    orbit.pitchDegrees = glm::degrees(std::asin(offset.y / distance));
+    return orbit;
+}
+
+}  // namespace
+
+void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
+                    const ScannerSettings& scanner) {
+    if (scanner.mode == ScannerSettings::Mode::Object) {
+        return;
+    }
+    constexpr double kFirstAzimuthDegrees = 45.0;
+    settings.viewpoints.clear();
+    ScannerSettings fixed = scanner;
+    if (scanner.mode == ScannerSettings::Mode::Station) {
+        const glm::dvec3 station = stationPosition(scene, scanner.station);
+        fixed.station.position = station;  // found once, not per pixel
+        constexpr double kAbove = 1.0, kBehind = 1.0, kLookDistance = 20.0, kDownDegrees = 10.0;
+        for (int view = 0; view < settings.views; ++view) {
+            const double azimuth =
+                glm::radians(kFirstAzimuthDegrees + 360.0 * view / settings.views);
+            const glm::dvec3 outward(std::sin(azimuth), 0.0, std::cos(azimuth));
+            const glm::dvec3 eye = station + glm::dvec3(0.0, kAbove, 0.0) - kBehind * outward;
+            const double down = glm::radians(kDownDegrees);
+            const glm::dvec3 target = eye + kLookDistance * (std::cos(down) * outward +
+                                                             glm::dvec3(0.0, -std::sin(down), 0.0));
+            settings.viewpoints.push_back(lookingAt(eye, target));
+        }
+    } else {
+        constexpr double kPitchDegrees = 45.0;
+        for (int view = 0; view < settings.views; ++view) {
+            OrbitView orbit;
+            orbit.yawDegrees = kFirstAzimuthDegrees + 360.0 * view / settings.views;
+            orbit.pitchDegrees = kPitchDegrees;
+            orbit.distance = settings.distance;
+            settings.viewpoints.push_back(orbit);
+        }
+    }
+    settings.sampled = [&scene, fixed](const glm::dvec3& p, const glm::dvec3& normal) {
+        return scannerCanSample(scene, fixed, p, normal);
     };
 }
 

@@ -3,14 +3,18 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "core/Camera.h"
 #include "core/PointCloud.h"
+#include "eval/GroundTruth.h"
 #include "eval/Metrics.h"
 #include "gpu/GlContext.h"
 #include "render/RenderSettings.h"
 #include "scan/Scene.h"
+#include "scan/VirtualScanner.h"
 
 namespace subscan {
 
@@ -30,7 +34,22 @@ struct EvaluationSettings {
     /// through) and normal_error.png (black 0° to white 45°). With --temporal, each frame's
     /// frameNNNN_{truth,points,surface,temporal}.png (the truth supersampled).
     std::filesystem::path exportDirectory;
+    /// When not empty, the views instead of the orbit (`views` is then ignored).
+    std::vector<OrbitView> viewpoints;
+    /// When set, which true surface points the scan could sample: coverage and leakage count
+    /// only those (DESIGN.md §7: coverage is of the ground truth the scan sampled).
+    SampledTest sampled;
 };
+
+/// Fits `settings` to a scan made with `scanner` of `scene` (DESIGN.md §7, real scans). Object
+/// scans keep the orbit. A station sees only what is visible from where it stands, so its
+/// `views` views stand 1 m above and 1 m behind the station, look out in azimuths 45 degrees
+/// plus equal turns, 10 degrees down; an airborne strip's look down at 45 degrees from the
+/// orbit's usual distance, in the same azimuths. Both count only surfaces the scan could sample
+/// (scannerCanSample): the backs of buildings, the ground behind a wall, walls parallel to the
+/// flight's scan planes are no reconstruction's to fill. `scene` must outlive `settings`.
+void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
+                    const ScannerSettings& scanner);
 
 /// DESIGN.md §7 metrics of each method, averaged over the views.
 struct EvaluationReport {

@@ -9,14 +9,17 @@
 
 namespace subscan {
 
-GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera) {
+GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera,
+                                    const SampledTest& sampled) {
     const int width = camera.width;
     const int height = camera.height;
     const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    GroundTruthImages images{width, height,
+    GroundTruthImages images{width,
+                             height,
                              std::vector<float>(pixels, std::numeric_limits<float>::infinity()),
                              std::vector<glm::vec3>(pixels, glm::vec3(0.0f)),
-                             std::vector<glm::vec3>(pixels, glm::vec3(0.0f))};
+                             std::vector<glm::vec3>(pixels, glm::vec3(0.0f)),
+                             std::vector<std::uint8_t>(sampled ? pixels : 0, 0)};
     const glm::dmat4 toFile = glm::inverse(camera.view);
     const glm::dvec3 eye = camera.eye();
     const glm::dmat3 rotation(camera.view);
@@ -40,6 +43,10 @@ GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera) {
                 images.depth[i] = static_cast<float>(hit->distance / glm::length(viewDirection));
                 images.normals[i] = glm::vec3(glm::normalize(rotation * hit->normal));
                 images.albedo[i] = hit->albedo;
+                if (sampled) {
+                    images.sampled[i] =
+                        sampled(ray.origin + hit->distance * ray.direction, hit->normal);
+                }
             }
         }
     };

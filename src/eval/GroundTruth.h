@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -17,10 +19,18 @@ struct GroundTruthImages {
     std::vector<float> depth;
     std::vector<glm::vec3> normals;
     std::vector<glm::vec3> albedo;
+    /// 1 where the pixel's surface point is one the scan could sample, else 0 (see
+    /// scannerCanSample); empty when every point could be. Metrics skip unsampled pixels.
+    std::vector<std::uint8_t> sampled;
 };
 
+/// Whether the scan sampled a surface point (scene coordinates, with its unit outward normal).
+using SampledTest = std::function<bool(const glm::dvec3& point, const glm::dvec3& normal)>;
+
 /// Casts one ray through the centre of every pixel (what rasterizing the true surface samples)
-/// and keeps the first hit. Uses all cores; deterministic.
-GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera);
+/// and keeps the first hit. With `sampled`, also fills GroundTruthImages::sampled. Uses all
+/// cores; deterministic.
+GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera,
+                                    const SampledTest& sampled = {});
 
 }  // namespace subscan

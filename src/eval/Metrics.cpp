@@ -33,8 +33,13 @@ QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
     std::vector<double> signedDepthErrors;
     std::vector<double> normalErrors;
     const bool hasNormals = !reconstruction.normals.empty();
+    const bool masked = !truth.sampled.empty();
     for (std::size_t i = 0; i < truth.depth.size(); ++i) {
         const bool inTruth = std::isfinite(truth.depth[i]);
+        // A true surface the scan could not sample is neither to be covered nor leaked onto.
+        if (inTruth && masked && truth.sampled[i] == 0) {
+            continue;
+        }
         const bool inReconstruction = std::isfinite(reconstruction.depth[i]);
         truthPixels += inTruth;
         reconstructed += inReconstruction;

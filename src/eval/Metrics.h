@@ -29,7 +29,9 @@ struct QualityMetrics {
     double psnrDb = 0.0;  // shaded image against the shaded ground truth, 8-bit sRGB
 };
 
-/// Everything but PSNR, from the images; `spacing` is h.
+/// Everything but PSNR, from the images; `spacing` is h. Pixels whose true surface the scan
+/// could not sample (GroundTruthImages::sampled) count nowhere: coverage is over the sampled
+/// true pixels, leakage over reconstructed pixels that are not on an unsampled true surface.
 QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
                                     const GroundTruthImages& truth, double spacing);
 

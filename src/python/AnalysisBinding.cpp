@@ -186,8 +186,10 @@ py::object evaluateMesh(const py::object& meshArgumentObject, const py::object& 
         const std::string spec = source.substr(kSynthetic.size());
         argumentErrors([&] {
             try {
-                truth = makeBuiltInScene(spec.substr(0, spec.find('?')));
-                points = makeSyntheticScene(spec);
+                SyntheticSource synthetic = makeSyntheticSource(spec);
+                truth = std::move(synthetic.scene);
+                points = std::move(synthetic.points);
+                adaptToScanner(evaluation, *truth, synthetic.scanner);
             } catch (const Error& error) {
                 throw Error(fmt::format("{}: {}", source, error.what()));
             }

@@ -52,7 +52,11 @@ std::span<const std::string_view> builtInSceneNames();
 ///  - "torus": ring of radius 0.1 and tube radius 0.035 around the Y axis (a 27 cm ring);
 ///  - "box-with-hole": a 20 x 12 x 10 cm block pierced along Z by a 6 cm hole, with a step cut
 ///    out of one top edge (concave edges, a through hole);
-///  - "sculpture": a 29 cm marble sculpture on a plinth (see BuiltInScenes.cpp).
+///  - "sculpture": a 29 cm marble sculpture on a plinth (see BuiltInScenes.cpp);
+///  - "outdoor": for LiDAR, a 60 x 60 m ground (top at y = 0, the middle kept clear for a
+///    station) with a flat-roofed block, a gable-roofed house, a free-standing 12 cm garden wall
+///    with a car hidden behind it (seen from the middle), a tree, a second car and a distant
+///    tower (see BuiltInScenes.cpp).
 /// Throws subscan::Error listing the available names.
 std::unique_ptr<Scene> makeBuiltInScene(std::string_view name);
 

@@ -1,5 +1,6 @@
 #include "scan/SyntheticScenes.h"
 
+#include <array>
 #include <charconv>
 #include <string>
 
@@ -14,6 +15,16 @@ namespace subscan {
 namespace {
 
 constexpr std::size_t kMaxSyntheticPoints = 100'000'000;
+
+constexpr std::string_view kLidarScene = "outdoor";
+constexpr std::string_view kStationSource = "outdoor-station";
+constexpr std::string_view kAirborneSource = "outdoor-airborne";
+constexpr std::array<std::string_view, 2> kLidarSourceNames{kStationSource, kAirborneSource};
+/// Range noise of a good terrestrial scanner (a few mm at tens of metres) and of airborne
+/// LiDAR (a few cm), in metres: unlike a structured-light scanner's, it does not scale with the
+/// spacing.
+constexpr double kStationNoiseMetres = 0.005;
+constexpr double kAirborneNoiseMetres = 0.03;
 
 struct SyntheticRequest {
     std::size_t points = 0;  // 0: the scene's default
@@ -65,22 +76,52 @@ SyntheticRequest parseParameters(std::string_view parameters) {
 }  // namespace
 
 PointCloud makeSyntheticScene(std::string_view spec) {
+    return makeSyntheticSource(spec).points;
+}
+
+std::span<const std::string_view> lidarSourceNames() {
+    return kLidarSourceNames;
+}
+
+SyntheticSource makeSyntheticSource(std::string_view spec) {
     const std::size_t query = spec.find('?');
     const std::string_view name = spec.substr(0, query);
     const SyntheticRequest request = parseParameters(
         query == std::string_view::npos ? std::string_view() : spec.substr(query + 1));
-    const std::unique_ptr<Scene> scene = makeBuiltInScene(name);
 
-    const bool sphere = name == "sphere";
-    ScannerSettings settings;
+    SyntheticSource source;
+    ScannerSettings& settings = source.scanner;
     settings.color = ScannerSettings::Color::Scene;
     settings.normals = true;
-    const NoiseAmount noise =
-        request.noise.value_or(NoiseAmount{.value = sphere ? 0.0 : 0.1, .inSpacingUnits = true});
+    NoiseAmount noise;
+    std::size_t defaultPoints = 200'000;
+    if (name == kStationSource || name == kAirborneSource) {
+        source.scene = makeBuiltInScene(kLidarScene);
+        const bool station = name == kStationSource;
+        settings.mode = station ? ScannerSettings::Mode::Station : ScannerSettings::Mode::Airborne;
+        noise = {.value = station ? kStationNoiseMetres : kAirborneNoiseMetres,
+                 .inSpacingUnits = false};
+        if (station) {
+            // Fixed once here, so the evaluation looks from the very spot that was scanned.
+            settings.station.position = stationPosition(*source.scene, settings.station);
+        }
+    } else {
+        try {
+            source.scene = makeBuiltInScene(name);
+        } catch (const Error& error) {
+            throw Error(fmt::format("{}, or the LiDAR sources {}", error.what(),
+                                    fmt::join(kLidarSourceNames, ", ")));
+        }
+        const bool sphere = name == "sphere";
+        noise = {.value = sphere ? 0.0 : 0.1, .inSpacingUnits = true};
+        defaultPoints = sphere ? 4000 : 200'000;
+    }
+    noise = request.noise.value_or(noise);
     settings.noise = noise.value;
     settings.noiseInSpacingUnits = noise.inSpacingUnits;
-    const std::size_t points = request.points != 0 ? request.points : (sphere ? 4000 : 200'000);
-    return scanToPointCount(*scene, settings, points);
+    const std::size_t points = request.points != 0 ? request.points : defaultPoints;
+    source.points = scanToPointCount(*source.scene, settings, points);
+    return source;
 }
 
 }  // namespace subscan

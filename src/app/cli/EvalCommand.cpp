@@ -40,12 +40,15 @@ int runEval(const EvalOptions& options) {
     }
     std::unique_ptr<Scene> truth;
     PointCloud points;
+    ScannerSettings scanner;
     constexpr std::string_view kSynthetic = "synthetic:";
     if (std::string_view(options.source).starts_with(kSynthetic)) {
         const std::string spec = options.source.substr(kSynthetic.size());
         try {
-            truth = makeBuiltInScene(spec.substr(0, spec.find('?')));
-            points = makeSyntheticScene(spec);
+            SyntheticSource source = makeSyntheticSource(spec);
+            truth = std::move(source.scene);
+            points = std::move(source.points);
+            scanner = source.scanner;
         } catch (const Error& error) {
             throw Error(fmt::format("{}: {}", options.source, error.what()));
         }
@@ -73,12 +76,15 @@ int runEval(const EvalOptions& options) {
         }
     }
 
+    EvaluationSettings evaluation = options.evaluation;
+    adaptToScanner(evaluation, *truth, scanner);
+
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
     if (options.temporal) {
-        const TemporalReport report = evaluateTemporal(*context, *truth, points, options.evaluation,
+        const TemporalReport report = evaluateTemporal(*context, *truth, points, evaluation,
                                                        options.temporalEvaluation, render);
         context->throwOnErrors("while evaluating");
         if (options.json) {
@@ -103,7 +109,7 @@ int runEval(const EvalOptions& options) {
             fmt::format("{:.2f}", report.stillPsnrTemporalDb));
         return 0;
     }
-    const EvaluationReport report = evaluate(*context, *truth, points, options.evaluation, render);
+    const EvaluationReport report = evaluate(*context, *truth, points, evaluation, render);
     context->throwOnErrors("while evaluating");
     if (options.json) {
         fmt::print("{}\n", toJson(report).dump(2));
@@ -136,7 +142,9 @@ int runEval(const EvalOptions& options) {
 Command addEvalCommand(CLI::App& parent) {
     auto options = std::make_shared<EvalOptions>();
     CLI::App* eval = parent.add_subcommand(
-        "eval", "Reconstruction quality against ground truth (a mesh, or synthetic:NAME)");
+        "eval",
+        "Reconstruction quality against ground truth (a mesh, or synthetic:NAME); LiDAR sources "
+        "are judged from views near their scanner, over the surfaces it could sample");
     eval->add_option("mesh", options->source, "Mesh PLY with faces, or synthetic:NAME")->required();
     eval->add_option("--views", options->evaluation.views, "Views on the orbit")
         ->check(CLI::Range(1, 360));

@@ -1,6 +1,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -24,6 +25,8 @@ struct ScanOptions {
     ScannerSettings settings;
     std::string noise = "0";
     std::string color = "auto";
+    std::string mode = "object";
+    std::vector<double> stationPosition;
     bool json = false;
 };
 
@@ -68,6 +71,12 @@ ScanSource openSource(const ScanOptions& options) {
 int runScan(ScanOptions options) {
     const ScanSource source = openSource(options);
     ScannerSettings& settings = options.settings;
+    settings.mode = parseScannerMode(options.mode).value();  // checked by the parser
+    if (!options.stationPosition.empty()) {
+        settings.station.position = glm::dvec3(
+            options.stationPosition[0], options.stationPosition[1], options.stationPosition[2]);
+    }
+    validate(settings);
     const NoiseAmount noise = parseNoiseAmount(options.noise).value();  // checked by the parser
     settings.noise = noise.value;
     settings.noiseInSpacingUnits = noise.inSpacingUnits;
@@ -87,12 +96,33 @@ int runScan(ScanOptions options) {
 
     const double sigma = noiseSigma(source.scene->bounds(), settings);
     if (options.json) {
-        const nlohmann::json summary = {{"points", cloud.size()},
-                                        {"views", settings.views},
-                                        {"resolution", settings.resolution},
-                                        {"noise_m", sigma},
-                                        {"seconds", seconds}};
+        nlohmann::json summary = {{"points", cloud.size()},
+                                  {"views", settings.views},
+                                  {"resolution", settings.resolution},
+                                  {"noise_m", sigma},
+                                  {"seconds", seconds}};
+        if (settings.mode != ScannerSettings::Mode::Object) {
+            summary["mode"] = scannerModeName(settings.mode);
+            summary["spacing_m"] = scanSpacing(source.scene->bounds(), settings);
+        }
         fmt::print("{}\n", summary.dump(2));
+        return 0;
+    }
+    if (settings.mode == ScannerSettings::Mode::Station) {
+        const glm::dvec3 station = stationPosition(*source.scene, settings.station);
+        fmt::print(
+            "{}: {} points scanned from {} by a station at ({:.3g}, {:.3g}, {:.3g}) in {} x {} "
+            "angular steps, noise {:.3g} m, {:.2f} s\n",
+            options.output, cloud.size(), options.source, station.x, station.y, station.z,
+            settings.station.azimuthSteps, settings.station.elevationSteps, sigma, seconds);
+        return 0;
+    }
+    if (settings.mode == ScannerSettings::Mode::Airborne) {
+        fmt::print(
+            "{}: {} points scanned from {} by an airborne strip {} m up, lines {} m apart of {} "
+            "points, noise {:.3g} m, {:.2f} s\n",
+            options.output, cloud.size(), options.source, settings.airborne.altitude,
+            settings.airborne.lineSpacing, settings.airborne.pointsPerLine, sigma, seconds);
         return 0;
     }
     fmt::print("{}: {} points scanned from {} in {} views at {}x{}, noise {:.3g} m, {:.2f} s\n",
@@ -138,6 +168,48 @@ Command addScanCommand(CLI::App& parent) {
                      "Point colours: the scene's (scene), procedural marble, none, or auto "
                      "(scene's when it has colours)")
         ->check(CLI::IsMember({"auto", "none", "scene", "marble"}))
+        ->capture_default_str();
+    scan->add_option("--mode", options->mode,
+                     "object: structured-light views around the object; station: one "
+                     "terrestrial LiDAR station (equal angular steps); airborne: one airborne "
+                     "LiDAR strip along +X")
+        ->check(CLI::IsMember({"object", "station", "airborne"}))
+        ->capture_default_str();
+    StationSettings& station = options->settings.station;
+    scan->add_option("--station", options->stationPosition,
+                     "Station position X Y Z; default: the instrument height above the first "
+                     "surface below the scene's middle")
+        ->expected(3);
+    scan->add_option("--instrument-height", station.instrumentHeight,
+                     "Station height above the ground below it (metres)")
+        ->capture_default_str();
+    scan->add_option("--azimuth-steps", station.azimuthSteps, "Station rays per full turn")
+        ->check(CLI::Range(1, kMaxScannerAngularSteps))
+        ->capture_default_str();
+    scan->add_option("--elevation-steps", station.elevationSteps,
+                     "Station rays per vertical profile, over the elevation range")
+        ->check(CLI::Range(1, kMaxScannerAngularSteps))
+        ->capture_default_str();
+    scan->add_option("--min-elevation", station.minElevationDegrees,
+                     "Station's lowest elevation (degrees, 0 horizontal)")
+        ->capture_default_str();
+    scan->add_option("--max-elevation", station.maxElevationDegrees,
+                     "Station's highest elevation (degrees, 90 straight up)")
+        ->capture_default_str();
+    scan->add_option("--max-range", station.maxRange, "Station's maximum range (metres; 0: none)")
+        ->capture_default_str();
+    AirborneSettings& airborne = options->settings.airborne;
+    scan->add_option("--altitude", airborne.altitude,
+                     "Airborne: flight height above the bottom of the scene (metres)")
+        ->capture_default_str();
+    scan->add_option("--field-of-view", airborne.fieldOfViewDegrees,
+                     "Airborne: the whole sweep across track (degrees), centred on nadir")
+        ->capture_default_str();
+    scan->add_option("--line-spacing", airborne.lineSpacing,
+                     "Airborne: distance between scan lines along the track (metres)")
+        ->capture_default_str();
+    scan->add_option("--points-per-line", airborne.pointsPerLine, "Airborne: rays per scan line")
+        ->check(CLI::Range(1, kMaxScannerAngularSteps))
         ->capture_default_str();
     scan->add_flag("--normals", options->settings.normals, "Store each point's true normal");
     scan->add_option("--seed", options->settings.seed, "Seed of the noise")

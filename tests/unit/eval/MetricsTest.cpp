@@ -1,4 +1,5 @@
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <vector>
@@ -37,6 +38,32 @@ TEST(MetricsTest, CountsCoverageLeakageDepthAndOcclusion) {
     EXPECT_NEAR(m.depthBiasH, 3.5, 1e-3);               // all behind: the signed median is the same
     EXPECT_DOUBLE_EQ(m.occlusionErrorRate, 3.0 / 6.0);  // 3.5, 4 and 10 exceed 3 h
     EXPECT_FALSE(m.normalErrorMeanDeg.has_value());     // no normals given
+}
+
+TEST(MetricsTest, UnsampledTruthCountsNeitherForCoverageNorForLeakage) {
+    // 8 pixels of truth, 0..7; the scan could sample only 0..3. The reconstruction covers 0..2
+    // and 4..5 (true surface it could not know about) and 9 (nothing there).
+    GroundTruthImages truth{10,
+                            1,
+                            std::vector<float>(10, kInf),
+                            std::vector<glm::vec3>(10, {0, 0, 1}),
+                            std::vector<glm::vec3>(10),
+                            std::vector<std::uint8_t>(10, 0)};
+    ReconstructionImages reconstruction{std::vector<float>(10, kInf), {}};
+    for (int i = 0; i < 8; ++i) {
+        truth.depth[i] = 1.0f;
+        truth.sampled[i] = i < 4;
+    }
+    for (const int i : {0, 1, 2, 4, 5, 9}) {
+        reconstruction.depth[i] = 1.0f;
+    }
+    const QualityMetrics m = compareToGroundTruth(reconstruction, truth, 0.01);
+    EXPECT_DOUBLE_EQ(m.coverage, 3.0 / 4.0);  // 3 of the 4 sampled true pixels
+    EXPECT_DOUBLE_EQ(m.leakage, 1.0 / 4.0);   // pixel 9 of the 4 judged reconstructed pixels
+    truth.sampled.clear();                    // every true pixel counts again
+    const QualityMetrics all = compareToGroundTruth(reconstruction, truth, 0.01);
+    EXPECT_DOUBLE_EQ(all.coverage, 5.0 / 8.0);
+    EXPECT_DOUBLE_EQ(all.leakage, 1.0 / 6.0);
 }
 
 TEST(MetricsTest, DepthBiasIsTheSignedMedianInFrontOfTheTruthNegative) {

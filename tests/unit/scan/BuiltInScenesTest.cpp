@@ -122,7 +122,8 @@ TEST_P(BuiltInSceneTest, MaxDistanceCutsTheRay) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, BuiltInSceneTest,
-                         ::testing::Values("sphere", "torus", "box-with-hole", "sculpture"),
+                         ::testing::Values("sphere", "torus", "box-with-hole", "sculpture",
+                                           "outdoor"),
                          [](const auto& testParam) {
                              std::string name = testParam.param;
                              std::erase(name, '-');
@@ -135,9 +136,9 @@ TEST(BuiltInScenesTest, UnknownNameListsTheScenes) {
         FAIL() << "no error";
     } catch (const Error& error) {
         EXPECT_THAT(error.what(), HasSubstr("no built-in scene 'teapot'"));
-        EXPECT_THAT(error.what(), HasSubstr("sphere, torus, box-with-hole, sculpture"));
+        EXPECT_THAT(error.what(), HasSubstr("sphere, torus, box-with-hole, sculpture, outdoor"));
     }
-    EXPECT_EQ(builtInSceneNames().size(), 4u);
+    EXPECT_EQ(builtInSceneNames().size(), 5u);
 }
 
 TEST(BuiltInScenesTest, SphereIsTheUnitSphereInClosedForm) {

@@ -1,0 +1,76 @@
+// The evaluation of LiDAR sources (a station, an airborne strip) at a small size: its views
+// near the scanner, coverage counted over the surfaces the scan sampled.
+#include <cmath>
+#include <cstddef>
+
+#include <gtest/gtest.h>
+
+#include "core/Camera.h"
+#include "eval/Evaluation.h"
+#include "eval/GroundTruth.h"
+#include "scan/SyntheticScenes.h"
+#include "support/GlTestSupport.h"
+
+namespace subscan {
+namespace {
+
+void expectFraction(double value, const char* what) {
+    EXPECT_GE(value, 0.0) << what;
+    EXPECT_LE(value, 1.0) << what;
+}
+
+TEST(LidarEvaluationGLTest, StationSourceGivesMetricsFromViewsNearTheStation) {
+    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    EvaluationSettings settings;
+    settings.views = 2;
+    settings.width = 96;
+    settings.height = 96;
+    adaptToScanner(settings, *source.scene, source.scanner);
+    ASSERT_EQ(settings.viewpoints.size(), 2u);
+    // Each view's eye stands within 1.5 m of the station (1 m up, 1 m back).
+    for (const OrbitView& view : settings.viewpoints) {
+        const Camera camera = orbitCamera(source.scene->bounds(), view, 96, 96, 45.0);
+        EXPECT_LT(glm::length(camera.eye() - *source.scanner.station.position), 1.5);
+    }
+    const EvaluationReport report =
+        evaluate(test::glTestContext(), *source.scene, source.points, settings, RenderSettings{});
+    EXPECT_EQ(report.views, 2);
+    for (const QualityMetrics& m : {report.points1px, report.surface}) {
+        expectFraction(m.coverage, "coverage");
+        expectFraction(m.leakage, "leakage");
+        expectFraction(m.occlusionErrorRate, "occlusion errors");
+    }
+    // The surface fills between the points: it must cover far more than 1-pixel points do,
+    // and at least half of what the station saw even at this size (typically over 0.8).
+    EXPECT_GT(report.surface.coverage, report.points1px.coverage);
+    EXPECT_GT(report.surface.coverage, 0.5);
+}
+
+TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {
+    const SyntheticSource source = makeSyntheticSource("outdoor-airborne?points=2000");
+    EvaluationSettings settings;
+    settings.views = 4;
+    adaptToScanner(settings, *source.scene, source.scanner);
+    ASSERT_EQ(settings.viewpoints.size(), 4u);
+    // Looking down at 45 degrees from +X+Z, the walls facing +X (parallel to the scan planes)
+    // are in view: unsampled, while the ground and the roofs are sampled.
+    const Camera camera = orbitCamera(source.scene->bounds(), settings.viewpoints[0], 96, 96, 45.0);
+    const GroundTruthImages truth = renderGroundTruth(*source.scene, camera, settings.sampled);
+    ASSERT_EQ(truth.sampled.size(), truth.depth.size());
+    std::size_t surface = 0, unsampled = 0;
+    for (std::size_t i = 0; i < truth.depth.size(); ++i) {
+        if (std::isfinite(truth.depth[i])) {
+            ++surface;
+            unsampled += truth.sampled[i] == 0;
+        }
+    }
+    ASSERT_GT(surface, 0u);
+    const double share = static_cast<double>(unsampled) / static_cast<double>(surface);
+    // The office's and the tower's +X walls cover a few percent of the view; everything else is
+    // sampled, so the share is small but not zero.
+    EXPECT_GT(share, 0.002);
+    EXPECT_LT(share, 0.2);
+}
+
+}  // namespace
+}  // namespace subscan
