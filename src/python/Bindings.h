@@ -11,6 +11,7 @@
 #include <pybind11/pybind11.h>
 
 #include "core/PointCloud.h"
+#include "core/SensorView.h"
 #include "render/RenderSettings.h"
 
 namespace subscan::python {
@@ -29,6 +30,11 @@ class CloudData {
     /// estimateSpacing(cloud()), computed on the first call (call without the GIL: it may take
     /// a second on millions of points; std::call_once makes concurrent first calls wait).
     double spacing() const;
+
+    /// Where the file says its sensor stood and an organised cloud's grid (subscan.load), for
+    /// Camera.sensor; empty for clouds made from arrays.
+    std::optional<SensorPose> sensor;
+    OrganisedGrid grid;
 
   private:
     PointCloud cloud_;

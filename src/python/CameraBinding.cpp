@@ -12,6 +12,7 @@
 
 #include "core/Camera.h"
 #include "core/Error.h"
+#include "core/SensorView.h"
 #include "io/CameraJson.h"
 #include "python/Bindings.h"
 #include "python/JsonConversion.h"
@@ -108,6 +109,36 @@ Camera orbit(const CloudData& cloud, double yaw, double pitch, std::optional<dou
     return checked(orbitCamera(cloud.cloud().bounds, view, width, height, fovy));
 }
 
+/// Camera.sensor: viewFromSensor with the CLI's --view sensor choices and ranges.
+Camera sensorView(const CloudData& cloud, const py::object& sensorObject, std::optional<int> width,
+                  std::optional<int> height, double fovy, const std::string& up) {
+    checkRange(fovy, 1.0, 170.0, "fovy");
+    checkRange(width.value_or(1), 1, 65536, "width");
+    checkRange(height.value_or(1), 1, 65536, "height");
+    if (up != "auto" && up != "y" && up != "z") {
+        throw py::value_error(fmt::format("up '{}' is not auto, y or z", up));
+    }
+    const UpAxis upAxis =
+        up == "z" || (up == "auto" && cloud.format() == "las") ? UpAxis::Z : UpAxis::Y;
+    // As --sensor: a given position overrides what the file says, its grid's camera included.
+    const OrganisedGrid noGrid;
+    std::optional<SensorPose> pose = cloud.sensor;
+    if (!sensorObject.is_none()) {
+        pose = SensorPose{vectorArgument(sensorObject, "sensor"), "sensor="};
+    }
+    std::vector<std::string> warnings;
+    Camera camera;
+    try {
+        camera = viewFromSensor(cloud.cloud(), sensorObject.is_none() ? cloud.grid : noGrid, pose,
+                                upAxis, width.value_or(1280), height.value_or(720),
+                                width.has_value() || height.has_value(), fovy, warnings);
+    } catch (const Error& error) {
+        throw py::value_error(error.what());
+    }
+    warnAll("the cloud", warnings);
+    return checked(camera);
+}
+
 Camera lookAt(const py::handle& eyeObject, const py::handle& targetObject,
               const py::handle& upObject, int width, int height, double fovy,
               std::optional<double> nearPlane, std::optional<double> farPlane,
@@ -202,6 +233,15 @@ The camera `subscan render` uses without --camera: orbiting the middle of the cl
 `distance` (default: the box of its points, 0.1 to 99.9 % per axis, fills 95 % of the picture's
 limiting side, centred); up 'auto' is Z for LAS files, else Y. Near and far hug the bounding
 sphere.
+)doc")
+        .def_static("sensor", &sensorView, py::arg("cloud"), py::arg("sensor") = py::none(),
+                    py::arg("width") = py::none(), py::arg("height") = py::none(),
+                    py::arg("fovy") = 45.0, py::arg("up") = "auto", R"doc(
+The camera of `subscan render --view sensor`: for an organised cloud (a depth camera's PCD) its
+own camera, fitted to its grid, at the grid's size unless width or height is given; else from
+`sensor` (x, y, z), the PCD VIEWPOINT or the E57 pose, looking at the middle of the points,
+width x height (default 1280 x 720) and `fovy` wide. ValueError when the cloud records no
+sensor and none is given, or the sensor is more than 20 extents from the points.
 )doc")
         .def_static("look_at", &lookAt, py::arg("eye"), py::arg("target"),
                     py::arg("up") = py::make_tuple(0.0, 1.0, 0.0), py::arg("width") = 1280,

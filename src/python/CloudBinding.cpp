@@ -586,7 +586,10 @@ CloudHandle load(const py::handle& pathObject) {
         scan = loadScan(source);
     }
     warnAll(source, scan.warnings);
-    return std::make_shared<CloudData>(std::move(scan.cloud), scan.format);
+    auto cloud = std::make_shared<CloudData>(std::move(scan.cloud), scan.format);
+    cloud->sensor = std::move(scan.sensor);
+    cloud->grid = std::move(scan.grid);
+    return cloud;
 }
 
 }  // namespace

@@ -16,6 +16,24 @@ def test_orbit_is_the_cli_camera(cli, sphere, tmp_path):
     assert camera.to_json() == (tmp_path / "camera.json").read_text()
 
 
+def test_sensor_is_the_cli_sensor_view(cli, data_dir, sphere, tmp_path):
+    table = data_dir / "table_scene_mug_stereo_textured.pcd"
+    cli("render", table, "-o", tmp_path / "a.png", "--view", "sensor", "--export-buffers",
+        tmp_path)
+    with pytest.warns(UserWarning):  # the stereo camera's NaN pixels are dropped
+        cloud = subscan.load(table)
+    camera = subscan.Camera.sensor(cloud)
+    assert camera == subscan.Camera.load(tmp_path / "camera.json")
+    assert (camera.width, camera.height) == (640, 480)
+    # A given position wins over the file's; a cloud from arrays records none.
+    at = subscan.Camera.sensor(sphere, sensor=(0.5, 0.2, 3.0), width=64, height=48)
+    assert np.allclose(at.eye, (0.5, 0.2, 3.0), atol=1e-12)
+    with pytest.raises(ValueError, match="records no sensor position"):
+        subscan.Camera.sensor(subscan.Cloud(np.eye(3)))
+    with pytest.raises(ValueError, match="more than 20 times"):
+        subscan.Camera.sensor(sphere, sensor=(1e9, 0, 0))
+
+
 def test_json_round_trip_and_attributes():
     camera = subscan.Camera.look_at(eye=(0, 1, 5), target=(0, 0, 0), width=320, height=200,
                                     fovy=30, near=0.5, far=20)
