@@ -47,8 +47,8 @@ struct FrameOptions {
     /// The settings file's settings (or the defaults) with the given options written over them;
     /// throws subscan::Error naming a bad value.
     RenderSettings settings() const;
-    /// The camera of --camera; or with --view sensor the sensor's (below); or the orbit of
-    /// --yaw, --pitch, --distance, --up and --fovy around the scan's bounds, framed by
+    /// The camera of --camera; or with --view sensor the sensor's (SensorViewOptions); or the
+    /// orbit of --yaw, --pitch, --distance, --up and --fovy around the scan's bounds, framed by
     /// `framing` when --distance is not given.
     Camera camera(const LoadedScan& scan, Framing framing = Framing::Box) const;
     /// The up axis --up names for `scan` (auto: Z for LAS, else Y).
