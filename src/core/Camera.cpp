@@ -8,6 +8,7 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
+#include <glm/trigonometric.hpp>
 
 namespace subscan {
 
@@ -128,6 +129,14 @@ BoxFit fitBox(const Bounds& bounds, const glm::dvec3& center, const glm::dmat3& 
 }
 
 }  // namespace
+
+glm::dvec2 orbitAngles(const glm::dvec3& towardsEye, UpAxis up) {
+    const glm::dvec3 direction = glm::normalize(towardsEye);
+    const double along = up == UpAxis::Y ? direction.y : direction.z;
+    const double yaw = up == UpAxis::Y ? std::atan2(direction.x, direction.z)
+                                       : std::atan2(direction.x, -direction.y);
+    return glm::degrees(glm::dvec2(yaw, std::asin(std::clamp(along, -1.0, 1.0))));
+}
 
 Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int height,
                    double fovyDegrees) {

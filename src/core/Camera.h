@@ -81,6 +81,10 @@ struct OrbitView {
     std::optional<Bounds> framed;
 };
 
+/// The yaw and pitch (degrees, x and y) of the orbit whose direction from the centre towards
+/// the eye is `towardsEye` (any length but zero): the inverse of orbitCamera's angles.
+glm::dvec2 orbitAngles(const glm::dvec3& towardsEye, UpAxis up);
+
 /// Frames `bounds` as `orbit` says; near and far hug the bounding sphere.
 Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int height,
                    double fovyDegrees);

@@ -442,15 +442,14 @@ nlohmann::json toJson(const EvaluationReport& report) {
 
 namespace {
 
-/// The orbit that puts the eye at `eye` looking at `target`.
+/// The orbit (Y up, as the built-in scenes) that puts the eye at `eye` looking at `target`.
 OrbitView lookingAt(const glm::dvec3& eye, const glm::dvec3& target) {
-    const glm::dvec3 offset = eye - target;
-    const double distance = glm::length(offset);
+    const glm::dvec2 angles = orbitAngles(eye - target, UpAxis::Y);
     OrbitView orbit;
     orbit.center = target;
-    orbit.distance = distance;
-    orbit.yawDegrees = glm::degrees(std::atan2(offset.x, offset.z));
-    orbit.pitchDegrees = glm::degrees(std::asin(offset.y / distance));
+    orbit.distance = glm::length(eye - target);
+    orbit.yawDegrees = angles.x;
+    orbit.pitchDegrees = angles.y;
     return orbit;
 }
 

@@ -129,12 +129,9 @@ void ViewerCamera::lookFrom(const glm::dvec3& eye, const glm::dvec3& target) {
     if (!(length > kMinDistanceRadii * sceneRadius_)) {
         return;
     }
-    const glm::dvec3 direction = fromTarget / length;
-    const double along = up_ == UpAxis::Y ? direction.y : direction.z;
-    pitchDegrees_ = std::clamp(glm::degrees(std::asin(std::clamp(along, -1.0, 1.0))),
-                               -kMaxPitchDegrees, kMaxPitchDegrees);
-    yawDegrees_ = up_ == UpAxis::Y ? glm::degrees(std::atan2(direction.x, direction.z))
-                                   : glm::degrees(std::atan2(direction.x, -direction.y));
+    const glm::dvec2 angles = orbitAngles(fromTarget, up_);
+    yawDegrees_ = angles.x;
+    pitchDegrees_ = std::clamp(angles.y, -kMaxPitchDegrees, kMaxPitchDegrees);
     centre_ = target;
     distance_ = length;
     clampDistance();
