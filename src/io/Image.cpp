@@ -71,9 +71,9 @@ std::optional<PictureFormat> formatOfExtension(const std::filesystem::path& path
     return std::nullopt;
 }
 
+/// Whether the image holds width x height x channels values.
 bool hasConsistentSize(const ImageF& image) {
-    return image.width > 0 && image.height > 0 &&
-           image.values.size() == static_cast<std::size_t>(image.width) *
+    return image.values.size() == static_cast<std::size_t>(image.width) *
                                       static_cast<std::size_t>(image.height) *
                                       static_cast<std::size_t>(image.channels);
 }
@@ -161,7 +161,7 @@ void writeLinearPicture(const std::filesystem::path& path, const ImageF& image) 
 }
 
 void writeExr(const std::filesystem::path& path, const ImageF& image) {
-    if (image.channels != 3 || !hasConsistentSize(image)) {
+    if (image.channels != 3 || image.width <= 0 || image.height <= 0 || !hasConsistentSize(image)) {
         throw Error(
             fmt::format("{}: EXR pictures hold 3 channels of a consistent size", path.string()));
     }
@@ -239,10 +239,7 @@ Image8 readPng(const std::filesystem::path& path) {
 }
 
 void writePfm(const std::filesystem::path& path, const ImageF& image) {
-    if ((image.channels != 1 && image.channels != 3) ||
-        image.values.size() != static_cast<std::size_t>(image.width) *
-                                   static_cast<std::size_t>(image.height) *
-                                   static_cast<std::size_t>(image.channels)) {
+    if ((image.channels != 1 && image.channels != 3) || !hasConsistentSize(image)) {
         throw Error(
             fmt::format("{}: PFM holds 1 or 3 channels of a consistent size", path.string()));
     }
