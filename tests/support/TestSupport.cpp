@@ -69,14 +69,19 @@ void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, 
     EXPECT_NEAR(p.z, z, 2e-6) << "point " << i;
 }
 
-std::string decodeError(std::string_view bytes, std::string_view fileName) {
+std::string errorMessage(const std::function<void()>& call) {
     try {
-        decode(bytes, fileName);
+        call();
     } catch (const Error& error) {
         return error.what();
     }
-    ADD_FAILURE() << "decoding " << fileName << " did not throw subscan::Error";
+    ADD_FAILURE() << "the call did not throw subscan::Error";
     return {};
+}
+
+std::string decodeError(std::string_view bytes, std::string_view fileName) {
+    SCOPED_TRACE("decoding " + std::string(fileName));
+    return errorMessage([&] { decode(bytes, fileName); });
 }
 
 std::string fileBytes(const std::filesystem::path& file) {

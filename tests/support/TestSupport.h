@@ -54,6 +54,10 @@ LoadedScan decode(std::string_view bytes, std::string_view fileName = "scan");
 /// The message of the subscan::Error that decode() throws; fails the test if none is thrown.
 std::string decodeError(std::string_view bytes, std::string_view fileName = "scan");
 
+/// The message of the subscan::Error that `call` throws; fails the test (and returns "") if
+/// none is thrown.
+std::string errorMessage(const std::function<void()>& call);
+
 struct CommandResult {
     int exitCode = -1;  // -1: killed by a signal (a crash)
     std::string out;

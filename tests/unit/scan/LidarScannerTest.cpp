@@ -17,6 +17,7 @@
 #include "scan/Scene.h"
 #include "scan/SyntheticScenes.h"
 #include "scan/VirtualScanner.h"
+#include "support/TestSupport.h"
 
 namespace subscan {
 namespace {
@@ -222,12 +223,7 @@ TEST(LidarScannerTest, ModeSettingsRoundTripThroughJsonAndAreValidated) {
     EXPECT_EQ(json.get<ScannerSettings>(), settings);
 
     auto error = [](const nlohmann::json& bad) {
-        try {
-            bad.get<ScannerSettings>();
-        } catch (const Error& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
+        return test::errorMessage([&] { bad.get<ScannerSettings>(); });
     };
     EXPECT_THAT(error({{"mode", "drone"}}), HasSubstr("'mode' is 'drone'"));
     EXPECT_THAT(error({{"station", {{"azimuth_steps", 0}}}}), HasSubstr("azimuth steps"));

@@ -16,6 +16,7 @@
 #include "scan/Scene.h"
 #include "scan/VirtualScanner.h"
 #include "support/TestMeshes.h"
+#include "support/TestSupport.h"
 
 namespace subscan {
 namespace {
@@ -338,12 +339,7 @@ TEST(VirtualScannerTest, SettingsRoundTripThroughJson) {
     EXPECT_EQ(nlohmann::json::object().get<ScannerSettings>(), ScannerSettings());
 
     auto error = [](const nlohmann::json& bad) {
-        try {
-            bad.get<ScannerSettings>();
-        } catch (const Error& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
+        return test::errorMessage([&] { bad.get<ScannerSettings>(); });
     };
     EXPECT_THAT(error({{"views", 0}}), HasSubstr("1 to 1000 views"));
     EXPECT_THAT(error({{"resolution", "big"}}), HasSubstr("'resolution' has the wrong type"));
