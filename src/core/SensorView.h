@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/Camera.h"
