@@ -41,7 +41,7 @@ void main() {
         return;
     }
     float depth = imageLoad(inFilledDepth, pixel).r;
-    bool surfacePixel = onSurface(pixel, depth);
+    bool surfacePixel = onSurface(pixel, depth, spacingRatioAt(pixel));
     imageStore(outMask, pixel, vec4(surfacePixel ? 1.0 : 0.0));
     imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? depth : kInfinity));
 #endif

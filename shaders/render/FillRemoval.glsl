@@ -29,7 +29,8 @@ uint reachOf(uint onLevel, ivec2 texel) {
 }
 
 /// Whether `pixel`, filled to `depth` by pull-push, belongs to the surface (the "mask").
-bool onSurface(ivec2 pixel, float depth) {
+/// `spacingRatio`: spacingRatioAt(pixel), which scales the expected gap.
+bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
     if (!(depth > 0.0 && !isinf(depth) && !isnan(depth))) {
         return false;
     }
@@ -38,7 +39,7 @@ bool onSurface(ivec2 pixel, float depth) {
     }
     // Level 1 at least: its texels bridge one-pixel gaps between dense points.
     uint levels = uint(
-        ceil(clamp(levelForRadius(surface.fill.x, depth), 1.0, float(levelCount() - 1u))));
+        ceil(clamp(levelForRadius(surface.fill.x * spacingRatio, depth), 1.0, float(levelCount() - 1u))));
     // kNoReach never counts: it could only mean the top level, whose one texel has no
     // neighbours.
     levels = min(levels, kNoReach - 1u);

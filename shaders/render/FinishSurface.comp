@@ -42,10 +42,11 @@ void main() {
     vec3 color = frame.background.rgb;
     float depth = kInfinity;
     vec4 filled = pushedValue(0u, pixel);
-    if (onSurface(pixel, filled.x)) {
+    float spacingRatio = spacingRatioAt(pixel);
+    if (onSurface(pixel, filled.x, spacingRatio)) {
         vec3 diffuse;
         vec3 specular;
-        shadePixel(pixel, filled.x, blendedNormal(pixel, filled.x), clamp(filled.yzw, 0.0, 1.0),
+        shadePixel(pixel, filled.x, blendedNormal(pixel, filled.x, spacingRatio), clamp(filled.yzw, 0.0, 1.0),
                    diffuse, specular);
         color = diffuse + specular;
         depth = filled.x;

@@ -11,12 +11,16 @@
 // share of levels it saw, and it takes no part in the edge rule. Counted in full as open, such
 // directions let points behind the surface near the border pass as visible; left out
 // entirely, the few directions left hid the surface itself in the image's corners.
+// The search radius is the settings' multiple of the point's local spacing (the "color"
+// image's alpha, RasterizePoints.comp): where points lie far apart, gaps between them must not
+// let a surface behind show through.
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
 #include "shared/surface.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
+layout(binding = SUBSCAN_IMAGE_IN0, rgba16f) readonly uniform image2D inColor;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility;
 
 // The pixels of this work group that hold a point, gathered so that the first invocations test
@@ -28,7 +32,8 @@ shared uint occupiedCount;
 bool visibleAt(ivec2 pixel, float depth) {
     vec3 x = viewPositionAt(vec2(pixel) + 0.5, depth);
     vec3 toCamera = towardsEye(x);
-    float maxLevel = clamp(levelForRadius(surface.visibility.x, depth), 0.0,
+    float radius = surface.visibility.x * imageLoad(inColor, pixel).a;
+    float maxLevel = clamp(levelForRadius(radius, depth), 0.0,
                            float(levelCount() - 1u));
     uint levels = uint(maxLevel);
     float tau = surface.visibility.y;

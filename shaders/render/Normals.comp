@@ -71,7 +71,7 @@ void main() {
         imageStore(outNormals, texel, vec4(0.0));
         return;
     }
-    vec3 normal = blendedNormal(texel, depth);
+    vec3 normal = blendedNormal(texel, depth, spacingRatioAt(texel));
     imageStore(outNormals, texel, vec4(normal, 1.0));
 #endif
 }

@@ -18,11 +18,12 @@ vec3 normalOnLevel(uint normalLevel, LevelLayout place, vec2 window) {
 }
 
 /// The view-space normal of surface pixel `texel` at `depth`: the normals of the two pyramid
-/// levels around its smoothing level, blended.
-vec3 blendedNormal(ivec2 texel, float depth) {
+/// levels around its smoothing level, blended. `spacingRatio`: spacingRatioAt(texel), which
+/// scales the smoothing radius.
+vec3 blendedNormal(ivec2 texel, float depth, float spacingRatio) {
     // Level 1 at least: where points are denser than pixels, neighbouring pixels are closer
     // than the scanner's noise allows a slope to be measured over.
-    float smoothing = clamp(levelForRadius(surface.normals.x, depth), 1.0,
+    float smoothing = clamp(levelForRadius(surface.normals.x * spacingRatio, depth), 1.0,
                             float(levelCount() - 1u));
     uint lower = uint(smoothing);
     uint upper = min(lower + 1u, levelCount() - 1u);

@@ -1,6 +1,8 @@
 #version 450
 // Pull-push interpolation (Kraus 2009) of depth and colour together, weighted by visibility.
-//   STAGE_PULL_INIT  level 0: w = 1 for visible points, else 0; a = w * (depth, r, g, b)
+//   STAGE_PULL_INIT  level 0: w = 1 for visible points, else 0; a = w * (depth, r, g, b); and
+//                    beside w, w * the point's local spacing ratio ("color"'s alpha), pulled
+//                    like the values but not pushed (PullPush.glsl's spacingRatioAt)
 //   STAGE_PULL       level R from R-1: W and A summed over the 4x4 children with the kernel
 //                    h = {1/3, 1, 1, 1/3} per axis; w = min(1, W), a = A * w / W. Beyond
 //                    Kraus: only children on the front-most surface take part (see below).
@@ -19,7 +21,7 @@ layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) writeonly buffer PullValues {
     vec4 pullValue[];
 };
 layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) writeonly buffer PullWeights {
-    float pullWeight[];
+    vec2 pullWeight[];  // w, w * local spacing ratio
 };
 layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) writeonly buffer PushValues {
     vec4 pushValue[];
@@ -45,9 +47,9 @@ void main() {
 #if STAGE_PULL_INIT
     bool visible = imageLoad(inVisibility, texel).r > 0.5;
     // Only visible texels carry values: an empty texel's depth is +inf, and 0 * inf is NaN.
-    pullWeight[index] = visible ? 1.0 : 0.0;
-    pullValue[index] = visible ? vec4(imageLoad(inDepth, texel).r, imageLoad(inColor, texel).rgb)
-                               : vec4(0.0);
+    vec4 color = imageLoad(inColor, texel);
+    pullWeight[index] = visible ? vec2(1.0, color.a) : vec2(0.0);
+    pullValue[index] = visible ? vec4(imageLoad(inDepth, texel).r, color.rgb) : vec4(0.0);
 #elif STAGE_PULL
     // Only the front-most surface among the children: a child deeper than the nearest one by
     // more than `slope` texel widths (at that depth) belongs to a surface behind and is left out.
@@ -55,6 +57,7 @@ void main() {
     // behind it; a surface steeper than the slope (atan 8 = 83 degrees by default) is cut.
     // The 16 children are read once into registers; both loops below are unrolled.
     float weights[16];
+    float spacings[16];
     vec4 values[16];
     float depths[16];
     float front = kInfinity;
@@ -63,7 +66,9 @@ void main() {
         ivec2 child = 2 * texel + ivec2(c % 4 - 1, c / 4 - 1);
         uint childIndex =
             texelIndex(level - 1u, clamp(child, ivec2(0), levelSize(level - 1u) - 1));
-        float weight = insideLevel(level - 1u, child) ? pullWeightAt(childIndex) : 0.0;
+        vec2 pulled = texelFetch(pullWeightTexels, int(childIndex)).rg;
+        float weight = insideLevel(level - 1u, child) ? pulled.x : 0.0;
+        spacings[c] = weight > 0.0 ? pulled.y : 0.0;
         vec4 value = pullValueAt(childIndex);
         weights[c] = weight;
         values[c] = weight > 0.0 ? value : vec4(0.0);
@@ -73,17 +78,20 @@ void main() {
     float tolerance = surface.fill.z * float(1u << level) * projectiveDepth(front) /
                       frame.depthRange.z;
     float weightSum = 0.0;
+    float spacingSum = 0.0;
     vec4 valueSum = vec4(0.0);
     for (int c = 0; c < 16; ++c) {
         if (weights[c] > 0.0 && depths[c] <= front + tolerance) {
             float h = kPullKernel[c % 4] * kPullKernel[c / 4];
             weightSum += h * weights[c];
+            spacingSum += h * spacings[c];
             valueSum += h * values[c];
         }
     }
     float clamped = min(1.0, weightSum);
-    pullWeight[index] = clamped;
-    pullValue[index] = weightSum > 0.0 ? valueSum * (clamped / weightSum) : vec4(0.0);
+    float scale = weightSum > 0.0 ? clamped / weightSum : 0.0;
+    pullWeight[index] = vec2(clamped, spacingSum * scale);
+    pullValue[index] = valueSum * scale;
 #elif STAGE_PUSH_TOP
     float weight = pullWeightAt(index);
     pushValue[index] = weight > 0.0 ? pullValueAt(index) / weight : vec4(kInfinity, 0.0, 0.0, 0.0);

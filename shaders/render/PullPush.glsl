@@ -2,6 +2,7 @@
 // (FinishSurface.comp pushes level 0 itself). The pyramids are written as storage buffers and
 // read as buffer textures (see Buffer::bindTexels).
 #include "shared/pyramid.glsl"
+#include "shared/surface.glsl"
 
 layout(binding = SUBSCAN_TEXELS_PULL_VALUES) uniform samplerBuffer pullValueTexels;
 layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
@@ -9,6 +10,23 @@ layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexe
 
 vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
 float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
+
+/// The local spacing around `pixel` in units of h (1 without local spacing): that of the
+/// visible points in the finest texel above it that holds any, so a pixel in a gap takes the
+/// spacing of the points around the gap. A single ratio per texel, not a smooth one: the
+/// passes round the levels it gives up to whole levels anyway.
+float spacingRatioAt(ivec2 pixel) {
+    if (surface.spacing.y < 0.5) {
+        return 1.0;
+    }
+    for (uint level = 0u; level < levelCount(); ++level) {
+        vec2 pulled = texelFetch(pullWeightTexels, int(texelIndex(level, pixel >> level))).rg;
+        if (pulled.x > 0.0) {
+            return pulled.y / pulled.x;
+        }
+    }
+    return 1.0;
+}
 vec4 pushValueAt(uint index) { return texelFetch(pushValueTexels, int(index)); }
 
 /// The complete (depth, r, g, b) of `texel` on `level` from the complete level above: m is the

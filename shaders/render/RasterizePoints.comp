@@ -10,7 +10,8 @@
 //                  pixel's sums (Schuetz et al. 2021's high-quality shading)
 //   STAGE_RESOLVE  one thread per pixel of the cloud's projected bounding box: the winner's
 //                  linear colour, or with USE_BLEND the mean of the sums (and with USE_INT64
-//                  the winner's depth) into images cleared before
+//                  the winner's depth) into images cleared before; alpha: the winner's local
+//                  spacing on screen in units of h's (1 without local spacing)
 // Positive IEEE floats order like their bit patterns, so depth bits compare as uints. Points
 // are read as buffer textures and the 32-bit path keeps its per-pixel words in images rather
 // than storage buffers: on llvmpipe a texel fetch or image load is a vector gather, a storage
@@ -21,6 +22,7 @@
 #endif
 #include "shared/common.glsl"
 #include "shared/region.glsl"
+#include "shared/surface.glsl"
 
 layout(std140, binding = SUBSCAN_UBO_PASS) uniform RasterBlock {
     RasterParams raster;
@@ -54,6 +56,29 @@ layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GRO
 layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
 #endif
 layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor;
+layout(binding = SUBSCAN_TEXELS_LOCAL_SPACING) uniform samplerBuffer localSpacing;
+
+/// The local spacing (estimateLocalSpacing) of chunk point `local` on screen, over h's there:
+/// the larger of its spacing w and its vector across scan lines projected. The projection is
+/// to first order (window = f xy / d at distance d: the offset a moves it by f / d * (a.xy +
+/// xy * a.z / d)), which an across vector pointing behind the eye cannot break.
+float spacingRatio(uint local) {
+    if (surface.spacing.y < 0.5) {
+        return 1.0;
+    }
+    int first = 3 * int(local);
+    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
+                         texelFetch(positions, first + 2).r);
+    vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+    vec4 spacing = texelFetch(localSpacing, int(local));
+    vec3 across = mat3(frame.viewFromCloud) * spacing.xyz;  // in units of h
+    float distance = projectiveDepth(-viewPosition.z);
+    vec2 moved = frame.depthRange.w > 0.0
+                     ? across.xy
+                     : across.xy + viewPosition.xy * (across.z / distance);
+    // Both lengths in units of h times f / distance.
+    return max(spacing.w, length(moved));
+}
 
 void main() {
     ivec2 pixel = dispatchTexel();
@@ -80,7 +105,7 @@ void main() {
 #else
     vec3 color = unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r);
 #endif
-    imageStore(outColor, pixel, vec4(color, 1.0));
+    imageStore(outColor, pixel, vec4(color, spacingRatio(winner - raster.firstPoint)));
 }
 
 #else

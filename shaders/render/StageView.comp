@@ -19,7 +19,7 @@ layout(std430, binding = SUBSCAN_SSBO_PULL_VALUES) readonly buffer PullValues {
     vec4 pullValue[];
 };
 layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) readonly buffer PullWeights {
-    float pullWeight[];
+    vec2 pullWeight[];  // w, w * local spacing ratio
 };
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inColor;
@@ -49,7 +49,7 @@ void main() {
     }
 #elif STAGE_PULL
     uint index = texelIndex(level, pixel >> level);
-    float weight = pullWeight[index];
+    float weight = pullWeight[index].x;
     if (weight > 0.0) {
         result = mix(frame.background.rgb, pullValue[index].yzw / weight, weight);
     }

@@ -35,7 +35,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
 #define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
 #define SUBSCAN_SSBO_PULL_VALUES 6    // vec4 per texel, all levels: w * (depth, r, g, b)
-#define SUBSCAN_SSBO_PULL_WEIGHTS 7   // float per texel, all levels: clamped weight w
+#define SUBSCAN_SSBO_PULL_WEIGHTS 7   // vec2 per texel, all levels: clamped weight w and
+                                      // w * the local spacing (in h) of the points pulled
 #define SUBSCAN_SSBO_PUSH_VALUES 8    // vec4 per texel, levels >= 1: complete (depth, r, g, b)
 #define SUBSCAN_SSBO_NORMALS 9        // vec4 per texel, levels >= 1: view-space normal, w unused
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
@@ -45,18 +46,19 @@ using mat4 = glm::mat4;
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
 #define SUBSCAN_TEXELS_PULL_VALUES 1   // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
-#define SUBSCAN_TEXELS_PULL_WEIGHTS 2  // r32f view of SUBSCAN_SSBO_PULL_WEIGHTS
+#define SUBSCAN_TEXELS_PULL_WEIGHTS 2  // rg32f view of SUBSCAN_SSBO_PULL_WEIGHTS
 #define SUBSCAN_TEXELS_PUSH_VALUES 3   // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
 #define SUBSCAN_TEXELS_NORMALS 4       // rgba32f view of SUBSCAN_SSBO_NORMALS
 #define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
 #define SUBSCAN_TEXELS_POSITIONS 6     // r32f: x, y, z per point (cloud-relative), one chunk
 #define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
 #define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
+#define SUBSCAN_TEXELS_LOCAL_SPACING 9  // rgba16f per point, one chunk (estimateLocalSpacing)
 
 // ---- textures read with texelFetch ----
-// sampler2D per directional light (units 9 .. 9 + SUBSCAN_MAX_LIGHTS - 1): its light map
+// sampler2D per directional light (units 10 .. 10 + SUBSCAN_MAX_LIGHTS - 1): its light map
 // (shared/lightmap.glsl)
-#define SUBSCAN_TEXTURES_LIGHT_MAPS 9
+#define SUBSCAN_TEXTURES_LIGHT_MAPS 10
 
 // ---- images ----
 #define SUBSCAN_IMAGE_OUT0 0
@@ -117,14 +119,15 @@ struct PyramidLayout {
 };
 
 // The reconstruction passes (HiddenPointRemoval, PullPush, FillRemoval, Normals). World radii
-// are in scene units; each pass turns its radius into a pyramid level per pixel:
-// level = log2(radius * focal length / depth).
+// are in scene units for the global spacing h; with local spacing each pixel scales them by
+// its local spacing ratio (RasterizePoints.comp, PullPush.glsl). Each pass turns its radius into a pyramid level per
+// pixel: level = log2(radius * focal length / depth).
 struct SurfaceParams {
     vec4 visibility;  // x: HPR radius, y: threshold tau, z: edge rule (1 or 0), w: unused
     vec4 fill;        // x: radius of the expected gap, y: directions that must find points,
                       // z: pull depth slope (texel widths), w: unused
     vec4 normals;     // x: smoothing radius
-    vec4 unused0;
+    vec4 spacing;     // x: h (scene units), y: 1 when the points carry their local spacing
 };
 
 // Deferred shading; directions are in view space, pointing towards the light.

@@ -9,30 +9,13 @@
 #include <thread>
 #include <vector>
 
-#include <nanoflann.hpp>
+#include "core/KdTree.h"
 
 namespace subscan {
 
 namespace {
 
 constexpr float kUnknown = std::numeric_limits<float>::infinity();
-
-struct PositionsAdaptor {
-    const std::vector<glm::vec3>& positions;
-
-    std::size_t kdtree_get_point_count() const { return positions.size(); }
-    float kdtree_get_pt(std::size_t index, std::size_t axis) const {
-        return positions[index][static_cast<glm::length_t>(axis)];
-    }
-    template <class BoundingBox>
-    bool kdtree_get_bbox(BoundingBox&) const {
-        return false;
-    }
-};
-
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PositionsAdaptor>,
-                                        PositionsAdaptor, 3, std::uint32_t>;
 
 float squaredDistance(const glm::vec3& a, const glm::vec3& b) {
     const glm::vec3 d = a - b;

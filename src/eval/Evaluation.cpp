@@ -41,7 +41,7 @@ class ImageShader {
                                     const std::vector<float>& depth,
                                     const std::vector<glm::vec3>& normals,
                                     const std::vector<glm::vec3>& albedo) {
-        const gpu::PyramidLayout& layout = uniforms_.update(camera, settings, 1.0, cloud_.origin());
+        const gpu::PyramidLayout& layout = uniforms_.update(camera, settings, 1.0, cloud_);
         const int w = camera.width, h = camera.height;
         std::vector<float> rgba(depth.size() * 4);
         auto upload = [&](const char* name, const std::vector<glm::vec3>& values) {

@@ -145,15 +145,16 @@ void Buffer::bindUniform(GLuint binding) const {
 
 void Buffer::bindTexels(GLuint unit, TextureFormat format) const {
     if (!texelView_ || texelFormat_ != format) {
-        if (format != TextureFormat::R32F && format != TextureFormat::RGBA32F &&
-            format != TextureFormat::R32UI) {
+        const bool halves = format == TextureFormat::RGBA16F;
+        if (format != TextureFormat::R32F && format != TextureFormat::RG32F &&
+            format != TextureFormat::RGBA32F && format != TextureFormat::R32UI && !halves) {
             throw Error(
                 fmt::format("the buffer '{}' cannot be read as texels of that format: "
-                            "only 32-bit channels are supported",
+                            "only 32-bit channels and RGBA16F are supported",
                             label_));
         }
         const FormatInfo texel = info(format);
-        const std::size_t texelBytes = static_cast<std::size_t>(texel.channels) * 4;
+        const std::size_t texelBytes = static_cast<std::size_t>(texel.channels) * (halves ? 2 : 4);
         GLint maxTexels = 0;
         glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
         if (size_ / texelBytes > static_cast<std::size_t>(maxTexels)) {

@@ -26,7 +26,7 @@ std::vector<std::string_view> FillRemovalPass::outputs() const {
 
 void FillRemovalPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
-    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
+    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     Buffer& fillReach =
         resources.ensureBuffer("fillReach", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t));
     fillReach.bindStorage(SUBSCAN_SSBO_FILL_REACH);

@@ -61,7 +61,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     }
     FrameResources& resources = frame.resources;
     resources.buffer("pullValues").bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
-    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
+    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
     resources.buffer("normalPyramid").bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);

@@ -7,9 +7,9 @@ namespace subscan {
 
 const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
                                                 const RenderSettings& settings, double spacing,
-                                                const glm::dvec3& cloudOrigin) {
+                                                const GpuPointCloud& cloud) {
     gpu::FrameParams frame{};
-    frame.viewFromCloud = glm::mat4(camera.viewFromCloud(cloudOrigin));
+    frame.viewFromCloud = glm::mat4(camera.viewFromCloud(cloud.origin()));
     frame.projection = glm::mat4(camera.projection());
     frame.viewport = {static_cast<float>(camera.width), static_cast<float>(camera.height),
                       1.0f / static_cast<float>(camera.width),
@@ -37,6 +37,7 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
     params.fill = {surface.fillRadius * h, static_cast<float>(surface.fillDirections),
                    surface.pullDepthSlope, 0.0f};
     params.normals = {surface.normalRadius * h, 0.0f, 0.0f, 0.0f};
+    params.spacing = {h, surface.localSpacing && cloud.hasLocalSpacing() ? 1.0f : 0.0f, 0.0f, 0.0f};
     surface_.set(params);
     surface_.bind(SUBSCAN_UBO_SURFACE);
     return pyramid_;

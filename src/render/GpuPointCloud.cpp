@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <span>
 
 #include <fmt/format.h>
+#include <glm/gtc/packing.hpp>
 
 #include "core/Coloring.h"
 #include "core/Error.h"
@@ -80,6 +82,23 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
         }
         chunks_.push_back(std::move(chunk));
     }
+}
+
+void GpuPointCloud::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
+    if (spacing.size() != size_) {
+        throw Error(fmt::format("local spacing for {} points given to a cloud of {}",
+                                spacing.size(), size_));
+    }
+    std::vector<glm::u16vec4> halves;
+    for (Chunk& chunk : chunks_) {
+        halves.resize(chunk.pointCount);
+        for (std::uint32_t i = 0; i < chunk.pointCount; ++i) {
+            halves[i] = glm::u16vec4(glm::packHalf(spacing[chunk.firstPoint + i]));
+        }
+        chunk.localSpacing =
+            Buffer::fromSpan(std::span<const glm::u16vec4>(halves), "points.localSpacing");
+    }
+    hasLocalSpacing_ = true;
 }
 
 }  // namespace subscan

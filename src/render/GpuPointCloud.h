@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "core/PointCloud.h"
 #include "gpu/GlContext.h"
@@ -15,7 +16,8 @@ namespace subscan {
 /// A point cloud on the GPU, split into chunks that each fit one buffer texture and one
 /// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8. The
 /// rasterizer reads both as buffer textures (Buffer::bindTexels), the GL_POINTS baseline as
-/// vertex attributes.
+/// vertex attributes. Clouds of uneven density also carry each point's local spacing
+/// (estimateLocalSpacing) as four half floats.
 class GpuPointCloud {
   public:
     struct Chunk {
@@ -23,6 +25,7 @@ class GpuPointCloud {
         std::uint32_t pointCount = 0;
         Buffer positions;
         Buffer colors;
+        Buffer localSpacing;  // empty unless hasLocalSpacing()
     };
 
     /// `maxChunkPoints` 0 = as large as the driver allows; tests pass small values to exercise
@@ -30,15 +33,24 @@ class GpuPointCloud {
     GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
                   std::size_t maxChunkPoints = 0);
 
+    /// Uploads estimateLocalSpacing's result, one entry per point.
+    void setLocalSpacing(const std::vector<glm::vec4>& spacing);
+    bool hasLocalSpacing() const { return hasLocalSpacing_; }
+
     const std::vector<Chunk>& chunks() const { return chunks_; }
     std::size_t size() const { return size_; }
     const glm::dvec3& origin() const { return origin_; }
-    std::size_t bytes() const { return size_ * (3 * sizeof(float) + sizeof(std::uint32_t)); }
+    std::size_t bytes() const {
+        return size_ * (3 * sizeof(float) + sizeof(std::uint32_t) +
+                        (hasLocalSpacing_ ? kLocalSpacingBytes : 0));
+    }
 
   private:
     std::vector<Chunk> chunks_;
     std::size_t size_ = 0;
     glm::dvec3 origin_{0.0};
+    bool hasLocalSpacing_ = false;
+    static constexpr std::size_t kLocalSpacingBytes = 4 * sizeof(std::uint16_t);
 };
 
 /// The colour each point is drawn with: its own, else its intensity as grey (stretched between

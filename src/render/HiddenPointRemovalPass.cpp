@@ -9,6 +9,7 @@ void HiddenPointRemovalPass::execute(FrameContext& frame) {
     Texture& visibility = frame.resources.ensureTexture("visibility", TextureFormat::R8,
                                                         frame.width(), frame.height());
     frame.resources.buffer("pyramid").bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
+    frame.resources.texture("color").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     visibility.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -6,13 +6,14 @@
 namespace subscan {
 
 /// Hidden point removal on the min-depth pyramid (DESIGN.md §5.3): "visibility" is 1 where a
-/// rasterized point is visible, 0 where it is hidden or there is none.
+/// rasterized point is visible, 0 where it is hidden or there is none. "color"'s alpha is the
+/// point's local spacing ratio, which scales its search radius.
 class HiddenPointRemovalPass final : public RenderPass {
   public:
     explicit HiddenPointRemovalPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "HiddenPointRemoval"; }
-    std::vector<std::string_view> inputs() const override { return {"pyramid"}; }
+    std::vector<std::string_view> inputs() const override { return {"pyramid", "color"}; }
     std::vector<std::string_view> outputs() const override { return {"visibility"}; }
     void execute(FrameContext& frame) override;
 

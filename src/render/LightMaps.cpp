@@ -117,7 +117,7 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
                             view.width, view.height, limit));
         }
         const gpu::PyramidLayout& layout =
-            uniforms_.update(view, lightSettings, spacing, cloud.origin());
+            uniforms_.update(view, lightSettings, spacing, cloud);
         FrameContext frame{view,       cloud,  lightSettings, context_.capabilities(),
                            resources_, layout, spacing};
         frame.cloudPixels = projectedPixelBounds(view, cloudBounds);

@@ -11,7 +11,7 @@ std::vector<std::string_view> NormalsPass::inputs() const {
     if (levelZero_ == LevelZero::Fused) {
         return {"pushValues"};
     }
-    return {"pushValues", "surfaceDepth"};
+    return {"pushValues", "pullWeights", "surfaceDepth"};
 }
 
 std::vector<std::string_view> NormalsPass::outputs() const {
@@ -40,6 +40,8 @@ void NormalsPass::execute(FrameContext& frame) {
     Texture& normals =
         resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    // The local spacing scales the smoothing radius (PullPush.glsl's spacingRatioAt).
+    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {
         normals.clear();

@@ -20,9 +20,9 @@ void PullPushPass::execute(FrameContext& frame) {
     Buffer& pullValues = resources.ensureBuffer("pullValues", texels * 4 * sizeof(float));
     pullValues.bindStorage(SUBSCAN_SSBO_PULL_VALUES);
     pullValues.bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
-    Buffer& pullWeights = resources.ensureBuffer("pullWeights", texels * sizeof(float));
+    Buffer& pullWeights = resources.ensureBuffer("pullWeights", texels * 2 * sizeof(float));
     pullWeights.bindStorage(SUBSCAN_SSBO_PULL_WEIGHTS);
-    pullWeights.bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::R32F);
+    pullWeights.bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     if (frame.restricted()) {
         // Pull and fill removal read weights around their region: there they must be zero.
         pullWeights.fill(0);

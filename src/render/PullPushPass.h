@@ -6,8 +6,9 @@
 namespace subscan {
 
 /// Pull-push fill of depth and colour from the visible points (DESIGN.md §5.4). Keeps every
-/// pull level ("pullValues" w*(depth, rgb), "pullWeights" w) and push level from 1 up
-/// ("pushValues"); level 0 of the push is "filledDepth" and "filledColor" (LevelZero::PerPass).
+/// pull level ("pullValues" w*(depth, rgb), "pullWeights" w and w * local spacing ratio) and
+/// push level from 1 up ("pushValues"); level 0 of the push is "filledDepth" and "filledColor"
+/// (LevelZero::PerPass).
 class PullPushPass final : public RenderPass {
   public:
     explicit PullPushPass(const ShaderSources& sources);

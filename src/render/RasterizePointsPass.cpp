@@ -87,6 +87,9 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
         params_.bind(SUBSCAN_UBO_PASS);
         chunk.positions.bindTexels(SUBSCAN_TEXELS_POSITIONS, TextureFormat::R32F);
         chunk.colors.bindTexels(SUBSCAN_TEXELS_COLORS, TextureFormat::R32UI);
+        if (frame.cloud.hasLocalSpacing()) {
+            chunk.localSpacing.bindTexels(SUBSCAN_TEXELS_LOCAL_SPACING, TextureFormat::RGBA16F);
+        }
         if (perPixel) {
             Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
                                 SUBSCAN_IMAGE_GROUP_SIZE);

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/Error.h"
+#include "core/LocalSpacing.h"
 #include "core/Spacing.h"
 #include "render/DrawPointsPass.h"
 #include "render/FinishSurfacePass.h"
@@ -48,7 +49,14 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
       resolutionChooser_(cloud),
       cloudBounds_(cloud.bounds),
       reconstruction_(sources_, context.capabilities()),
-      lightMaps_(context, sources_, reconstruction_) {}
+      lightMaps_(context, sources_, reconstruction_) {
+    // A few thousand nearest neighbours tell an even scan (kept on h alone: its local spacing
+    // would only add noise to the radii) from one whose density varies.
+    constexpr std::size_t kVariationSamples = 4000;
+    if (spacingVaries(sampledNearestDistances(cloud, kVariationSamples))) {
+        cloud_.setLocalSpacing(estimateLocalSpacing(cloud, spacing_));
+    }
+}
 
 Renderer::~Renderer() = default;
 
@@ -187,7 +195,7 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
             temporalHistory_.nextJitter(pipelineCamera_, settings.temporal);
     }
     const gpu::PyramidLayout& layout =
-        uniforms_.update(pipelineCamera_, settings, spacing_, cloud_.origin());
+        uniforms_.update(pipelineCamera_, settings, spacing_, cloud_);
 
     const bool fused =
         outputs == FrameOutputs::Picture && settings.raster.mode == RenderMode::Surface &&

@@ -65,6 +65,9 @@ class Renderer {
     const GpuPointCloud& gpuCloud() const { return cloud_; }
     const GlCapabilities& capabilities() const { return context_.capabilities(); }
     double spacing() const { return spacing_; }
+    /// Gives the cloud the local spacing `spacing` (estimateLocalSpacing's form, one entry per
+    /// point) in place of the one the constructor estimated for an uneven cloud, or none.
+    void setLocalSpacing(const std::vector<glm::vec4>& spacing) { cloud_.setLocalSpacing(spacing); }
     /// The camera of the last frame's pipeline images (all but "image"): the frame's own
     /// camera, or reducedCamera(it, divisor) when it reconstructed at reduced resolution.
     const Camera& pipelineCamera() const { return pipelineCamera_; }

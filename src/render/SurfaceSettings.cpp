@@ -19,13 +19,15 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
         {"fill_directions", settings.fillDirections},
         {"normal_radius", settings.normalRadius},
         {"restrict_to_points", settings.restrictToPoints},
+        {"local_spacing", settings.localSpacing},
     };
 }
 
 void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
-    rejectUnknownKeys(json, "surface",
-                      {"visibility_radius", "visibility_threshold", "edge_rule", "pull_depth_slope",
-                       "fill_radius", "fill_directions", "normal_radius", "restrict_to_points"});
+    rejectUnknownKeys(
+        json, "surface",
+        {"visibility_radius", "visibility_threshold", "edge_rule", "pull_depth_slope",
+         "fill_radius", "fill_directions", "normal_radius", "restrict_to_points", "local_spacing"});
     readSetting(json, "visibility_radius", settings.visibilityRadius, 0.1f, 1000.0f);
     readSetting(json, "visibility_threshold", settings.visibilityThreshold, 0.0f, 2.0f);
     readSetting(json, "edge_rule", settings.edgeRule);
@@ -34,6 +36,7 @@ void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
     readSetting(json, "fill_directions", settings.fillDirections, 1, 8);
     readSetting(json, "normal_radius", settings.normalRadius, 0.1f, 1000.0f);
     readSetting(json, "restrict_to_points", settings.restrictToPoints);
+    readSetting(json, "local_spacing", settings.localSpacing);
 }
 
 namespace {

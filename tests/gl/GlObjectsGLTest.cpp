@@ -23,13 +23,15 @@ std::string errorOf(auto&& call) {
     return "";
 }
 
-TEST(GlObjectsGLTest, BufferTexelsNeedThirtyTwoBitChannelsAndNameTheBuffer) {
+TEST(GlObjectsGLTest, BufferTexelsNeedThirtyTwoBitChannelsOrHalvesAndNameTheBuffer) {
     test::glTestContext();
     Buffer buffer(64, nullptr, "test.pyramid");
     EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::R32F));
     EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::RGBA32F));  // a new view of the same
+    EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::RG32F));
     EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::R32UI));
-    const std::string message = errorOf([&] { buffer.bindTexels(0, TextureFormat::RGBA16F); });
+    EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::RGBA16F));
+    const std::string message = errorOf([&] { buffer.bindTexels(0, TextureFormat::RGBA8); });
     EXPECT_NE(message.find("'test.pyramid'"), std::string::npos) << message;
 }
 

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_transform.hpp>
+#include <glm/gtc/packing.hpp>
 #include <glm/matrix.hpp>
 
 #include "core/Camera.h"
@@ -180,6 +181,63 @@ TEST_P(RasterPathGLTest, MatchesTheCpuReferenceWithChunking) {
         renderer.render(camera, settings);
         // The test cloud covers most pixels.
         EXPECT_GT(expectMatchesReference(renderer, cloud, reference), reference.winner.size() / 2);
+    }
+}
+
+TEST_P(RasterPathGLTest, ColorAlphaIsTheWinnersLocalSpacingOnScreen) {
+    GlContext& context = test::glTestContext();
+    if (GetParam() == RasterPath::Int64 && !context.capabilities().int64Atomics) {
+        GTEST_SKIP() << context.capabilities().renderer << " has no 64-bit atomics";
+    }
+    const Camera camera = smallCamera();
+    const PointCloud cloud = testCloud(camera, 2);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+    // Random spacings, half of the points with an across vector of up to 12 h in any
+    // direction (towards the eye too); rounded to halves as the GPU stores them.
+    std::mt19937 random(4);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::vector<glm::vec4> spacing(cloud.size());
+    for (std::size_t i = 0; i < spacing.size(); ++i) {
+        const glm::vec3 across = i % 2 == 0
+                                     ? glm::vec3(0.0f)
+                                     : 7.0f * glm::vec3(unit(random), unit(random), unit(random));
+        spacing[i] = glm::unpackHalf(glm::packHalf(glm::vec4(across, 2.0f + unit(random))));
+    }
+    for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
+        SCOPED_TRACE(chunk ? "chunks of 97" : "one chunk");
+        Renderer renderer(context, cloud, 0.01, chunk);
+        renderer.setLocalSpacing(spacing);
+        RenderSettings settings;
+        settings.raster.path = GetParam();
+        for (const bool local : {true, false}) {
+            settings.surface.localSpacing = local;
+            renderer.render(camera, settings);
+            const std::vector<float> color = renderer.resources().texture("color").readFloats();
+            const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
+            int acrossWins = 0;
+            for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
+                const std::uint32_t winner = reference.winner[pixel];
+                if (winner == kEmpty) {
+                    continue;
+                }
+                double expected = 1.0;
+                if (local) {
+                    // The first-order projection of the across vector (RasterizePoints.comp).
+                    const glm::dvec3 p(viewFromCloud *
+                                       glm::dvec4(glm::dvec3(cloud.positions[winner]), 1.0));
+                    const glm::dvec3 a =
+                        glm::dmat3(viewFromCloud) * glm::dvec3(glm::vec3(spacing[winner]));
+                    const double across = glm::length(glm::dvec2(a) + glm::dvec2(p) * (a.z / -p.z));
+                    expected = std::max<double>(spacing[winner].w, across);
+                    acrossWins += across > spacing[winner].w;
+                }
+                // RGBA16F: 11 significant bits; the float evaluation adds ~1e-6.
+                EXPECT_NEAR(color[4 * pixel + 3], expected, 1e-3 * expected) << pixel;
+            }
+            if (local) {
+                EXPECT_GT(acrossWins, 100);  // both terms of the maximum decide somewhere
+            }
+        }
     }
 }
 

@@ -75,7 +75,9 @@ constexpr double kSpacing = 0.4;
 
 /// The 37x23 frame of these tests; `stageLevel` is the level the pyramid and pull stage views
 /// show.
-PassHarness makeHarness(int stageLevel = 3) {
+/// With `localSpacing` the passes scale their radii by the ratios uploadInputs puts in the
+/// colour's alpha.
+PassHarness makeHarness(int stageLevel = 3, bool localSpacing = false) {
     RenderSettings settings;
     settings.raster.stageLevel = stageLevel;
     // A threshold amid the many mean omegas of this frame (0.6..0.9), so that a formula
@@ -83,12 +85,14 @@ PassHarness makeHarness(int stageLevel = 3) {
     settings.surface.visibilityThreshold = 0.7f;
     // Fewer than 8 directions, so the count itself is tested, not only "all".
     settings.surface.fillDirections = 7;
-    return PassHarness(kWidth, kHeight, settings, kSpacing);
+    return PassHarness(kWidth, kHeight, settings, kSpacing, 50.0, localSpacing);
 }
 
 /// Depth: a curved surface at 4..6 with holes (+inf) and a few far "back" points showing
-/// through; colour random.
-void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color) {
+/// through; colour random; alpha (the local spacing ratio) 1, or with `spacingRatios` random
+/// in 0.5..4.5 (sparser points search farther).
+void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
+                  bool spacingRatios = false) {
     std::mt19937 random(5);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     depth.assign(kWidth * kHeight, 0.0f);
@@ -107,6 +111,9 @@ void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<f
             depth[i] = d;
             for (int c = 0; c < 3; ++c) {
                 color[4 * i + c] = unit(random);
+            }
+            if (spacingRatios) {
+                color[4 * i + 3] = 0.5f + 4.0f * unit(random) * unit(random);
             }
         }
     }
@@ -161,7 +168,7 @@ TEST(SurfacePassesGLTest, MinDepthPyramidIsExact) {
 /// The CPU twin of HiddenPointRemoval.comp. Returns nullopt where a quantity lies within
 /// rounding distance of a decision boundary (the flag may then legitimately differ).
 std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<double>& pyramid,
-                               int px, int py) {
+                               int px, int py, double spacingRatio) {
     const auto all = levels();
     const double depth = pyramid[py * kWidth + px];
     if (std::isinf(depth)) {
@@ -172,9 +179,9 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     constexpr double kTie = 1e-4;  // float evaluation of omega differs from double by ~1e-6
     const glm::dvec3 x = harness.viewPosition(px + 0.5, py + 0.5, depth);
     const glm::dvec3 toCamera = glm::normalize(-x);
-    const double levelValue =
-        std::clamp(std::log2(surface.visibilityRadius * kSpacing * harness.focal() / depth), 0.0,
-                   static_cast<double>(all.size() - 1));
+    const double levelValue = std::clamp(
+        std::log2(surface.visibilityRadius * kSpacing * spacingRatio * harness.focal() / depth),
+        0.0, static_cast<double>(all.size() - 1));
     if (std::abs(levelValue - std::round(levelValue)) < kTie) {
         return std::nullopt;
     }
@@ -233,19 +240,31 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     return visible;
 }
 
-TEST(SurfacePassesGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
-    PassHarness harness = makeHarness();
+/// The reconstruction tests run twice: on the global spacing, and with per-pixel local spacing
+/// ratios (the parameter).
+class SurfacePassesSpacingGLTest : public ::testing::TestWithParam<bool> {};
+
+INSTANTIATE_TEST_SUITE_P(Spacing, SurfacePassesSpacingGLTest, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& tested) {
+                             return tested.param ? "Local" : "Global";
+                         });
+
+TEST_P(SurfacePassesSpacingGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
+    PassHarness harness = makeHarness(3, GetParam());
     std::vector<float> depth, color;
-    uploadInputs(harness, depth, color);
+    uploadInputs(harness, depth, color, GetParam());
     FrameContext frame = harness.context();
     MinDepthPyramidPass(harness.sources()).execute(frame);
     HiddenPointRemovalPass(harness.sources()).execute(frame);
     const std::vector<float> flags = harness.resources().texture("visibility").readFloats();
+    // The ratios as the GPU read them (RGBA16F).
+    const std::vector<float> color16 = harness.resources().texture("color").readFloats();
     const std::vector<double> pyramid = cpuPyramid(depth);
     int ties = 0, visible = 0, hidden = 0;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
-            const std::optional<bool> expected = cpuVisible(harness, pyramid, x, y);
+            const std::optional<bool> expected =
+                cpuVisible(harness, pyramid, x, y, color16[4 * (y * kWidth + x) + 3]);
             if (!expected) {
                 ++ties;
                 continue;
@@ -265,6 +284,7 @@ struct PullPush {
     std::vector<glm::dvec4> pullValue;
     std::vector<double> pullWeight;
     std::vector<glm::dvec4> push;
+    std::vector<double> pullSpacing;  // w * local spacing ratio
 };
 
 /// The CPU twin of PullPush.comp from the given visibility flags.
@@ -273,10 +293,11 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
     const auto all = levels();
     const std::size_t texels = all.back().offset + 1;
     PullPush result{std::vector<glm::dvec4>(texels), std::vector<double>(texels),
-                    std::vector<glm::dvec4>(texels)};
+                    std::vector<glm::dvec4>(texels), std::vector<double>(texels)};
     for (int i = 0; i < kWidth * kHeight; ++i) {
         const bool visible = visibility[i] > 0.5f;
         result.pullWeight[i] = visible ? 1.0 : 0.0;
+        result.pullSpacing[i] = visible ? color[4 * i + 3] : 0.0;
         result.pullValue[i] =
             visible ? glm::dvec4(depth[i], color[4 * i], color[4 * i + 1], color[4 * i + 2])
                     : glm::dvec4(0.0);
@@ -306,6 +327,7 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
                 }
                 const double tolerance = slope * (1 << l) * front / harness.focal();
                 double weight = 0.0;
+                double spacing = 0.0;
                 glm::dvec4 value(0.0);
                 for (int j = 0; j < 4; ++j) {
                     for (int i = 0; i < 4; ++i) {
@@ -316,6 +338,7 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
                             continue;
                         }
                         weight += kernel[i] * kernel[j] * result.pullWeight[child];
+                        spacing += kernel[i] * kernel[j] * result.pullSpacing[child];
                         value += kernel[i] * kernel[j] * result.pullValue[child];
                     }
                 }
@@ -324,6 +347,7 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
                 result.pullWeight[index] = clamped;
                 result.pullValue[index] =
                     weight > 0.0 ? value * (clamped / weight) : glm::dvec4(0.0);
+                result.pullSpacing[index] = weight > 0.0 ? spacing * (clamped / weight) : 0.0;
             }
         }
     }
@@ -354,38 +378,43 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
     return result;
 }
 
-void runUpToPullPush(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color) {
-    uploadInputs(harness, depth, color);
+void runUpToPullPush(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
+                     bool spacingRatios = false) {
+    uploadInputs(harness, depth, color, spacingRatios);
     FrameContext frame = harness.context();
     MinDepthPyramidPass(harness.sources()).execute(frame);
     HiddenPointRemovalPass(harness.sources()).execute(frame);
     PullPushPass(harness.sources()).execute(frame);
 }
 
-void runUpToNormals(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color) {
-    runUpToPullPush(harness, depth, color);
+void runUpToNormals(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
+                    bool spacingRatios = false) {
+    runUpToPullPush(harness, depth, color, spacingRatios);
     FrameContext frame = harness.context();
     FillRemovalPass(harness.sources()).execute(frame);
     NormalsPass(harness.sources()).execute(frame);
 }
 
-TEST(SurfacePassesGLTest, PullPushMatchesToFloatPrecision) {
-    PassHarness harness = makeHarness();
+TEST_P(SurfacePassesSpacingGLTest, PullPushMatchesToFloatPrecision) {
+    PassHarness harness = makeHarness(3, GetParam());
     std::vector<float> depth, color;
-    runUpToPullPush(harness, depth, color);
+    runUpToPullPush(harness, depth, color, GetParam());
     const FrameResources& resources = harness.resources();
     // The colour input is RGBA16F: feed the reference the values the GPU actually read.
     const std::vector<float> color16 = resources.texture("color").readFloats();
     const PullPush cpu =
         cpuPullPush(harness, depth, color16, resources.texture("visibility").readFloats());
     const auto values = resources.buffer("pullValues").read<glm::vec4>();
-    const auto weights = resources.buffer("pullWeights").read<float>();
+    const auto weights = resources.buffer("pullWeights").read<glm::vec2>();
     const auto push = resources.buffer("pushValues").read<glm::vec4>();
     ASSERT_EQ(weights.size(), cpu.pullWeight.size());
     for (std::size_t i = 0; i < weights.size(); ++i) {
         // Sums of up to 16 floats per level over ~6 levels: relative error ~1e-6; 1e-4 of the
-        // value's scale (depths ~5, colours ~1) leaves room without hiding a formula error.
-        EXPECT_NEAR(weights[i], cpu.pullWeight[i], 1e-5) << "texel " << i;
+        // value's scale (depths ~5, colours ~1, ratios up to 4.5) leaves room without hiding a
+        // formula error.
+        EXPECT_NEAR(weights[i].x, cpu.pullWeight[i], 1e-5) << "texel " << i;
+        EXPECT_NEAR(weights[i].y, cpu.pullSpacing[i], 1e-4 * (1.0 + cpu.pullSpacing[i]))
+            << "texel " << i;
         for (int c = 0; c < 4; ++c) {
             EXPECT_NEAR(values[i][c], cpu.pullValue[i][c],
                         1e-4 * (1.0 + std::abs(cpu.pullValue[i][c])))
@@ -410,14 +439,33 @@ TEST(SurfacePassesGLTest, PullPushMatchesToFloatPrecision) {
     }
 }
 
-TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
-    PassHarness harness = makeHarness();
+/// The CPU twin of PullPush.glsl's spacingRatioAt on the GPU's pull weights (w, w * ratio).
+double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, int y) {
+    if (!local) {
+        return 1.0;
+    }
+    for (const Level& level : levels()) {
+        const glm::vec2 texel = pulled[level.offset + y * level.width + x];
+        if (texel.x > 0.0f) {
+            return static_cast<double>(texel.y) / texel.x;
+        }
+        x >>= 1;
+        y >>= 1;
+    }
+    return 1.0;
+}
+
+TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
+    PassHarness harness = makeHarness(3, GetParam());
     std::vector<float> depth, color;
-    runUpToPullPush(harness, depth, color);
+    runUpToPullPush(harness, depth, color, GetParam());
     FrameContext frame = harness.context();
     FillRemovalPass(harness.sources()).execute(frame);
     const FrameResources& resources = harness.resources();
-    const auto weights = resources.buffer("pullWeights").read<float>();
+    const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
+    std::vector<float> weights(pulled.size());
+    std::transform(pulled.begin(), pulled.end(), weights.begin(),
+                   [](const glm::vec2& texel) { return texel.x; });
     const std::vector<float> filled = resources.texture("filledDepth").readFloats();
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const std::vector<float> surfaceDepth = resources.texture("surfaceDepth").readFloats();
@@ -431,8 +479,9 @@ TEST(SurfacePassesGLTest, FillRemovalMaskMatchesExceptTies) {
             const int i = y * kWidth + x;
             bool expected = weights[i] > 0.0f;  // a visible point of its own
             if (!expected) {
-                const double raw =
-                    std::log2(surface.fillRadius * kSpacing * harness.focal() / filled[i]);
+                const double raw = std::log2(surface.fillRadius * kSpacing *
+                                             cpuSpacingRatio(pulled, GetParam(), x, y) *
+                                             harness.focal() / filled[i]);
                 const double level = std::clamp(raw, 1.0, static_cast<double>(all.size() - 1));
                 // float vs double: an unclamped level this close to an integer may round up
                 // either way.
@@ -532,11 +581,12 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
     }
 }
 
-TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
-    PassHarness harness = makeHarness();
+TEST_P(SurfacePassesSpacingGLTest, NormalBlendFollowsTheSmoothingLevel) {
+    PassHarness harness = makeHarness(3, GetParam());
     std::vector<float> depth, color;
-    runUpToNormals(harness, depth, color);
+    runUpToNormals(harness, depth, color, GetParam());
     const FrameResources& resources = harness.resources();
+    const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
     const auto pyramid = resources.buffer("normalPyramid").read<glm::vec4>();
     const auto surfaceDepth = resources.texture("surfaceDepth").readFloats();
     const auto normals = resources.texture("normals").readFloats();
@@ -550,8 +600,10 @@ TEST(SurfacePassesGLTest, NormalBlendFollowsTheSmoothingLevel) {
                 EXPECT_EQ(normals[4 * i + 3], 0.0f);  // no normal off the surface
                 continue;
             }
-            const double level = std::clamp(std::log2(radius * harness.focal() / surfaceDepth[i]),
-                                            1.0, static_cast<double>(all.size() - 1));
+            const double ratio = cpuSpacingRatio(pulled, GetParam(), x, y);
+            const double level =
+                std::clamp(std::log2(radius * ratio * harness.focal() / surfaceDepth[i]), 1.0,
+                           static_cast<double>(all.size() - 1));
             auto bilinear = [&](int l) {
                 return bilinearOnLevel(all[l], l, x, y,
                                        [&](int texel) { return glm::dvec3(pyramid[texel]); });
@@ -648,7 +700,7 @@ TEST(SurfacePassesGLTest, StageViewsShowTheirBuffers) {
     const auto visible = resources.texture("visibility").readFloats();
     const auto pyramid = resources.buffer("pyramid").read<float>();
     const auto pullValues = resources.buffer("pullValues").read<glm::vec4>();
-    const auto pullWeights = resources.buffer("pullWeights").read<float>();
+    const auto pullWeights = resources.buffer("pullWeights").read<glm::vec2>();
     const auto filled = resources.texture("filledColor").readFloats();
     const auto mask = resources.texture("mask").readFloats();
     const auto normals = resources.texture("normals").readFloats();
@@ -678,7 +730,7 @@ TEST(SurfacePassesGLTest, StageViewsShowTheirBuffers) {
                         }
                         break;
                     case Stage::Pull:
-                        if (const double w = pullWeights[texel]; w > 0.0) {
+                        if (const double w = pullWeights[texel].x; w > 0.0) {
                             const glm::dvec3 value(pullValues[texel].y, pullValues[texel].z,
                                                    pullValues[texel].w);
                             expected = background + (value / w - background) * w;

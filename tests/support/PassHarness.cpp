@@ -20,7 +20,7 @@ PointCloud onePointCloud() {
 }  // namespace
 
 PassHarness::PassHarness(int width, int height, const RenderSettings& settings, double spacing,
-                         double fovyDegrees)
+                         double fovyDegrees, bool localSpacing)
     : settings_(settings),
       spacing_(spacing),
       cloud_(onePointCloud(), glTestContext().capabilities()) {
@@ -29,7 +29,10 @@ PassHarness::PassHarness(int width, int height, const RenderSettings& settings, 
     camera_.fovyDegrees = fovyDegrees;
     camera_.nearPlane = 0.1;
     camera_.farPlane = 100.0;
-    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_.origin());
+    if (localSpacing) {
+        cloud_.setLocalSpacing({glm::vec4(0.0f, 0.0f, 0.0f, 1.0f)});
+    }
+    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_);
 }
 
 FrameContext PassHarness::context() {
@@ -39,7 +42,7 @@ FrameContext PassHarness::context() {
 
 void PassHarness::setCamera(const Camera& camera) {
     camera_ = camera;
-    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_.origin());
+    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_);
 }
 
 glm::dvec3 PassHarness::viewPosition(double wx, double wy, double depth) const {

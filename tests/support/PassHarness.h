@@ -14,11 +14,12 @@ namespace subscan::test {
 
 /// A frame of the pipeline outside the Renderer, for testing one pass on inputs the test
 /// uploads itself: a camera looking down −z, the frame uniforms, named resources and the
-/// context a pass runs with.
+/// context a pass runs with. With `localSpacing` the cloud carries a local spacing, so the passes
+/// scale their radii by the "color" image's alpha and the pulled ratios.
 class PassHarness {
   public:
     PassHarness(int width, int height, const RenderSettings& settings, double spacing,
-                double fovyDegrees = 50.0);
+                double fovyDegrees = 50.0, bool localSpacing = false);
 
     FrameContext context();
     /// Another camera (its size must stay) for the passes run after this; uniforms updated.

@@ -387,6 +387,10 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
     ImGui::SliderInt("fill directions", &surface.fillDirections, 1, 8);
     ImGui::SliderFloat("normal radius (h)", &surface.normalRadius, 0.25f, 16.0f, "%.2f",
                        kLogarithmic);
+    ImGui::Checkbox("local spacing", &surface.localSpacing);
+    helpTooltip(
+        "Radii scale with each point's own spacing where the scan's density varies (a LiDAR "
+        "station); off: the one global h.");
     ImGui::Checkbox("skip the screen around the points", &surface.restrictToPoints);
     helpTooltip(
         "Passes after rasterization work only inside the points' bounds (the same "

@@ -57,6 +57,7 @@ TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
     settings.surface.visibilityThreshold = 0.3f;
     settings.surface.edgeRule = false;
     settings.surface.restrictToPoints = false;
+    settings.surface.localSpacing = false;
     settings.shading.lights.push_back({{1, 2, 3}, {0.5f, 0.5f, 0.5f}});
     const test::TempDir dir;
     writeSettingsFile(dir / "s.json", settings);
@@ -66,6 +67,7 @@ TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
     EXPECT_EQ(back.surface.visibilityThreshold, 0.3f);
     EXPECT_FALSE(back.surface.edgeRule);
     EXPECT_FALSE(back.surface.restrictToPoints);
+    EXPECT_FALSE(back.surface.localSpacing);
     ASSERT_EQ(back.shading.lights.size(), 1u);
     EXPECT_EQ(back.shading.lights[0].direction, glm::vec3(1, 2, 3));
     const auto bad = dir.write("bad.json", R"({"surface": {"fill_directions": 9}})");

@@ -1,0 +1,151 @@
+#include "core/LocalSpacing.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include <glm/geometric.hpp>
+
+#include "core/KdTree.h"
+
+namespace subscan {
+
+namespace {
+
+/// Neighbours searched first; repeated points (overlapping scans) take some of them.
+constexpr std::size_t kNeighbours = 24;
+/// Neighbours searched when all of the first lie along the point's line: enough to reach the
+/// next line where lines lie up to ~40 points' spacings apart (far ground of a station).
+constexpr std::size_t kWideNeighbours = 96;
+/// Which non-coincident neighbour's distance is the spacing: the 4th is past the pairs that
+/// scanner noise and overlapping scans make, and still within the point's own surroundings.
+constexpr std::size_t kSpacingNeighbour = 4;
+/// A neighbour more than 45 degrees off the line's direction lies across it.
+constexpr float kAcrossCosine = 0.70710678f;
+/// Gaps across lines up to this many spacings are ordinary irregularity, not scan lines.
+constexpr float kLineGapRatio = 2.0f;
+/// Half floats (the GPU's copy) end at 65504.
+constexpr float kLargest = 6.0e4f;
+
+struct Neighbourhood {
+    float spacingNeighbour = std::numeric_limits<float>::infinity();  // its distance
+    glm::vec3 across{0.0f};
+};
+
+/// The nearest neighbour of `point` across its line among `found` neighbours sorted by distance,
+/// or nothing; also the kSpacingNeighbour-th non-coincident distance.
+bool scanNeighbours(const std::vector<glm::vec3>& positions, const glm::vec3& point,
+                    const std::uint32_t* indices, const float* squared, std::size_t found,
+                    Neighbourhood& result) {
+    std::size_t distinct = 0;
+    glm::vec3 line{0.0f};
+    for (std::size_t k = 0; k < found; ++k) {
+        if (!(squared[k] > 0.0f)) {
+            continue;
+        }
+        const glm::vec3 offset = positions[indices[k]] - point;
+        const float distance = std::sqrt(squared[k]);
+        ++distinct;
+        if (distinct <= kSpacingNeighbour) {
+            result.spacingNeighbour = distance;
+        }
+        if (distinct == 1) {
+            line = offset / distance;
+        } else if (std::abs(glm::dot(offset, line)) < kAcrossCosine * distance) {
+            result.across = offset;
+            return true;
+        }
+    }
+    return false;
+}
+
+Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& positions,
+                              const glm::vec3& point) {
+    std::array<std::uint32_t, kWideNeighbours> indices{};
+    std::array<float, kWideNeighbours> squared{};
+    Neighbourhood result;
+    const std::size_t found = tree.knnSearch(&point.x, kNeighbours, indices.data(), squared.data());
+    if (scanNeighbours(positions, point, indices.data(), squared.data(), found, result) ||
+        found < kNeighbours) {
+        return result;
+    }
+    const std::size_t wide =
+        tree.knnSearch(&point.x, kWideNeighbours, indices.data(), squared.data());
+    result = {};
+    scanNeighbours(positions, point, indices.data(), squared.data(), wide, result);
+    return result;
+}
+
+}  // namespace
+
+std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
+    const std::vector<glm::vec3>& positions = cloud.positions;
+    std::vector<glm::vec4> spacing(positions.size(), glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    if (positions.size() < 2 || !(h > 0.0)) {
+        return spacing;
+    }
+    const PositionsAdaptor adaptor{positions};
+    const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    // Raw distances first (w: the spacing neighbour's, xyz: the across vector), in parallel.
+    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+    const auto search = [&](std::size_t thread) {
+        const std::size_t first = thread * positions.size() / threads;
+        const std::size_t last = (thread + 1) * positions.size() / threads;
+        for (std::size_t i = first; i < last; ++i) {
+            const Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
+            spacing[i] = glm::vec4(found.across, found.spacingNeighbour);
+        }
+    };
+    {
+        std::vector<std::jthread> workers;
+        for (std::size_t thread = 1; thread < threads; ++thread) {
+            workers.emplace_back(search, thread);
+        }
+        search(0);
+    }
+    std::vector<float> distances;
+    distances.reserve(spacing.size());
+    for (const glm::vec4& entry : spacing) {
+        if (std::isfinite(entry.w)) {
+            distances.push_back(entry.w);
+        }
+    }
+    if (distances.empty()) {
+        std::fill(spacing.begin(), spacing.end(), glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+        return spacing;
+    }
+    const auto middle = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+    std::nth_element(distances.begin(), middle, distances.end());
+    const float median = *middle;
+    const auto inverseH = static_cast<float>(1.0 / h);
+    for (glm::vec4& entry : spacing) {
+        // A point without neighbours (a cloud of repeated points) keeps the global h.
+        const float local = std::isfinite(entry.w) ? std::min(entry.w / median, kLargest) : 1.0f;
+        const glm::vec3 across = glm::vec3(entry) * inverseH;
+        const float acrossLength = glm::length(across);
+        const bool acrossLines = acrossLength > kLineGapRatio * local && acrossLength < kLargest;
+        entry = glm::vec4(acrossLines ? across : glm::vec3(0.0f), local);
+    }
+    return spacing;
+}
+
+bool spacingVaries(std::vector<float> sampledNearest) {
+    std::erase_if(sampledNearest, [](float d) { return !std::isfinite(d); });
+    if (sampledNearest.size() < 10) {
+        return false;
+    }
+    const auto at = [&](double share) {
+        const auto position =
+            sampledNearest.begin() +
+            static_cast<std::ptrdiff_t>(share * static_cast<double>(sampledNearest.size() - 1));
+        std::nth_element(sampledNearest.begin(), position, sampledNearest.end());
+        return *position;
+    };
+    const float low = at(0.1);
+    const float high = at(0.9);
+    return high > kVaryingSpacingRatio * low;
+}
+
+}  // namespace subscan

@@ -1,0 +1,34 @@
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "core/PointCloud.h"
+
+namespace subscan {
+
+/// The local spacing of DESIGN.md §4 for clouds whose density varies (LiDAR stations, depth
+/// cameras): per point, in units of the global spacing h,
+///   w    the spacing where the point is: its 4th nearest non-coincident neighbour's distance,
+///        scaled so that over the whole cloud its median is 1 (h itself on an even cloud);
+///   xyz  where the point lies on a scan line whose neighbouring lines are more than twice w
+///        away (far ground seen by a station comes as rings), the vector to the nearest point
+///        across the line: the nearest neighbour more than 45 degrees off the line's direction
+///        (the direction to the nearest neighbour); else 0.
+/// The reconstruction takes, per pixel, the larger of w and the across vector projected into
+/// the picture: an across gap seen end-on, as from the scanner itself, is small on screen.
+std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h);
+
+/// Whether the cloud's spacing varies enough for estimateLocalSpacing to matter: the 90th
+/// percentile of `sampledNearest` (sampledNearestDistances) over its 10th above
+/// kVaryingSpacingRatio.
+bool spacingVaries(std::vector<float> sampledNearest);
+
+/// Even scans (range images, photogrammetry, synthetic object scans) stay below this ratio of
+/// the 90th to the 10th percentile of nearest-neighbour distances; a station's points lie
+/// 10-50 times farther apart at the edge of its range than next to it.
+inline constexpr float kVaryingSpacingRatio = 6.0f;
+
+}  // namespace subscan

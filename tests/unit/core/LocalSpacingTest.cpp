@@ -1,0 +1,185 @@
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <glm/glm.hpp>
+
+#include "core/LocalSpacing.h"
+#include "core/PointCloud.h"
+#include "core/Spacing.h"
+
+namespace subscan {
+namespace {
+
+/// Points on the plane z = 3: rows along x `along` apart, rows `across` apart in y, each point
+/// given `copies` times.
+PointCloud lines(int rows, int perRow, double along, double across, int copies = 1) {
+    PointCloudBuilder builder({}, static_cast<std::size_t>(rows * perRow * copies));
+    for (int copy = 0; copy < copies; ++copy) {
+        for (int r = 0; r < rows; ++r) {
+            for (int i = 0; i < perRow; ++i) {
+                PointRecord record;
+                record.position = {i * along, r * across, 3.0};
+                builder.add(record);
+            }
+        }
+    }
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
+/// Whether point `index` of lines(rows, perRow, ...) lies `rowMargin` rows and `pointMargin`
+/// points from every edge (where neighbourhoods are whole).
+bool interior(std::size_t index, int rows, int perRow, int rowMargin, int pointMargin) {
+    const int r = static_cast<int>(index) / perRow, i = static_cast<int>(index) % perRow;
+    return r >= rowMargin && r < rows - rowMargin && i >= pointMargin && i < perRow - pointMargin;
+}
+
+TEST(LocalSpacingTest, AnEvenGridHasTheGlobalSpacingAndNoLines) {
+    const PointCloud cloud = lines(40, 40, 0.01, 0.01);
+    const std::vector<glm::vec4> spacing = estimateLocalSpacing(cloud, estimateSpacing(cloud));
+    ASSERT_EQ(spacing.size(), cloud.size());
+    for (std::size_t i = 0; i < spacing.size(); ++i) {
+        if (interior(i, 40, 40, 3, 3)) {
+            // Inside, every point's 4th neighbour is one step away, as is the median's:
+            // floats relative to the cloud's centre carry ~1e-6 relative error.
+            EXPECT_NEAR(spacing[i].w, 1.0f, 1e-4f) << i;
+            EXPECT_EQ(glm::vec3(spacing[i]), glm::vec3(0.0f)) << i;
+        }
+    }
+}
+
+/// Scan lines `ratio` times farther apart than their points: every inner point's across
+/// vector is the gap to the next line, in units of h (the step along the lines), pointing
+/// across them; its spacing w stays the one along its line.
+void expectLinesFound(double ratio) {
+    constexpr int kRows = 12, kPerRow = 300;
+    constexpr double kAlong = 0.01;
+    const PointCloud cloud = lines(kRows, kPerRow, kAlong, ratio * kAlong);
+    const double h = estimateSpacing(cloud);
+    ASSERT_NEAR(h, kAlong, 1e-7);  // the nearest neighbour lies along the line
+    const std::vector<glm::vec4> spacing = estimateLocalSpacing(cloud, h);
+    int checked = 0;
+    for (std::size_t i = 0; i < spacing.size(); ++i) {
+        // Every row has a neighbour row; two points from a row's end its 4th neighbour lies two
+        // steps away as elsewhere.
+        if (!interior(i, kRows, kPerRow, 0, 2)) {
+            continue;
+        }
+        ++checked;
+        // The 4th neighbour along a line lies 2 steps away, for every point alike.
+        EXPECT_NEAR(spacing[i].w, 1.0f, 1e-4f) << i;
+        // Float positions: ~1e-6 relative.
+        EXPECT_NEAR(std::abs(spacing[i].y), ratio, 1e-3 * ratio) << i;
+        EXPECT_NEAR(spacing[i].x, 0.0f, 1e-3f) << i;
+        EXPECT_NEAR(spacing[i].z, 0.0f, 1e-3f) << i;
+    }
+    EXPECT_GT(checked, 1000);
+}
+
+TEST(LocalSpacingTest, LinesTenStepsApartAreFound) {
+    expectLinesFound(10.0);
+}
+
+TEST(LocalSpacingTest, LinesThirtyStepsApartAreFoundByTheWiderSearch) {
+    // 60 points of the own line lie nearer than the next one: past the first 24 neighbours.
+    expectLinesFound(30.0);
+}
+
+TEST(LocalSpacingTest, ALineGapOfOneAndAHalfStepsIsNoScanLine) {
+    const PointCloud cloud = lines(30, 30, 0.01, 0.015);
+    const std::vector<glm::vec4> spacing = estimateLocalSpacing(cloud, estimateSpacing(cloud));
+    for (std::size_t i = 0; i < spacing.size(); ++i) {
+        if (interior(i, 30, 30, 3, 3)) {
+            EXPECT_EQ(glm::vec3(spacing[i]), glm::vec3(0.0f)) << i;
+        }
+    }
+}
+
+TEST(LocalSpacingTest, RepeatedPointsAreLookedPast) {
+    const PointCloud once = lines(12, 200, 0.01, 0.1);
+    const PointCloud twice = lines(12, 200, 0.01, 0.1, 2);
+    const std::vector<glm::vec4> single = estimateLocalSpacing(once, estimateSpacing(once));
+    const std::vector<glm::vec4> doubled = estimateLocalSpacing(twice, estimateSpacing(twice));
+    for (std::size_t i = 0; i < single.size(); ++i) {
+        if (interior(i, 12, 200, 0, 2)) {
+            // Both copies find the same neighbours (at equal distances the order may differ,
+            // the lengths not).
+            for (const std::size_t copy : {i, i + single.size()}) {
+                EXPECT_NEAR(doubled[copy].w, single[i].w, 1e-4f) << i;
+                EXPECT_NEAR(glm::length(glm::vec3(doubled[copy])),
+                            glm::length(glm::vec3(single[i])), 1e-3f)
+                    << i;
+            }
+        }
+    }
+}
+
+TEST(LocalSpacingTest, SpacingFollowsTheDensity) {
+    // Two even patches, the second four times sparser: w is 4x as large there as in the
+    // first, relative to the median (the dense patch holds more points, so the median is its).
+    PointCloudBuilder builder({}, 40 * 40 + 20 * 20);
+    for (int i = 0; i < 40; ++i) {
+        for (int j = 0; j < 40; ++j) {
+            PointRecord record;
+            record.position = {i * 0.01, j * 0.01, 0.0};
+            builder.add(record);
+        }
+    }
+    for (int i = 0; i < 20; ++i) {
+        for (int j = 0; j < 20; ++j) {
+            PointRecord record;
+            record.position = {5.0 + i * 0.04, j * 0.04, 0.0};
+            builder.add(record);
+        }
+    }
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    const std::vector<glm::vec4> spacing = estimateLocalSpacing(cloud, estimateSpacing(cloud));
+    // Centres of each patch (float positions: 1e-4 relative).
+    EXPECT_NEAR(spacing[20 * 40 + 20].w, 1.0f, 1e-4f);
+    EXPECT_NEAR(spacing[1600 + 10 * 20 + 10].w, 4.0f, 4e-4f);
+}
+
+TEST(LocalSpacingTest, DegenerateCloudsKeepTheGlobalSpacing) {
+    EXPECT_TRUE(estimateLocalSpacing(PointCloud{}, 1.0).empty());
+    const PointCloud single = lines(1, 1, 1.0, 1.0);
+    EXPECT_EQ(estimateLocalSpacing(single, 1.0), std::vector<glm::vec4>{glm::vec4(0, 0, 0, 1)});
+    // One point given ten times: no neighbour at a distance.
+    const PointCloud repeated = lines(1, 1, 1.0, 1.0, 10);
+    for (const glm::vec4& entry : estimateLocalSpacing(repeated, 1.0)) {
+        EXPECT_EQ(entry, glm::vec4(0, 0, 0, 1));
+    }
+}
+
+TEST(LocalSpacingTest, VariationIsFoundInAStationsRangeNotInEvenOrRandomScans) {
+    EXPECT_FALSE(spacingVaries(sampledNearestDistances(lines(100, 100, 0.01, 0.01))));
+    // Uniformly random points on a plane: nearest distances follow a Rayleigh law, whose 90th
+    // percentile is 4.7 times its 10th: the most uneven an even scan gets.
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    PointCloudBuilder builder({}, 20000);
+    for (int i = 0; i < 20000; ++i) {
+        PointRecord record;
+        record.position = {unit(random), unit(random), 0.0};
+        builder.add(record);
+    }
+    std::vector<std::string> warnings;
+    EXPECT_FALSE(spacingVaries(sampledNearestDistances(builder.finish(warnings))));
+    // Rows whose spacing grows 30-fold from first to last, as a station's with range.
+    PointCloudBuilder station({}, 20000);
+    for (int r = 0; r < 100; ++r) {
+        const double step = 0.01 * std::pow(30.0, r / 99.0);
+        for (int i = 0; i < 200; ++i) {
+            PointRecord record;
+            record.position = {i * step, r * 1.0, 0.0};
+            station.add(record);
+        }
+    }
+    EXPECT_TRUE(spacingVaries(sampledNearestDistances(station.finish(warnings))));
+}
+
+}  // namespace
+}  // namespace subscan
