@@ -11,9 +11,13 @@
 // share of levels it saw, and it takes no part in the edge rule. Counted in full as open, such
 // directions let points behind the surface near the border pass as visible; left out
 // entirely, the few directions left hid the surface itself in the image's corners.
-// The search radius is the settings' multiple of the point's local spacing (the "color"
-// image's alpha, RasterizePoints.comp): where points lie far apart, gaps between them must not
-// let a surface behind show through.
+// The search radius is the settings' multiple of h, shrunk where the point's local spacing (the
+// "color" image's alpha, RasterizePoints.comp) is smaller. The radius must span the gaps of the
+// surface in front, not the point's own: a far, sparse background behind a near, dense object
+// would otherwise search past the object's silhouette (measured: the table scene from its
+// sensor lost 0.3 % of its measured cells, a station's views 0.5 % coverage), while for a
+// point denser than h what lies in front of it is, for a station or a depth camera, nearer
+// and at least as dense.
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
 #include "shared/surface.glsl"
@@ -32,7 +36,7 @@ shared uint occupiedCount;
 bool visibleAt(ivec2 pixel, float depth) {
     vec3 x = viewPositionAt(vec2(pixel) + 0.5, depth);
     vec3 toCamera = towardsEye(x);
-    float radius = surface.visibility.x * imageLoad(inColor, pixel).a;
+    float radius = surface.visibility.x * min(imageLoad(inColor, pixel).a, 1.0);
     float maxLevel = clamp(levelForRadius(radius, depth), 0.0,
                            float(levelCount() - 1u));
     uint levels = uint(maxLevel);

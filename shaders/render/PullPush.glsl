@@ -11,10 +11,12 @@ layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexe
 vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
 float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
 
-/// The local spacing around `pixel` in units of h (1 without local spacing): that of the
-/// visible points in the finest texel above it that holds any, so a pixel in a gap takes the
-/// spacing of the points around the gap. A single ratio per texel, not a smooth one: the
-/// passes round the levels it gives up to whole levels anyway.
+/// The local spacing around `pixel` in units of h (1 without local spacing): a point's own, and
+/// for a pixel in a gap that of the visible points in the finest texel above it that holds any
+/// or in that texel's parent, whichever is larger: a gap between sparse points (a canopy) next
+/// to dense ones (the ground it hides in part) must take the sparse points' spacing, and the
+/// finest texel often holds only dense ones (measured on tests/gl/LocalSpacingGLTest.cpp's
+/// canopy: 115 pixels of background left from the finest texel alone, 7 with its parent).
 float spacingRatioAt(ivec2 pixel) {
     if (surface.spacing.y < 0.5) {
         return 1.0;
@@ -22,7 +24,13 @@ float spacingRatioAt(ivec2 pixel) {
     for (uint level = 0u; level < levelCount(); ++level) {
         vec2 pulled = texelFetch(pullWeightTexels, int(texelIndex(level, pixel >> level))).rg;
         if (pulled.x > 0.0) {
-            return pulled.y / pulled.x;
+            float ratio = pulled.y / pulled.x;
+            if (level == 0u || level + 1u >= levelCount()) {
+                return ratio;
+            }
+            vec2 parent =
+                texelFetch(pullWeightTexels, int(texelIndex(level + 1u, pixel >> (level + 1u)))).rg;
+            return max(ratio, parent.y / parent.x);
         }
     }
     return 1.0;

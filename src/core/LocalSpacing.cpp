@@ -9,13 +9,14 @@
 #include <glm/geometric.hpp>
 
 #include "core/KdTree.h"
+#include "core/Spacing.h"
 
 namespace subscan {
 
 namespace {
 
 /// Neighbours searched first; repeated points (overlapping scans) take some of them.
-constexpr std::size_t kNeighbours = 24;
+constexpr std::size_t kNeighbours = 12;
 /// Neighbours searched when all of the first lie along the point's line: enough to reach the
 /// next line where lines lie up to ~40 points' spacings apart (far ground of a station).
 constexpr std::size_t kWideNeighbours = 96;
@@ -29,9 +30,13 @@ constexpr float kLineGapRatio = 2.0f;
 /// Half floats (the GPU's copy) end at 65504.
 constexpr float kLargest = 6.0e4f;
 
+using NearestIndices = std::array<std::uint32_t, kSpacingNeighbour>;
+
 struct Neighbourhood {
     float spacingNeighbour = std::numeric_limits<float>::infinity();  // its distance
     glm::vec3 across{0.0f};
+    NearestIndices nearest{};  // the first kSpacingNeighbour non-coincident ones (repeated
+                               // when fewer)
 };
 
 /// The nearest neighbour of `point` across its line among `found` neighbours sorted by distance,
@@ -50,6 +55,8 @@ bool scanNeighbours(const std::vector<glm::vec3>& positions, const glm::vec3& po
         ++distinct;
         if (distinct <= kSpacingNeighbour) {
             result.spacingNeighbour = distance;
+            std::fill(result.nearest.begin() + static_cast<std::ptrdiff_t>(distinct - 1),
+                      result.nearest.end(), indices[k]);
         }
         if (distinct == 1) {
             line = offset / distance;
@@ -78,6 +85,23 @@ Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& 
     return result;
 }
 
+/// Runs `work(i)` for every i < count, split across the machine's cores.
+template <class Work>
+void inParallel(std::size_t count, const Work& work) {
+    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+    const auto range = [&](std::size_t thread) {
+        const std::size_t last = (thread + 1) * count / threads;
+        for (std::size_t i = thread * count / threads; i < last; ++i) {
+            work(i);
+        }
+    };
+    std::vector<std::jthread> workers;
+    for (std::size_t thread = 1; thread < threads; ++thread) {
+        workers.emplace_back(range, thread);
+    }
+    range(0);
+}
+
 }  // namespace
 
 std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
@@ -88,22 +112,32 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
     }
     const PositionsAdaptor adaptor{positions};
     const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    // Raw distances first (w: the spacing neighbour's, xyz: the across vector), in parallel.
-    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
-    const auto search = [&](std::size_t thread) {
-        const std::size_t first = thread * positions.size() / threads;
-        const std::size_t last = (thread + 1) * positions.size() / threads;
-        for (std::size_t i = first; i < last; ++i) {
-            const Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
-            spacing[i] = glm::vec4(found.across, found.spacingNeighbour);
+    // Raw distances first (w: the spacing neighbour's, xyz: the across vector).
+    std::vector<NearestIndices> nearest(positions.size());
+    inParallel(positions.size(), [&](std::size_t i) {
+        Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
+        if (!std::isfinite(found.spacingNeighbour)) {
+            found.nearest.fill(static_cast<std::uint32_t>(i));
         }
-    };
-    {
-        std::vector<std::jthread> workers;
-        for (std::size_t thread = 1; thread < threads; ++thread) {
-            workers.emplace_back(search, thread);
+        spacing[i] = glm::vec4(found.across, found.spacingNeighbour);
+        nearest[i] = found.nearest;
+    });
+    // The median over the point and its nearest neighbours: a point on a boundary (a
+    // silhouette, a scan's edge) finds its 4th neighbour farther than inside, though the
+    // points there lie no farther apart; most of its neighbours lie inside.
+    std::vector<float> smoothed(positions.size());
+    inParallel(positions.size(), [&](std::size_t i) {
+        std::array<float, kSpacingNeighbour + 1> around{};
+        around[0] = spacing[i].w;
+        for (std::size_t k = 0; k < kSpacingNeighbour; ++k) {
+            around[k + 1] = spacing[nearest[i][k]].w;
         }
-        search(0);
+        const auto middle = around.begin() + kSpacingNeighbour / 2;
+        std::nth_element(around.begin(), middle, around.end());
+        smoothed[i] = *middle;
+    });
+    for (std::size_t i = 0; i < spacing.size(); ++i) {
+        spacing[i].w = smoothed[i];
     }
     std::vector<float> distances;
     distances.reserve(spacing.size());
@@ -127,6 +161,22 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
         const float acrossLength = glm::length(across);
         const bool acrossLines = acrossLength > kLineGapRatio * local && acrossLength < kLargest;
         entry = glm::vec4(acrossLines ? across : glm::vec3(0.0f), local);
+    }
+    return spacing;
+}
+
+PointSpacing estimatePointSpacing(const PointCloud& cloud, std::optional<double> global) {
+    PointSpacing spacing;
+    // Not value_or: it would estimate even when the caller knows h.
+    spacing.global = global ? *global : estimateSpacing(cloud);
+    if (!(spacing.global > 0.0) || !std::isfinite(spacing.global)) {
+        return spacing;
+    }
+    // A few thousand nearest neighbours tell a station from an even scan.
+    constexpr std::size_t kVariationSamples = 4000;
+    if (cloud.size() <= kAlwaysLocalSpacingPoints ||
+        spacingVaries(sampledNearestDistances(cloud, kVariationSamples))) {
+        spacing.local = estimateLocalSpacing(cloud, spacing.global);
     }
     return spacing;
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -11,8 +12,9 @@ namespace subscan {
 
 /// The local spacing of DESIGN.md §4 for clouds whose density varies (LiDAR stations, depth
 /// cameras): per point, in units of the global spacing h,
-///   w    the spacing where the point is: its 4th nearest non-coincident neighbour's distance,
-///        scaled so that over the whole cloud its median is 1 (h itself on an even cloud);
+///   w    the spacing where the point is: the distance to the 4th nearest non-coincident
+///        neighbour, its median over the point and its 4 nearest (a boundary point's own is
+///        too large), scaled so that over the whole cloud its median is 1 (h on an even cloud);
 ///   xyz  where the point lies on a scan line whose neighbouring lines are more than twice w
 ///        away (far ground seen by a station comes as rings), the vector to the nearest point
 ///        across the line: the nearest neighbour more than 45 degrees off the line's direction
@@ -21,14 +23,30 @@ namespace subscan {
 /// the picture: an across gap seen end-on, as from the scanner itself, is small on screen.
 std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h);
 
-/// Whether the cloud's spacing varies enough for estimateLocalSpacing to matter: the 90th
-/// percentile of `sampledNearest` (sampledNearestDistances) over its 10th above
-/// kVaryingSpacingRatio.
+/// Whether the cloud's spacing varies a lot: the 90th percentile of `sampledNearest`
+/// (sampledNearestDistances) over its 10th above kVaryingSpacingRatio.
 bool spacingVaries(std::vector<float> sampledNearest);
 
 /// Even scans (range images, photogrammetry, synthetic object scans) stay below this ratio of
 /// the 90th to the 10th percentile of nearest-neighbour distances; a station's points lie
 /// 10-50 times farther apart at the edge of its range than next to it.
 inline constexpr float kVaryingSpacingRatio = 6.0f;
+
+/// Up to this many points the local spacing is estimated for every cloud (about a second on two
+/// cores): it changes little on even scans and much where density varies moderately (an
+/// airborne scan's tree canopy against its ground). Larger clouds get it only when their
+/// spacing varies a lot, as a station's does.
+inline constexpr std::size_t kAlwaysLocalSpacingPoints = 2'000'000;
+
+/// The spacing the renderer works with: h, and the local spacing (empty where not estimated).
+struct PointSpacing {
+    double global = 0.0;
+    std::vector<glm::vec4> local;
+};
+
+/// h (`global` when given, else estimateSpacing) and the local spacing by the rule of
+/// kAlwaysLocalSpacingPoints.
+PointSpacing estimatePointSpacing(const PointCloud& cloud,
+                                  std::optional<double> global = std::nullopt);
 
 }  // namespace subscan

@@ -7,7 +7,7 @@ namespace subscan {
 
 /// Hidden point removal on the min-depth pyramid (DESIGN.md §5.3): "visibility" is 1 where a
 /// rasterized point is visible, 0 where it is hidden or there is none. "color"'s alpha is the
-/// point's local spacing ratio, which scales its search radius.
+/// point's local spacing ratio, which shrinks its search radius where below 1.
 class HiddenPointRemovalPass final : public RenderPass {
   public:
     explicit HiddenPointRemovalPass(const ShaderSources& sources);

@@ -116,8 +116,7 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
                             "({} per side): lower 'light_map_resolution'",
                             view.width, view.height, limit));
         }
-        const gpu::PyramidLayout& layout =
-            uniforms_.update(view, lightSettings, spacing, cloud);
+        const gpu::PyramidLayout& layout = uniforms_.update(view, lightSettings, spacing, cloud);
         FrameContext frame{view,       cloud,  lightSettings, context_.capabilities(),
                            resources_, layout, spacing};
         frame.cloudPixels = projectedPixelBounds(view, cloudBounds);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
 #include <glm/trigonometric.hpp>
 
 namespace subscan {
@@ -46,13 +48,23 @@ glm::dvec2 reducedPosition(const Camera& output, const Camera& reduced, int divi
 ResolutionChooser::ResolutionChooser(const PointCloud& cloud) {
     const std::size_t count = std::min(cloud.size(), kSampleSize);
     sample_.reserve(count);
+    sampleIndices_.reserve(count);
     for (std::size_t i = 0; i < count; ++i) {
-        sample_.push_back(cloud.positions[i * cloud.size() / count]);
+        sampleIndices_.push_back(i * cloud.size() / count);
+        sample_.push_back(cloud.positions[sampleIndices_.back()]);
+    }
+}
+
+void ResolutionChooser::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
+    localSpacing_.clear();
+    for (const std::size_t index : sampleIndices_) {
+        localSpacing_.push_back(spacing.at(index));
     }
 }
 
 int ResolutionChooser::divisor(Resolution resolution, const Camera& camera,
-                               const glm::dvec3& cloudOrigin, double spacing) const {
+                               const glm::dvec3& cloudOrigin, double spacing,
+                               bool useLocalSpacing) const {
     if (resolution != Resolution::Auto) {
         return resolution == Resolution::Half ? 2 : 1;
     }
@@ -62,15 +74,23 @@ int ResolutionChooser::divisor(Resolution resolution, const Camera& camera,
     const double halfHeight = 0.5 * camera.height;
     std::vector<double> spacingPixels;
     spacingPixels.reserve(sample_.size());
-    for (const glm::vec3& position : sample_) {
-        const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(position), 1.0);
+    const bool local = useLocalSpacing && !localSpacing_.empty();
+    for (std::size_t s = 0; s < sample_.size(); ++s) {
+        const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(sample_[s]), 1.0);
         const double depth = -view.z;
         if (!(depth > camera.nearPlane && depth < camera.farPlane) ||
             std::abs(view.x) * focal > halfWidth * depth ||
             std::abs(view.y) * focal > halfHeight * depth) {
             continue;
         }
-        spacingPixels.push_back(focal * spacing / depth);
+        double ratio = 1.0;
+        if (local) {
+            // RasterizePoints.comp's spacingRatio, for a pinhole camera.
+            const glm::dvec3 across = glm::dmat3(viewFromCloud) * glm::dvec3(localSpacing_[s]);
+            const glm::dvec2 moved = glm::dvec2(across) + glm::dvec2(view) * (across.z / depth);
+            ratio = std::max<double>(localSpacing_[s].w, glm::length(moved));
+        }
+        spacingPixels.push_back(focal * spacing * ratio / depth);
     }
     if (spacingPixels.size() < kFewestInView) {
         return 1;

@@ -5,6 +5,7 @@
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "core/Camera.h"
 #include "core/PointCloud.h"
@@ -32,12 +33,19 @@ class ResolutionChooser {
   public:
     explicit ResolutionChooser(const PointCloud& cloud);
 
-    /// 1 or 2. `spacing` is the point spacing h in scene units.
+    /// Takes the sample's entries of the cloud's local spacing (estimateLocalSpacing).
+    void setLocalSpacing(const std::vector<glm::vec4>& spacing);
+
+    /// 1 or 2. `spacing` is the point spacing h in scene units; with `useLocalSpacing` (and a
+    /// local spacing given) each sample point's own spacing on screen, as the rasterizer
+    /// projects it, stands in for h.
     int divisor(Resolution resolution, const Camera& camera, const glm::dvec3& cloudOrigin,
-                double spacing) const;
+                double spacing, bool useLocalSpacing) const;
 
   private:
     std::vector<glm::vec3> sample_;  // cloud-relative positions
+    std::vector<std::size_t> sampleIndices_;
+    std::vector<glm::vec4> localSpacing_;  // per sample point, empty without
 };
 
 }  // namespace subscan

@@ -6,8 +6,6 @@
 #include <fmt/format.h>
 
 #include "core/Error.h"
-#include "core/LocalSpacing.h"
-#include "core/Spacing.h"
 #include "render/DrawPointsPass.h"
 #include "render/FinishSurfacePass.h"
 #include "render/PresentPass.h"
@@ -23,10 +21,7 @@ namespace subscan {
 namespace {
 
 /// h for the screen-space radii; a cloud without two distinct points still needs a scale.
-double usableSpacing(const PointCloud& cloud, std::optional<double> spacing) {
-    // Not value_or: it would estimate (a k-d tree over every point, seconds for millions) even
-    // when the caller knows h.
-    const double h = spacing ? *spacing : estimateSpacing(cloud);
+double usableSpacing(const PointCloud& cloud, double h) {
     if (h > 0.0 && std::isfinite(h)) {
         return h;
     }
@@ -43,19 +38,25 @@ double FrameResult::totalMilliseconds() const {
 
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<double> spacing,
                    std::size_t maxChunkPoints)
+    : Renderer(context, cloud, estimatePointSpacing(cloud, spacing), maxChunkPoints) {}
+
+Renderer::Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
+                   std::size_t maxChunkPoints)
     : context_(context),
       cloud_(cloud, context.capabilities(), maxChunkPoints),
-      spacing_(usableSpacing(cloud, spacing)),
+      spacing_(usableSpacing(cloud, spacing.global)),
       resolutionChooser_(cloud),
       cloudBounds_(cloud.bounds),
       reconstruction_(sources_, context.capabilities()),
       lightMaps_(context, sources_, reconstruction_) {
-    // A few thousand nearest neighbours tell an even scan (kept on h alone: its local spacing
-    // would only add noise to the radii) from one whose density varies.
-    constexpr std::size_t kVariationSamples = 4000;
-    if (spacingVaries(sampledNearestDistances(cloud, kVariationSamples))) {
-        cloud_.setLocalSpacing(estimateLocalSpacing(cloud, spacing_));
+    if (!spacing.local.empty()) {
+        setLocalSpacing(spacing.local);
     }
+}
+
+void Renderer::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
+    cloud_.setLocalSpacing(spacing);
+    resolutionChooser_.setLocalSpacing(spacing);
 }
 
 Renderer::~Renderer() = default;
@@ -182,10 +183,11 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     }
 
     // The point modes draw every pixel: at reduced resolution they would lose points.
-    const int divisor = reconstructsSurface(settings.raster.mode)
-                            ? resolutionChooser_.divisor(settings.raster.resolution, camera,
-                                                         cloud_.origin(), spacing_)
-                            : 1;
+    const int divisor =
+        reconstructsSurface(settings.raster.mode)
+            ? resolutionChooser_.divisor(settings.raster.resolution, camera, cloud_.origin(),
+                                         spacing_, settings.surface.localSpacing)
+            : 1;
     pipelineCamera_ = divisor == 1 ? camera : reducedCamera(camera, divisor);
     if (!filtersTemporally(settings)) {
         // Frames without the filter move on without it: its history no longer lines up.

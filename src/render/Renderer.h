@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/Camera.h"
+#include "core/LocalSpacing.h"
 #include "core/PointCloud.h"
 #include "gpu/GlContext.h"
 #include "gpu/PassTimer.h"
@@ -47,8 +48,12 @@ struct FrameResult {
 class Renderer {
   public:
     /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` see GpuPointCloud.
+    /// The local spacing is estimated as estimatePointSpacing says.
     Renderer(GlContext& context, const PointCloud& cloud,
              std::optional<double> spacing = std::nullopt, std::size_t maxChunkPoints = 0);
+    /// With the spacing estimated beforehand (off the render thread).
+    Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
+             std::size_t maxChunkPoints = 0);
     ~Renderer();
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a
@@ -67,7 +72,7 @@ class Renderer {
     double spacing() const { return spacing_; }
     /// Gives the cloud the local spacing `spacing` (estimateLocalSpacing's form, one entry per
     /// point) in place of the one the constructor estimated for an uneven cloud, or none.
-    void setLocalSpacing(const std::vector<glm::vec4>& spacing) { cloud_.setLocalSpacing(spacing); }
+    void setLocalSpacing(const std::vector<glm::vec4>& spacing);
     /// The camera of the last frame's pipeline images (all but "image"): the frame's own
     /// camera, or reducedCamera(it, divisor) when it reconstructed at reduced resolution.
     const Camera& pipelineCamera() const { return pipelineCamera_; }

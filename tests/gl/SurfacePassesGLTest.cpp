@@ -179,9 +179,10 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     constexpr double kTie = 1e-4;  // float evaluation of omega differs from double by ~1e-6
     const glm::dvec3 x = harness.viewPosition(px + 0.5, py + 0.5, depth);
     const glm::dvec3 toCamera = glm::normalize(-x);
-    const double levelValue = std::clamp(
-        std::log2(surface.visibilityRadius * kSpacing * spacingRatio * harness.focal() / depth),
-        0.0, static_cast<double>(all.size() - 1));
+    const double levelValue =
+        std::clamp(std::log2(surface.visibilityRadius * kSpacing * std::min(spacingRatio, 1.0) *
+                             harness.focal() / depth),
+                   0.0, static_cast<double>(all.size() - 1));
     if (std::abs(levelValue - std::round(levelValue)) < kTie) {
         return std::nullopt;
     }
@@ -444,13 +445,15 @@ double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, 
     if (!local) {
         return 1.0;
     }
-    for (const Level& level : levels()) {
-        const glm::vec2 texel = pulled[level.offset + y * level.width + x];
-        if (texel.x > 0.0f) {
-            return static_cast<double>(texel.y) / texel.x;
+    const auto all = levels();
+    const auto ratioAt = [&](std::size_t l) {
+        const glm::vec2 texel = pulled[all[l].offset + (y >> l) * all[l].width + (x >> l)];
+        return texel.x > 0.0f ? static_cast<double>(texel.y) / texel.x : -1.0;
+    };
+    for (std::size_t l = 0; l < all.size(); ++l) {
+        if (const double ratio = ratioAt(l); ratio >= 0.0) {
+            return l == 0 || l + 1 == all.size() ? ratio : std::max(ratio, ratioAt(l + 1));
         }
-        x >>= 1;
-        y >>= 1;
     }
     return 1.0;
 }

@@ -4,7 +4,6 @@
 #include <utility>
 
 #include "core/Error.h"
-#include "core/Spacing.h"
 
 namespace subscan::viewer {
 
@@ -32,7 +31,7 @@ void ScanLoadJob::load() {
     };
     try {
         PreparedScan prepared{source_, loadScan(source_, reportProgress), 0.0};
-        prepared.spacing = estimateSpacing(prepared.scan.cloud);
+        prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
         result_ = std::move(prepared);
     } catch (const LoadCancelled&) {
         error_ = std::make_exception_ptr(Error(source_ + ": loading was cancelled"));

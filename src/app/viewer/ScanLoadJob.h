@@ -6,16 +6,17 @@
 #include <string>
 #include <thread>
 
+#include "core/LocalSpacing.h"
 #include "io/ScanLoader.h"
 
 namespace subscan::viewer {
 
-/// A scan as the viewer needs it: the cloud for the GPU upload and its spacing, both made off
-/// the render thread.
+/// A scan as the viewer needs it: the cloud for the GPU upload and its spacing (h and the local
+/// spacing), both made off the render thread.
 struct PreparedScan {
     std::string source;
     LoadedScan scan;
-    double spacing = 0.0;  // estimateSpacing's result (0: the renderer picks a fallback)
+    PointSpacing spacing;  // estimatePointSpacing's result (h = 0: the renderer picks one)
 };
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)

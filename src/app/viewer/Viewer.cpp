@@ -408,9 +408,7 @@ void Viewer::finishLoading() {
         prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, options_.coloring, up);
         const PointCloud& cloud = prepared.scan.cloud;
         // Built before the old one goes, so a failure keeps the scan on screen.
-        auto renderer = std::make_unique<Renderer>(
-            context_, cloud,
-            prepared.spacing > 0.0 ? std::optional<double>(prepared.spacing) : std::nullopt);
+        auto renderer = std::make_unique<Renderer>(context_, cloud, prepared.spacing);
         renderer_ = std::move(renderer);
         bounds_ = cloud.bounds;
         status_.scanSource = prepared.source;

@@ -181,5 +181,18 @@ TEST(LocalSpacingTest, VariationIsFoundInAStationsRangeNotInEvenOrRandomScans) {
     EXPECT_TRUE(spacingVaries(sampledNearestDistances(station.finish(warnings))));
 }
 
+TEST(LocalSpacingTest, PointSpacingTakesAGivenHAndEstimatesTheLocalOneForSmallClouds) {
+    const PointCloud cloud = lines(20, 20, 0.01, 0.01);
+    const PointSpacing given = estimatePointSpacing(cloud, 0.02);
+    EXPECT_EQ(given.global, 0.02);
+    ASSERT_EQ(given.local.size(), cloud.size());
+    EXPECT_EQ(given.local, estimateLocalSpacing(cloud, 0.02));
+    const PointSpacing estimated = estimatePointSpacing(cloud);
+    EXPECT_NEAR(estimated.global, 0.01, 1e-7);  // float positions
+    EXPECT_EQ(estimated.local.size(), cloud.size());
+    // No h, no scale for the local spacing.
+    EXPECT_TRUE(estimatePointSpacing(lines(1, 1, 1.0, 1.0)).local.empty());
+}
+
 }  // namespace
 }  // namespace subscan

@@ -68,8 +68,8 @@ TEST(ReducedResolutionTest, FullAndHalfAreWhatTheySay) {
     const PointCloud cloud = grid(100, 0.01);
     const ResolutionChooser chooser(cloud);
     for (const double distance : {1.0, 100.0}) {
-        EXPECT_EQ(chooser.divisor(Resolution::Full, facing(cloud, distance), {}, 0.01), 1);
-        EXPECT_EQ(chooser.divisor(Resolution::Half, facing(cloud, distance), {}, 0.01), 2);
+        EXPECT_EQ(chooser.divisor(Resolution::Full, facing(cloud, distance), {}, 0.01, false), 1);
+        EXPECT_EQ(chooser.divisor(Resolution::Half, facing(cloud, distance), {}, 0.01, false), 2);
     }
 }
 
@@ -80,10 +80,10 @@ TEST(ReducedResolutionTest, AutoHalvesOnlyWhilePointsAreFourPixelsApartOrMore) {
     // Distances where the grid's points are 4.4 and 3.6 pixels apart (f * h / z).
     const double sparse = focal * 0.01 / 4.4;
     const double dense = focal * 0.01 / 3.6;
-    EXPECT_EQ(chooser.divisor(Resolution::Auto, facing(cloud, sparse), {}, 0.01), 2);
-    EXPECT_EQ(chooser.divisor(Resolution::Auto, facing(cloud, dense), {}, 0.01), 1);
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, facing(cloud, sparse), {}, 0.01, false), 2);
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, facing(cloud, dense), {}, 0.01, false), 1);
     // A close-up where only part of the grid is in view still counts only that part.
-    EXPECT_EQ(chooser.divisor(Resolution::Auto, facing(cloud, 0.2), {}, 0.01), 2);
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, facing(cloud, 0.2), {}, 0.01, false), 2);
 }
 
 TEST(ReducedResolutionTest, AutoKeepsFullResolutionWithoutEvidence) {
@@ -93,11 +93,32 @@ TEST(ReducedResolutionTest, AutoKeepsFullResolutionWithoutEvidence) {
     // eye at z = 0.5): the grid is behind it.
     Camera away = facing(cloud, 0.5);
     away.view = glm::dmat4(-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 0.5, 1);
-    EXPECT_EQ(chooser.divisor(Resolution::Auto, away, {}, 0.01), 1);
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, away, {}, 0.01, false), 1);
     // An empty cloud, and a few points only.
-    EXPECT_EQ(ResolutionChooser(PointCloud{}).divisor(Resolution::Auto, away, {}, 0.01), 1);
+    EXPECT_EQ(ResolutionChooser(PointCloud{}).divisor(Resolution::Auto, away, {}, 0.01, false), 1);
     const PointCloud few = grid(5, 0.01);
-    EXPECT_EQ(ResolutionChooser(few).divisor(Resolution::Auto, facing(few, 0.1), {}, 0.01), 1);
+    EXPECT_EQ(ResolutionChooser(few).divisor(Resolution::Auto, facing(few, 0.1), {}, 0.01, false),
+              1);
+}
+
+TEST(ReducedResolutionTest, AutoUsesEachPointsLocalSpacingOnScreen) {
+    const PointCloud cloud = grid(100, 0.01);
+    const double focal = facing(cloud, 1.0).focalLengthPixels();
+    // Where h puts the points 3.6 pixels apart: full resolution on h alone.
+    const Camera dense = facing(cloud, focal * 0.01 / 3.6);
+    ResolutionChooser chooser(cloud);
+    ASSERT_EQ(chooser.divisor(Resolution::Auto, dense, {}, 0.01, true), 1);  // none given yet
+    // Twice h everywhere: 7.2 pixels apart, half resolution; unless told to use h alone.
+    chooser.setLocalSpacing(std::vector<glm::vec4>(cloud.size(), glm::vec4(0, 0, 0, 2)));
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, dense, {}, 0.01, true), 2);
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, dense, {}, 0.01, false), 1);
+    // Lines 3 h apart across y, seen face-on: the projected across vector decides (10.8 px)...
+    chooser.setLocalSpacing(std::vector<glm::vec4>(cloud.size(), glm::vec4(0, 3, 0, 1)));
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, dense, {}, 0.01, true), 2);
+    // ...and seen end-on (the vector along the view direction, at the image's centre) it
+    // counts for nothing: the points are 3.6 pixels apart.
+    chooser.setLocalSpacing(std::vector<glm::vec4>(cloud.size(), glm::vec4(0, 0, 3, 1)));
+    EXPECT_EQ(chooser.divisor(Resolution::Auto, dense, {}, 0.01, true), 1);
 }
 
 }  // namespace
