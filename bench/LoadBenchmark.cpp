@@ -3,9 +3,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include <glm/vec4.hpp>
+
+#include "core/LocalSpacing.h"
+#include "core/Spacing.h"
 #include "io/LasReader.h"
 #include "io/MappedFile.h"
 #include "io/ReadContext.h"
@@ -90,6 +95,48 @@ BENCHMARK_CAPTURE(loadFile, happy_binary_ply, std::string("happy_stand_registere
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(loadFile, bunny_ascii_ply, std::string("bun_zipper.ply"))
     ->Unit(benchmark::kMillisecond);
+
+/// What the renderer adds to a load: h (estimateSpacing), and with `local` also the local
+/// spacing (estimateLocalSpacing, on every core). `source` is a file name in the data folder
+/// or synthetic:NAME.
+void pointSpacing(benchmark::State& state, const std::string& source, bool local) {
+    const bool synthetic = source.starts_with("synthetic:");
+    const std::filesystem::path path = dataDirectory() / source;
+    if (!synthetic && !std::filesystem::exists(path)) {
+        state.SkipWithError(("missing " + path.string()).c_str());
+        return;
+    }
+    const subscan::LoadedScan scan = subscan::loadScan(synthetic ? source : path.string());
+    for (auto _ : state) {
+        const double h = subscan::estimateSpacing(scan.cloud);
+        benchmark::DoNotOptimize(h);
+        if (local) {
+            const std::vector<glm::vec4> spacing = subscan::estimateLocalSpacing(scan.cloud, h);
+            benchmark::DoNotOptimize(spacing.data());
+        }
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * scan.cloud.size()));
+    state.counters["points"] = static_cast<double>(scan.cloud.size());
+}
+
+BENCHMARK_CAPTURE(pointSpacing, autzen_h, std::string("autzen_trim.las"), false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pointSpacing, autzen_h_and_local, std::string("autzen_trim.las"), true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pointSpacing, station_h, std::string("synthetic:outdoor-station"), false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pointSpacing, station_h_and_local, std::string("synthetic:outdoor-station"), true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pointSpacing, happy_h, std::string("happy_stand_registered.ply"), false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pointSpacing, happy_h_and_local, std::string("happy_stand_registered.ply"), true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

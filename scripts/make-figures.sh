@@ -20,13 +20,9 @@ build/tools/subscan_figures materials "$scan" docs/images/materials-happy.png --
 build/tools/subscan_figures single "$scan" docs/images/single-happy.png --yaw 0 --pitch 10 --distance 0.18 --size 320 420
 build/tools/subscan_figures shadows "$scan" docs/images/shadows-happy.png --yaw 0 --pitch 10 --distance 0.3 --size 300 460
 build/tools/subscan_figures backlit "$scan" docs/images/backlit-happy.png --yaw 0 --pitch 10 --distance 0.3 --size 300 460
-# The depth camera's table scene from render's default orbit and from its own sensor.
-table="$data/table_scene_mug_stereo_textured.pcd"
-if [[ -f "$table" ]]; then
-    tmp=$(mktemp -d)
-    build/src/subscan render "$table" --mode surface --width 480 --height 360 -o "$tmp/orbit.png" 2>/dev/null
-    build/src/subscan render "$table" --mode surface --view sensor --width 480 --height 360 -o "$tmp/sensor.png" 2>/dev/null
-    /usr/bin/python3 - "$tmp/orbit.png" "$tmp/sensor.png" docs/images/sensor-table.png <<'PY'
+# Two renders side by side, 8 white pixels between them.
+side_by_side() {
+    /usr/bin/python3 - "$1" "$2" "$3" <<'PY'
 import sys
 from PIL import Image
 left, right = Image.open(sys.argv[1]).convert("RGB"), Image.open(sys.argv[2]).convert("RGB")
@@ -35,6 +31,32 @@ pair.paste(left, (0, 0))
 pair.paste(right, (left.width + 8, 0))
 pair.save(sys.argv[3])
 PY
-    rm -r "$tmp"
+}
+tmp=$(mktemp -d)
+trap 'rm -r "$tmp"' EXIT
+# The depth camera's table scene from render's default orbit and from its own sensor.
+table="$data/table_scene_mug_stereo_textured.pcd"
+if [[ -f "$table" ]]; then
+    build/src/subscan render "$table" --mode surface --width 480 --height 360 -o "$tmp/orbit.png" 2>/dev/null
+    build/src/subscan render "$table" --mode surface --view sensor --width 480 --height 360 -o "$tmp/sensor.png" 2>/dev/null
+    side_by_side "$tmp/orbit.png" "$tmp/sensor.png" docs/images/sensor-table.png
 fi
+# The local spacing: the global h (left) against it (right), on autzen's trees from close by
+# and on the virtual LiDAR station from where it stood.
+echo '{"surface": {"local_spacing": false}}' >"$tmp/global.json"
+autzen="$data/autzen_trim.las"
+if [[ -f "$autzen" ]]; then
+    for kind in global local; do
+        settings=()
+        [[ $kind == global ]] && settings=(--settings "$tmp/global.json")
+        build/src/subscan render "$autzen" --mode surface --pitch 50 --distance 250 --width 560 --height 420 "${settings[@]}" -o "$tmp/autzen-$kind.png"
+    done
+    side_by_side "$tmp/autzen-global.png" "$tmp/autzen-local.png" docs/images/local-spacing-autzen.png
+fi
+for kind in global local; do
+    settings=()
+    [[ $kind == global ]] && settings=(--settings "$tmp/global.json")
+    build/src/subscan render synthetic:outdoor-station --mode surface --view sensor --width 480 --height 360 "${settings[@]}" -o "$tmp/station-$kind.png"
+done
+side_by_side "$tmp/station-global.png" "$tmp/station-local.png" docs/images/local-spacing-station.png
 ls -1 docs/images

@@ -11,12 +11,15 @@ layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexe
 vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
 float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
 
-/// The local spacing around `pixel` in units of h (1 without local spacing): a point's own, and
-/// for a pixel in a gap that of the visible points in the finest texel above it that holds any
-/// or in that texel's parent, whichever is larger: a gap between sparse points (a canopy) next
-/// to dense ones (the ground it hides in part) must take the sparse points' spacing, and the
-/// finest texel often holds only dense ones (measured on tests/gl/LocalSpacingGLTest.cpp's
-/// canopy: 115 pixels of background left from the finest texel alone, 7 with its parent).
+/// The local spacing around `pixel` in units of h (1 without local spacing), for the fill's
+/// expected gap and the normals' smoothing: a point's own, and for a pixel in a gap that of the
+/// visible points in the finest texel above it that holds any or in that texel's parent,
+/// whichever is larger: a gap between sparse points (a canopy) next to dense ones (the ground it
+/// hides in part) must take the sparse points' spacing, and the finest texel often holds only
+/// dense ones (measured on tests/gl/LocalSpacingGLTest.cpp's canopy: 115 pixels of background
+/// left from the finest texel alone, 7 with its parent). Never below 1: where overlapping
+/// strips or scans interleave, points lie closer than h but leave gaps of h between them
+/// (autzen's meadow showed holes).
 float spacingRatioAt(ivec2 pixel) {
     if (surface.spacing.y < 0.5) {
         return 1.0;
@@ -25,12 +28,12 @@ float spacingRatioAt(ivec2 pixel) {
         vec2 pulled = texelFetch(pullWeightTexels, int(texelIndex(level, pixel >> level))).rg;
         if (pulled.x > 0.0) {
             float ratio = pulled.y / pulled.x;
-            if (level == 0u || level + 1u >= levelCount()) {
-                return ratio;
+            if (level > 0u && level + 1u < levelCount()) {
+                vec2 parent = texelFetch(pullWeightTexels,
+                                         int(texelIndex(level + 1u, pixel >> (level + 1u)))).rg;
+                ratio = max(ratio, parent.y / parent.x);
             }
-            vec2 parent =
-                texelFetch(pullWeightTexels, int(texelIndex(level + 1u, pixel >> (level + 1u)))).rg;
-            return max(ratio, parent.y / parent.x);
+            return max(ratio, 1.0);
         }
     }
     return 1.0;

@@ -27,6 +27,10 @@ constexpr std::size_t kSpacingNeighbour = 4;
 constexpr float kAcrossCosine = 0.70710678f;
 /// Gaps across lines up to this many spacings are ordinary irregularity, not scan lines.
 constexpr float kLineGapRatio = 2.0f;
+/// Spacings within this factor of h are an even scan's sampling noise, not a change of density:
+/// they count as h itself, so that an even scan renders as with h alone (measured on the
+/// bunny's vertices, 1024², 8 views: without it, leakage 0.020 -> 0.025 and 0.7 dB less).
+constexpr float kEvenSpread = 1.5f;
 /// Half floats (the GPU's copy) end at 65504.
 constexpr float kLargest = 6.0e4f;
 
@@ -156,7 +160,10 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
     const auto inverseH = static_cast<float>(1.0 / h);
     for (glm::vec4& entry : spacing) {
         // A point without neighbours (a cloud of repeated points) keeps the global h.
-        const float local = std::isfinite(entry.w) ? std::min(entry.w / median, kLargest) : 1.0f;
+        float local = std::isfinite(entry.w) ? std::min(entry.w / median, kLargest) : 1.0f;
+        if (local > 1.0f / kEvenSpread && local < kEvenSpread) {
+            local = 1.0f;
+        }
         const glm::vec3 across = glm::vec3(entry) * inverseH;
         const float acrossLength = glm::length(across);
         const bool acrossLines = acrossLength > kLineGapRatio * local && acrossLength < kLargest;

@@ -14,7 +14,8 @@ namespace subscan {
 /// cameras): per point, in units of the global spacing h,
 ///   w    the spacing where the point is: the distance to the 4th nearest non-coincident
 ///        neighbour, its median over the point and its 4 nearest (a boundary point's own is
-///        too large), scaled so that over the whole cloud its median is 1 (h on an even cloud);
+///        too large), scaled so that over the whole cloud its median is 1, and 1 where within
+///        a factor 1.5 of that (an even scan's sampling noise);
 ///   xyz  where the point lies on a scan line whose neighbouring lines are more than twice w
 ///        away (far ground seen by a station comes as rings), the vector to the nearest point
 ///        across the line: the nearest neighbour more than 45 degrees off the line's direction

@@ -180,8 +180,13 @@ Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up
     camera.fovyDegrees = fovyDegrees;
     glm::dvec3 upVector = up == UpAxis::Y ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
     glm::dvec3 direction = target - sensor.position;
-    if (glm::length(direction) <= 1e-9 * std::max(diagonal, 1.0)) {
-        // At the middle of the points (a scanner station inside its scene): look at the front.
+    if (nearestInBox == sensor.position) {
+        // A station inside its scene sees all round: look level, towards the middle's azimuth
+        // (the middle itself may lie straight above, where a tower raises the box).
+        direction -= glm::dot(direction, upVector) * upVector;
+    }
+    if (glm::length(direction) <= 1e-6 * std::max(diagonal, 1e-9)) {
+        // At the middle of the points: look at the front.
         direction = up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
     }
     direction = glm::normalize(direction);

@@ -47,9 +47,10 @@ PinholeFit fitPinhole(const PointCloud& cloud, const OrganisedGrid& grid);
 /// image; a scanner's organised grid (rows of angles, not a pinhole) misses by far more.
 inline constexpr double kPinholeToleranceRmsPixels = 1.0;
 
-/// The view from `sensor`: towards the middle of the points' framing box, `up` kept upright
-/// (or the orbit's front direction when looking straight along it), near and far around the
-/// points. Throws subscan::Error when the sensor lies more than 20 box diagonals from the
+/// The view from `sensor`: towards the middle of the points' framing box (level, towards its
+/// azimuth, from a sensor inside the points' bounds: a station amid its scene), `up` kept
+/// upright (or the orbit's front direction when looking straight along it), near and far around
+/// the points. Throws subscan::Error when the sensor lies more than 20 box diagonals from the
 /// points (a default or unrelated pose: the points would be a speck).
 Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up, int width,
                     int height, double fovyDegrees);

@@ -169,7 +169,13 @@ LoadedScan loadScan(std::string_view source, const std::function<void(double)>& 
     LoadedScan scan;
     try {
         if (source.starts_with(kSyntheticPrefix)) {
-            scan.cloud = makeSyntheticScene(source.substr(kSyntheticPrefix.size()));
+            SyntheticSource synthetic = makeSyntheticSource(source.substr(kSyntheticPrefix.size()));
+            if (synthetic.scanner.mode == ScannerSettings::Mode::Station) {
+                scan.sensor =
+                    SensorPose{stationPosition(*synthetic.scene, synthetic.scanner.station),
+                               "the virtual station"};
+            }
+            scan.cloud = std::move(synthetic.points);
             scan.format = "synthetic";
             scan.formatDetail = fmt::format("built-in scene {}", source);
         } else {

@@ -101,8 +101,21 @@ CloudHandle meshArgument(const py::handle& argument, std::string_view command) {
 /// `subscan scan SCENE -o OUT.ply [options]`, returning the cloud it would write.
 CloudHandle scanSceneArgument(const py::object& sceneArgument, int views, int resolution,
                               const py::object& noise, const std::string& color, bool normals,
-                              std::uint64_t seed) {
+                              std::uint64_t seed, const std::string& mode,
+                              const py::object& station, const py::object& airborne) {
     ScannerSettings settings;
+    const std::optional<ScannerSettings::Mode> scannerMode = parseScannerMode(mode);
+    if (!scannerMode) {
+        throw py::value_error(fmt::format("mode '{}' is not object, station or airborne", mode));
+    }
+    settings.mode = *scannerMode;
+    // The scanner settings' JSON form (as `subscan scan --settings` reads it).
+    if (!station.is_none()) {
+        argumentErrors([&] { from_json(toJson(station, "station"), settings.station); });
+    }
+    if (!airborne.is_none()) {
+        argumentErrors([&] { from_json(toJson(airborne, "airborne"), settings.airborne); });
+    }
     settings.views = views;
     settings.resolution = resolution;
     settings.normals = normals;
@@ -262,11 +275,15 @@ ValueError for an unknown material or one without measured coefficients.
 )doc");
     module.def("scan", &scanSceneArgument, py::arg("scene"), py::kw_only(), py::arg("views") = 8,
                py::arg("resolution") = 512, py::arg("noise") = 0.0, py::arg("color") = "auto",
-               py::arg("normals") = false, py::arg("seed") = 1, R"doc(
-The virtual structured-light scanner (`subscan scan`): a Cloud scanned from `scene`, which is
-'synthetic:NAME', a mesh file, or a Cloud with triangles. views: scanner positions;
-resolution: rays per side of each view; noise: range noise in metres (a number) or in scan
-spacings ('0.1h'); color: 'auto', 'none', 'scene' or 'marble'; normals: keep true normals.
+               py::arg("normals") = false, py::arg("seed") = 1, py::arg("mode") = "object",
+               py::arg("station") = py::none(), py::arg("airborne") = py::none(), R"doc(
+The virtual scanner (`subscan scan`): a Cloud scanned from `scene`, which is 'synthetic:NAME', a
+mesh file, or a Cloud with triangles. views: scanner positions; resolution: rays per side of
+each view; noise: range noise in metres (a number) or in scan spacings ('0.1h'); color:
+'auto', 'none', 'scene' or 'marble'; normals: keep true normals. mode: 'object' (the
+structured-light scanner around the object), 'station' (one terrestrial LiDAR station) or
+'airborne' (one airborne strip); station and airborne: their settings as the scanner settings'
+JSON names them, e.g. station={'position': [0, 1.5, 0], 'azimuth_steps': 900}.
 )doc");
     module.def("evaluate", &evaluateMesh, py::arg("mesh"), py::kw_only(),
                py::arg("points") = "vertices", py::arg("views") = 8, py::arg("width") = 1024,

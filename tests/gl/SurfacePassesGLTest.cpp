@@ -452,7 +452,8 @@ double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, 
     };
     for (std::size_t l = 0; l < all.size(); ++l) {
         if (const double ratio = ratioAt(l); ratio >= 0.0) {
-            return l == 0 || l + 1 == all.size() ? ratio : std::max(ratio, ratioAt(l + 1));
+            return std::max(l == 0 || l + 1 == all.size() ? ratio : std::max(ratio, ratioAt(l + 1)),
+                            1.0);
         }
     }
     return 1.0;

@@ -43,6 +43,29 @@ def test_scan_is_the_cli_scan(cli, tmp_path):
     np.testing.assert_array_equal(cloud.normals, expected.normals)
 
 
+@pytest.mark.parametrize("mode, cli_options, settings", [
+    ("station", ["--station", 5, 1.5, 3, "--azimuth-steps", 360, "--elevation-steps", 60],
+     {"position": [5, 1.5, 3], "azimuth_steps": 360, "elevation_steps": 60}),
+    ("airborne", ["--line-spacing", 4, "--points-per-line", 120],
+     {"line_spacing": 4, "points_per_line": 120}),
+])
+def test_lidar_scans_are_the_cli_scans(cli, tmp_path, mode, cli_options, settings):
+    cli("scan", "synthetic:outdoor", "-o", tmp_path / "scan.ply", "--mode", mode, *cli_options)
+    expected = subscan.load(tmp_path / "scan.ply")
+    cloud = subscan.scan("synthetic:outdoor", mode=mode, **{mode: settings})
+    assert len(cloud) == len(expected) > 1000
+    # float32 file coordinates in the PLY, as above.
+    tolerance = np.abs(expected.points).max() * 2.0 ** -23
+    np.testing.assert_allclose(cloud.points, expected.points, rtol=0, atol=tolerance)
+
+
+def test_bad_lidar_scans_raise_value_error():
+    with pytest.raises(ValueError, match="mode 'lidar' is not object, station or airborne"):
+        subscan.scan("synthetic:outdoor", mode="lidar")
+    with pytest.raises(ValueError, match="'station.azimuth' is not a scanner setting"):
+        subscan.scan("synthetic:outdoor", mode="station", station={"azimuth": 3})
+
+
 def test_scan_of_a_cloud_with_triangles_and_bad_scans(cli, tmp_path):
     points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], dtype=float)
     mesh = subscan.Cloud(points, triangles=[[0, 1, 2], [1, 3, 2]])

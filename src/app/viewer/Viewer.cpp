@@ -307,12 +307,7 @@ void Viewer::handleKey(int key) {
             camera_.frameAll(size.x, size.y);
             break;
         case GLFW_KEY_V:
-            if (sensorLook_) {
-                camera_.lookFrom(sensorLook_->first, sensorLook_->second);
-                notify("the view from the scan's sensor");
-            } else {
-                notify("this scan records no sensor position");
-            }
+            lookFromSensor();
             break;
         case GLFW_KEY_P:
             pendingScreenshots_.push_back(nextScreenshotPath());
@@ -463,6 +458,7 @@ void Viewer::runScriptCommand(const ScriptCommand& command) {
                    },
                    [&](const script::Reset&) { camera_.reset(size.x, size.y); },
                    [&](const script::FrameAll&) { camera_.frameAll(size.x, size.y); },
+                   [&](const script::Sensor&) { lookFromSensor(); },
                    [&](const script::Resize& resize) { resizeWindow(resize.width, resize.height); },
                    [&](const script::Screenshot& screenshot) {
                        pendingScreenshots_.push_back(screenshot.path);
@@ -491,6 +487,15 @@ void Viewer::changeSettings(const std::string& patch) {
     } catch (const nlohmann::json::exception& error) {
         fail(fmt::format("the script's settings do not fit the settings file's form: {}",
                          error.what()));
+    }
+}
+
+void Viewer::lookFromSensor() {
+    if (sensorLook_) {
+        camera_.lookFrom(sensorLook_->first, sensorLook_->second);
+        notify("the view from the scan's sensor");
+    } else {
+        notify("this scan records no sensor position");
     }
 }
 

@@ -100,6 +100,8 @@ class Viewer {
     /// settings file is; an impossible result is an error and changes nothing.
     void changeSettings(const std::string& patch);
     void resizeWindow(int width, int height);
+    /// `V`: the camera to where the scan was taken, or a note that it records no such place.
+    void lookFromSensor();
     void flyWithKeys(double seconds);
 
     /// The panel's settings with the scattering settings in effect (AppliedScattering): what

@@ -35,6 +35,7 @@ struct Pick {  // a double click: orbit around the surface under the cursor
 };
 struct Reset {};     // `R`
 struct FrameAll {};  // `F`
+struct Sensor {};    // `V`: the view from the scan's sensor
 struct Resize {
     int width = 0;
     int height = 0;
@@ -65,8 +66,8 @@ struct Exit {};
 
 using ScriptCommand =
     std::variant<script::Orbit, script::Pan, script::Zoom, script::Pick, script::Reset,
-                 script::FrameAll, script::Resize, script::Screenshot, script::SetMode,
-                 script::ShowPanel, script::Light, script::Settings, script::Exit>;
+                 script::FrameAll, script::Sensor, script::Resize, script::Screenshot,
+                 script::SetMode, script::ShowPanel, script::Light, script::Settings, script::Exit>;
 
 struct ScriptAction {
     /// Frames count from the first frame that shows the scan (0); the actions of a frame run

@@ -38,10 +38,11 @@ TEST(ViewerScriptTest, ReadsEveryActionInFrameOrder) {
         {"frame": 9, "action": "resize", "width": 320, "height": 200},
         {"frame": 9, "action": "mode", "mode": "sss"},
         {"frame": 9, "action": "panel", "show": false},
+        {"frame": 10, "action": "sensor"},
         {"frame": 10, "action": "exit"}
     ])"));
-    ASSERT_EQ(actions.size(), 13u);
-    const int frames[] = {0, 2, 5, 5, 6, 6, 7, 7, 8, 9, 9, 9, 10};
+    ASSERT_EQ(actions.size(), 14u);
+    const int frames[] = {0, 2, 5, 5, 6, 6, 7, 7, 8, 9, 9, 9, 10, 10};
     for (std::size_t i = 0; i < actions.size(); ++i) {
         EXPECT_EQ(actions[i].frame, frames[i]) << "action " << i;
     }
@@ -69,7 +70,8 @@ TEST(ViewerScriptTest, ReadsEveryActionInFrameOrder) {
     EXPECT_EQ(resize.height, 200);
     EXPECT_EQ(std::get<script::SetMode>(actions[10].command).mode, RenderMode::Sss);
     EXPECT_FALSE(std::get<script::ShowPanel>(actions[11].command).show);
-    EXPECT_TRUE(std::holds_alternative<script::Exit>(actions[12].command));
+    EXPECT_TRUE(std::holds_alternative<script::Sensor>(actions[12].command));
+    EXPECT_TRUE(std::holds_alternative<script::Exit>(actions[13].command));
 }
 
 TEST(ViewerScriptTest, ReadsTheLightDragAndSettingsChanges) {

@@ -117,9 +117,8 @@ TEST(LocalSpacingTest, RepeatedPointsAreLookedPast) {
     }
 }
 
-TEST(LocalSpacingTest, SpacingFollowsTheDensity) {
-    // Two even patches, the second four times sparser: w is 4x as large there as in the
-    // first, relative to the median (the dense patch holds more points, so the median is its).
+/// A 40 x 40 patch of step 0.01 and, beside it, a 20 x 20 patch of step `sparseStep`.
+PointCloud twoPatches(double sparseStep) {
     PointCloudBuilder builder({}, 40 * 40 + 20 * 20);
     for (int i = 0; i < 40; ++i) {
         for (int j = 0; j < 40; ++j) {
@@ -131,16 +130,31 @@ TEST(LocalSpacingTest, SpacingFollowsTheDensity) {
     for (int i = 0; i < 20; ++i) {
         for (int j = 0; j < 20; ++j) {
             PointRecord record;
-            record.position = {5.0 + i * 0.04, j * 0.04, 0.0};
+            record.position = {5.0 + i * sparseStep, j * sparseStep, 0.0};
             builder.add(record);
         }
     }
     std::vector<std::string> warnings;
-    const PointCloud cloud = builder.finish(warnings);
+    return builder.finish(warnings);
+}
+
+TEST(LocalSpacingTest, SpacingFollowsTheDensity) {
+    // The second patch four times sparser: w is 4x as large there as in the first, relative
+    // to the median (the dense patch holds more points, so the median is its).
+    const PointCloud cloud = twoPatches(0.04);
     const std::vector<glm::vec4> spacing = estimateLocalSpacing(cloud, estimateSpacing(cloud));
     // Centres of each patch (float positions: 1e-4 relative).
     EXPECT_NEAR(spacing[20 * 40 + 20].w, 1.0f, 1e-4f);
     EXPECT_NEAR(spacing[1600 + 10 * 20 + 10].w, 4.0f, 4e-4f);
+}
+
+TEST(LocalSpacingTest, SpacingWithinAFactorOneAndAHalfOfHCountsAsH) {
+    // 1.4 times sparser: an even scan's sampling noise, h itself; 1.6 times: a density.
+    const PointCloud even = twoPatches(0.014);
+    EXPECT_EQ(estimateLocalSpacing(even, estimateSpacing(even))[1600 + 10 * 20 + 10].w, 1.0f);
+    const PointCloud uneven = twoPatches(0.016);
+    EXPECT_NEAR(estimateLocalSpacing(uneven, estimateSpacing(uneven))[1600 + 10 * 20 + 10].w, 1.6f,
+                2e-4f);
 }
 
 TEST(LocalSpacingTest, DegenerateCloudsKeepTheGlobalSpacing) {

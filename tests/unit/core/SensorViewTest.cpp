@@ -186,5 +186,40 @@ TEST(SensorViewTest, SensorCameraLooksFromTheSensorAtThePoints) {
     }
 }
 
+TEST(SensorViewTest, AStationAmidItsPointsLooksLevelTowardsTheirMiddle) {
+    // Ground 60 x 60 m around the station (1.5 m above it, Y up), a 30 m tower straight above
+    // the station's feet raising the framing box's middle to 15 m, and a building 45 m east.
+    PointCloudBuilder builder({}, 4000);
+    const auto add = [&](const glm::dvec3& position) {
+        PointRecord record;
+        record.position = position;
+        builder.add(record);
+    };
+    for (int i = 0; i < 60; ++i) {
+        for (int j = 0; j < 60; ++j) {
+            add({i - 30.0, 0.0, j - 30.0});
+        }
+    }
+    for (int k = 0; k <= 30; ++k) {
+        add({0.0, k, 0.0});
+    }
+    for (int k = 0; k < 10; ++k) {
+        for (int j = 0; j < 10; ++j) {
+            add({45.0, k, j - 5.0});  // the building's wall
+        }
+    }
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    const SensorPose station{{0.0, 1.5, 0.0}, "the test's station"};
+    const Camera camera = sensorCamera(cloud, station, UpAxis::Y, 320, 200, 60.0);
+    // Level: the view direction has no vertical part; it faces the middle's azimuth (+X here,
+    // where the building widens the box).
+    const glm::dvec3 forward = -glm::dvec3(glm::transpose(glm::dmat3(camera.view))[2]);
+    EXPECT_NEAR(forward.y, 0.0, 1e-9);
+    const glm::dvec3 middle = framingBounds(cloud).center();
+    const glm::dvec3 level = glm::normalize(glm::dvec3(middle.x, 0.0, middle.z));
+    EXPECT_NEAR(glm::dot(forward, level), 1.0, 1e-9);
+}
+
 }  // namespace
 }  // namespace subscan

@@ -7,6 +7,8 @@
 
 #include "core/Error.h"
 #include "io/ScanLoader.h"
+#include "scan/SyntheticScenes.h"
+#include "scan/VirtualScanner.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
@@ -122,6 +124,15 @@ TEST(ScanLoaderTest, SyntheticScenes) {
     EXPECT_THAT(loadError("synthetic:sphere?points=12x"), HasSubstr("not a point count"));
     EXPECT_THAT(loadError("synthetic:sphere?size=3"),
                 HasSubstr("unknown synthetic scene parameter"));
+    EXPECT_FALSE(sphere.sensor);  // an object scan has no one place it was taken from
+}
+
+TEST(ScanLoaderTest, ASyntheticStationRecordsWhereItStood) {
+    const LoadedScan scan = loadScan("synthetic:outdoor-station?points=2000");
+    ASSERT_TRUE(scan.sensor);
+    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=2000");
+    EXPECT_EQ(scan.sensor->position, stationPosition(*source.scene, source.scanner.station));
+    EXPECT_FALSE(loadScan("synthetic:outdoor-airborne?points=2000").sensor);
 }
 
 }  // namespace
