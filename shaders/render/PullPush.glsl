@@ -17,7 +17,7 @@ float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index))
 /// whichever is larger: a gap between sparse points (a canopy) next to dense ones (the ground it
 /// hides in part) must take the sparse points' spacing, and the finest texel often holds only
 /// dense ones (measured on tests/gl/LocalSpacingGLTest.cpp's canopy: 115 pixels of background
-/// left from the finest texel alone, 7 with its parent). Never below 1: where overlapping
+/// left from the finest texel alone, 3 to 7 with its parent). Never below 1: where overlapping
 /// strips or scans interleave, points lie closer than h but leave gaps of h between them
 /// (autzen's meadow showed holes).
 float spacingRatioAt(ivec2 pixel) {

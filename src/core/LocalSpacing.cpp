@@ -43,14 +43,16 @@ struct Neighbourhood {
                                // when fewer)
 };
 
-/// The nearest neighbour of `point` across its line among `found` neighbours sorted by distance,
-/// or nothing; also the kSpacingNeighbour-th non-coincident distance.
+/// The nearest neighbour of `point` across its line among `found` neighbours sorted by distance
+/// (true when there is one), and the kSpacingNeighbour-th non-coincident distance (or the last
+/// one found).
 bool scanNeighbours(const std::vector<glm::vec3>& positions, const glm::vec3& point,
                     const std::uint32_t* indices, const float* squared, std::size_t found,
                     Neighbourhood& result) {
     std::size_t distinct = 0;
     glm::vec3 line{0.0f};
-    for (std::size_t k = 0; k < found; ++k) {
+    bool acrossFound = false;
+    for (std::size_t k = 0; k < found && !(acrossFound && distinct >= kSpacingNeighbour); ++k) {
         if (!(squared[k] > 0.0f)) {
             continue;
         }
@@ -64,12 +66,12 @@ bool scanNeighbours(const std::vector<glm::vec3>& positions, const glm::vec3& po
         }
         if (distinct == 1) {
             line = offset / distance;
-        } else if (std::abs(glm::dot(offset, line)) < kAcrossCosine * distance) {
+        } else if (!acrossFound && std::abs(glm::dot(offset, line)) < kAcrossCosine * distance) {
             result.across = offset;
-            return true;
+            acrossFound = true;
         }
     }
-    return false;
+    return acrossFound;
 }
 
 Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& positions,

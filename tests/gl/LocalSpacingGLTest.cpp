@@ -98,7 +98,7 @@ TEST(LocalSpacingGLTest, ASparseCanopyOverDenseGroundLeavesNoHoles) {
                 withGlobal.background, withGlobal.pixels, withLocal.background);
     // The global h leaves holes (the scene reproduces the artefact: measured 1854 of 2309
     // pixels); the local spacing fills all but single pixels where ground and canopy meet
-    // (measured 7).
+    // (measured 3).
     EXPECT_GT(withGlobal.background, withGlobal.pixels / 2);
     EXPECT_LT(withLocal.background, withLocal.pixels / 100);
 }
