@@ -238,6 +238,31 @@ TEST_F(ViewerTest, ScriptedOrbitAndZoomMoveTheCameraAndScreenshotsShowIt) {
     EXPECT_LT(differingFraction(orbited, readPng(path("rendered.png")), 8), 0.005);
 }
 
+TEST_F(ViewerTest, TheColouringChoiceRecoloursThePointsAsRenderDoes) {
+    const auto script = writeScript(nlohmann::json::array({
+        {{"frame", 0}, {"action", "screenshot"}, {"path", path("own.png")}},
+        {{"frame", 1}, {"action", "color"}, {"color", "height"}},
+        {{"frame", 1}, {"action", "screenshot"}, {"path", path("height.png")}},
+        {{"frame", 1}, {"action", "exit"}},
+    }));
+    const CommandResult result =
+        view({kScan, "--mode", "surface", "--width", "320", "--height", "240", "--hide-panel",
+              "--script", script.string(), "--exit-after-frames", kFrameLimit, "--settings",
+              withoutTemporalFilter()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const Image8 own = readPng(path("own.png"));
+    const Image8 height = readPng(path("height.png"));
+    // The sculpture's own marble against the height ramp: most of its pixels change.
+    EXPECT_GT(differingFraction(own, height, 24), 0.5 * foregroundFraction(own));
+    // `subscan render --color height` from the screenshot's camera makes the same picture.
+    const CommandResult render =
+        runSubscan({"render", kScan, "-o", path("rendered.png"), "--color", "height", "--camera",
+                    path("height.camera.json"), "--settings", path("height.settings.json")});
+    ASSERT_EQ(render.exitCode, 0) << render.err;
+    // Both run on llvmpipe; a pixel may only differ where atomics resolve a tie differently.
+    EXPECT_LT(differingFraction(height, readPng(path("rendered.png")), 8), 0.005);
+}
+
 TEST_F(ViewerTest, ResizingTheWindowReallocatesThePipeline) {
     const auto script = writeScript(nlohmann::json::array({
         {{"frame", 0}, {"action", "screenshot"}, {"path", path("small.png")}},

@@ -400,11 +400,17 @@ void Viewer::finishLoading() {
         }
         const UpAxis up =
             options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
+        std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
         prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, options_.coloring, up);
-        const PointCloud& cloud = prepared.scan.cloud;
         // Built before the old one goes, so a failure keeps the scan on screen.
-        auto renderer = std::make_unique<Renderer>(context_, cloud, prepared.spacing);
+        auto renderer = std::make_unique<Renderer>(context_, prepared.scan.cloud, prepared.spacing);
         renderer_ = std::move(renderer);
+        scan_ = std::move(prepared.scan.cloud);
+        scanColors_ = std::move(fileColors);
+        scanSpacing_ = std::move(prepared.spacing);
+        scanUp_ = up;
+        status_.coloring = options_.coloring;
+        const PointCloud& cloud = scan_;
         bounds_ = cloud.bounds;
         status_.scanSource = prepared.source;
         status_.scanFormat =
@@ -459,6 +465,7 @@ void Viewer::runScriptCommand(const ScriptCommand& command) {
                    [&](const script::Reset&) { camera_.reset(size.x, size.y); },
                    [&](const script::FrameAll&) { camera_.frameAll(size.x, size.y); },
                    [&](const script::Sensor&) { lookFromSensor(); },
+                   [&](const script::Color& color) { applyColoring(color.coloring); },
                    [&](const script::Resize& resize) { resizeWindow(resize.width, resize.height); },
                    [&](const script::Screenshot& screenshot) {
                        pendingScreenshots_.push_back(screenshot.path);
@@ -488,6 +495,18 @@ void Viewer::changeSettings(const std::string& patch) {
         fail(fmt::format("the script's settings do not fit the settings file's form: {}",
                          error.what()));
     }
+}
+
+void Viewer::applyColoring(Coloring coloring) {
+    if (!renderer_) {
+        return;
+    }
+    scan_.colors = scanColors_;
+    scan_.colors = pointColors(scan_, coloring, scanUp_);
+    renderer_ = std::make_unique<Renderer>(context_, scan_, scanSpacing_);
+    status_.coloring = coloring;
+    renderedCamera_.reset();
+    notify("points coloured by " + toString(coloring));
 }
 
 void Viewer::lookFromSensor() {
@@ -617,6 +636,9 @@ void Viewer::drawPanel() {
         pendingOpen_ = requests.openScan;
     }
     try {
+        if (requests.coloring) {
+            applyColoring(*requests.coloring);
+        }
         if (requests.saveSettings) {
             // A file of refused settings would not load again; the panel's are the ones the
             // user means, so they are not swapped for the applied ones either.

@@ -144,7 +144,16 @@ class Viewer {
     bool redrawEveryFrame_ = false;
     Navigation navigation_ = Navigation::Orbit;
 
-    // The scan on screen.
+    /// Colours the scan's points by `coloring` (the panel's choice; the file's own colours
+    /// stay in scanColors_) and uploads it again with its spacing.
+    void applyColoring(Coloring coloring);
+
+    // The scan on screen: its points as loaded, their own colours, the spacing and up axis
+    // they were prepared with (a new colouring uploads them again).
+    PointCloud scan_;
+    std::vector<Rgba8> scanColors_;
+    PointSpacing scanSpacing_;
+    UpAxis scanUp_ = UpAxis::Y;
     std::unique_ptr<Renderer> renderer_;
     PanelStatus status_;
     Bounds bounds_;

@@ -241,6 +241,18 @@ void ViewerPanel::drawScan(const PanelStatus& status, PanelRequests& requests) {
         ImGui::TextWrapped("%s", status.scanFormat.c_str());
         ImGui::Text("%s points, h = %.4g", groupedThousands(status.points).c_str(), status.spacing);
         ImGui::Text("loaded in %.0f ms", status.loadMilliseconds);
+        constexpr Coloring kColorings[] = {Coloring::Auto,           Coloring::Rgb,
+                                           Coloring::Intensity,      Coloring::Height,
+                                           Coloring::Classification, Coloring::Uniform};
+        Coloring coloring = status.coloring;
+        if (choiceCombo("colour", coloring, std::span<const Coloring>(kColorings),
+                        [](Coloring c) { return toString(c); })) {
+            requests.coloring = coloring;
+        }
+        helpTooltip(
+            "What the points' colours show: auto (their own, else height for Z-up data, else "
+            "grey), rgb, intensity, height (a ramp along the up axis), classification (ASPRS "
+            "colours), uniform.");
     }
     if (status.loadingSource) {
         ImGui::TextWrapped("loading %s", status.loadingSource->c_str());

@@ -7,6 +7,7 @@
 
 #include <glm/vec2.hpp>
 
+#include "core/Coloring.h"
 #include "gpu/PassTimer.h"
 #include "render/RenderSettings.h"
 
@@ -24,6 +25,7 @@ struct PanelStatus {
     std::size_t points = 0;
     double spacing = 0.0;
     double loadMilliseconds = 0.0;
+    Coloring coloring = Coloring::Auto;        // what the points' colours show
     std::optional<std::string> loadingSource;  // a load in progress
     double loadingProgress = 0.0;
     std::string glRenderer;
@@ -69,6 +71,7 @@ struct PanelRequests {
     bool resetView = false;
     bool frameAll = false;
     std::optional<std::string> openScan;
+    std::optional<Coloring> coloring;  // show the points coloured by this instead
     std::optional<std::string> loadSettings;
     std::optional<std::string> saveSettings;
 };

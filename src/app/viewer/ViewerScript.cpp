@@ -17,8 +17,8 @@ namespace subscan::viewer {
 namespace {
 
 constexpr std::string_view kActionNames =
-    "orbit, pan, zoom, pick, reset, frame, sensor, resize, screenshot, mode, panel, light, "
-    "settings, exit";
+    "orbit, pan, zoom, pick, reset, frame, sensor, color, resize, screenshot, mode, panel, "
+    "light, settings, exit";
 // Beyond this a window is a typo, not a request (and larger than any GPU's texture limit).
 constexpr int kMaxWindowSide = 16384;
 
@@ -148,6 +148,10 @@ ScriptCommand parseCommand(const std::string& name, const ActionReader& reader) 
     if (name == "sensor") {
         reader.allowOnly({});
         return script::Sensor{};
+    }
+    if (name == "color") {
+        reader.allowOnly({"color"});
+        return script::Color{parseColoring(reader.text("color"))};
     }
     if (name == "resize") {
         reader.allowOnly({"width", "height"});

@@ -9,6 +9,7 @@
 #include <glm/vec2.hpp>
 #include <nlohmann/json_fwd.hpp>
 
+#include "core/Coloring.h"
 #include "render/RenderSettings.h"
 
 namespace subscan::viewer {
@@ -36,6 +37,9 @@ struct Pick {  // a double click: orbit around the surface under the cursor
 struct Reset {};     // `R`
 struct FrameAll {};  // `F`
 struct Sensor {};    // `V`: the view from the scan's sensor
+struct Color {       // the panel's "colour" choice
+    Coloring coloring = Coloring::Auto;
+};
 struct Resize {
     int width = 0;
     int height = 0;
@@ -66,8 +70,9 @@ struct Exit {};
 
 using ScriptCommand =
     std::variant<script::Orbit, script::Pan, script::Zoom, script::Pick, script::Reset,
-                 script::FrameAll, script::Sensor, script::Resize, script::Screenshot,
-                 script::SetMode, script::ShowPanel, script::Light, script::Settings, script::Exit>;
+                 script::FrameAll, script::Sensor, script::Color, script::Resize,
+                 script::Screenshot, script::SetMode, script::ShowPanel, script::Light,
+                 script::Settings, script::Exit>;
 
 struct ScriptAction {
     /// Frames count from the first frame that shows the scan (0); the actions of a frame run

@@ -39,10 +39,11 @@ TEST(ViewerScriptTest, ReadsEveryActionInFrameOrder) {
         {"frame": 9, "action": "mode", "mode": "sss"},
         {"frame": 9, "action": "panel", "show": false},
         {"frame": 10, "action": "sensor"},
+        {"frame": 10, "action": "color", "color": "height"},
         {"frame": 10, "action": "exit"}
     ])"));
-    ASSERT_EQ(actions.size(), 14u);
-    const int frames[] = {0, 2, 5, 5, 6, 6, 7, 7, 8, 9, 9, 9, 10, 10};
+    ASSERT_EQ(actions.size(), 15u);
+    const int frames[] = {0, 2, 5, 5, 6, 6, 7, 7, 8, 9, 9, 9, 10, 10, 10};
     for (std::size_t i = 0; i < actions.size(); ++i) {
         EXPECT_EQ(actions[i].frame, frames[i]) << "action " << i;
     }
@@ -71,7 +72,8 @@ TEST(ViewerScriptTest, ReadsEveryActionInFrameOrder) {
     EXPECT_EQ(std::get<script::SetMode>(actions[10].command).mode, RenderMode::Sss);
     EXPECT_FALSE(std::get<script::ShowPanel>(actions[11].command).show);
     EXPECT_TRUE(std::holds_alternative<script::Sensor>(actions[12].command));
-    EXPECT_TRUE(std::holds_alternative<script::Exit>(actions[13].command));
+    EXPECT_EQ(std::get<script::Color>(actions[13].command).coloring, Coloring::Height);
+    EXPECT_TRUE(std::holds_alternative<script::Exit>(actions[14].command));
 }
 
 TEST(ViewerScriptTest, ReadsTheLightDragAndSettingsChanges) {
