@@ -21,7 +21,7 @@ float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index))
 /// strips or scans interleave, points lie closer than h but leave gaps of h between them
 /// (autzen's meadow showed holes).
 float spacingRatioAt(ivec2 pixel) {
-    if (surface.spacing.y < 0.5) {
+    if (surface.spacing.x < 0.5) {
         return 1.0;
     }
     for (uint level = 0u; level < levelCount(); ++level) {

@@ -63,7 +63,7 @@ layout(binding = SUBSCAN_TEXELS_LOCAL_SPACING) uniform samplerBuffer localSpacin
 /// to first order (window = f xy / d at distance d: the offset a moves it by f / d * (a.xy +
 /// xy * a.z / d)), which an across vector pointing behind the eye cannot break.
 float spacingRatio(uint local) {
-    if (surface.spacing.y < 0.5) {
+    if (surface.spacing.x < 0.5) {
         return 1.0;
     }
     int first = 3 * int(local);
@@ -76,8 +76,8 @@ float spacingRatio(uint local) {
     vec2 moved = frame.depthRange.w > 0.0
                      ? across.xy
                      : across.xy + viewPosition.xy * (across.z / distance);
-    // Both lengths in units of h times f / distance.
-    return max(spacing.w, length(moved));
+    // Both lengths in units of h times f / distance; the image holds half floats.
+    return min(max(spacing.w, length(moved)), 6.0e4);
 }
 
 void main() {

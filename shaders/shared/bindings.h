@@ -119,15 +119,16 @@ struct PyramidLayout {
 };
 
 // The reconstruction passes (HiddenPointRemoval, PullPush, FillRemoval, Normals). World radii
-// are in scene units for the global spacing h; with local spacing each pixel scales them by
-// its local spacing ratio (RasterizePoints.comp, PullPush.glsl). Each pass turns its radius into a pyramid level per
-// pixel: level = log2(radius * focal length / depth).
+// are in scene units for the global spacing h; with local spacing each pixel's ratio
+// (RasterizePoints.comp) shrinks HPR's (min(ratio, 1)) and grows the fill's and the normals'
+// (PullPush.glsl's spacingRatioAt, at least 1). Each pass turns its radius into a pyramid
+// level per pixel: level = log2(radius * focal length / depth).
 struct SurfaceParams {
     vec4 visibility;  // x: HPR radius, y: threshold tau, z: edge rule (1 or 0), w: unused
     vec4 fill;        // x: radius of the expected gap, y: directions that must find points,
                       // z: pull depth slope (texel widths), w: unused
     vec4 normals;     // x: smoothing radius
-    vec4 spacing;     // x: h (scene units), y: 1 when the points carry their local spacing
+    vec4 spacing;     // x: 1 when the points carry their local spacing, else 0
 };
 
 // Deferred shading; directions are in view space, pointing towards the light.

@@ -41,6 +41,7 @@ struct Neighbourhood {
     glm::vec3 across{0.0f};
     NearestIndices nearest{};  // the first kSpacingNeighbour non-coincident ones (repeated
                                // when fewer)
+    std::size_t distinct = 0;  // non-coincident neighbours looked at
 };
 
 /// The nearest neighbour of `point` across its line among `found` neighbours sorted by distance
@@ -59,6 +60,7 @@ bool scanNeighbours(const std::vector<glm::vec3>& positions, const glm::vec3& po
         const glm::vec3 offset = positions[indices[k]] - point;
         const float distance = std::sqrt(squared[k]);
         ++distinct;
+        result.distinct = distinct;
         if (distinct <= kSpacingNeighbour) {
             result.spacingNeighbour = distance;
             std::fill(result.nearest.begin() + static_cast<std::ptrdiff_t>(distinct - 1),
@@ -80,8 +82,11 @@ Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& 
     std::array<float, kWideNeighbours> squared{};
     Neighbourhood result;
     const std::size_t found = tree.knnSearch(&point.x, kNeighbours, indices.data(), squared.data());
-    if (scanNeighbours(positions, point, indices.data(), squared.data(), found, result) ||
-        found < kNeighbours) {
+    const bool across =
+        scanNeighbours(positions, point, indices.data(), squared.data(), found, result);
+    // Wider when no neighbour lay across the line, or copies of points (overlapping scans)
+    // left fewer than the spacing neighbour.
+    if ((across && result.distinct >= kSpacingNeighbour) || found < kNeighbours) {
         return result;
     }
     const std::size_t wide =

@@ -10,8 +10,9 @@
 
 namespace subscan {
 
-/// The local spacing of DESIGN.md §4 for clouds whose density varies (LiDAR stations, depth
-/// cameras): per point, in units of the global spacing h,
+/// The local spacing of DESIGN.md §4, for clouds whose density varies (LiDAR stations, depth
+/// cameras, an airborne scan's canopy over its ground): per point, in units of the global
+/// spacing h,
 ///   w    the spacing where the point is: the distance to the 4th nearest non-coincident
 ///        neighbour, its median over the point and its 4 nearest (a boundary point's own is
 ///        too large), scaled so that over the whole cloud its median is 1, and 1 where within
@@ -33,8 +34,8 @@ bool spacingVaries(std::vector<float> sampledNearest);
 /// 10-50 times farther apart at the edge of its range than next to it.
 inline constexpr float kVaryingSpacingRatio = 6.0f;
 
-/// Up to this many points the local spacing is estimated for every cloud (about a second on two
-/// cores): it changes little on even scans and much where density varies moderately (an
+/// Up to this many points the local spacing is estimated for every cloud (about two seconds on
+/// two cores, bench/README.md): it changes little on even scans and much where density varies moderately (an
 /// airborne scan's tree canopy against its ground). Larger clouds get it only when their
 /// spacing varies a lot, as a station's does.
 inline constexpr std::size_t kAlwaysLocalSpacingPoints = 2'000'000;

@@ -37,7 +37,8 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
     params.fill = {surface.fillRadius * h, static_cast<float>(surface.fillDirections),
                    surface.pullDepthSlope, 0.0f};
     params.normals = {surface.normalRadius * h, 0.0f, 0.0f, 0.0f};
-    params.spacing = {h, surface.localSpacing && cloud.hasLocalSpacing() ? 1.0f : 0.0f, 0.0f, 0.0f};
+    params.spacing = {surface.localSpacing && cloud.hasLocalSpacing() ? 1.0f : 0.0f, 0.0f, 0.0f,
+                      0.0f};
     surface_.set(params);
     surface_.bind(SUBSCAN_UBO_SURFACE);
     return pyramid_;

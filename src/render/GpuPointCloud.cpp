@@ -84,6 +84,16 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
     }
 }
 
+void GpuPointCloud::setColors(const std::vector<Rgba8>& colors) {
+    if (colors.size() != size_) {
+        throw Error(fmt::format("{} colours given to a cloud of {} points", colors.size(), size_));
+    }
+    for (Chunk& chunk : chunks_) {
+        chunk.colors = Buffer(chunk.pointCount * sizeof(std::uint32_t), &colors[chunk.firstPoint],
+                              "points.colors");
+    }
+}
+
 void GpuPointCloud::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
     if (spacing.size() != size_) {
         throw Error(fmt::format("local spacing for {} points given to a cloud of {}",

@@ -16,8 +16,8 @@ namespace subscan {
 /// A point cloud on the GPU, split into chunks that each fit one buffer texture and one
 /// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8. The
 /// rasterizer reads both as buffer textures (Buffer::bindTexels), the GL_POINTS baseline as
-/// vertex attributes. Clouds of uneven density also carry each point's local spacing
-/// (estimateLocalSpacing) as four half floats.
+/// vertex attributes. A cloud may also carry each point's local spacing (estimateLocalSpacing)
+/// as four half floats.
 class GpuPointCloud {
   public:
     struct Chunk {
@@ -33,6 +33,8 @@ class GpuPointCloud {
     GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
                   std::size_t maxChunkPoints = 0);
 
+    /// Replaces the points' colours (sRGB-encoded, one per point), e.g. for another colouring.
+    void setColors(const std::vector<Rgba8>& colors);
     /// Uploads estimateLocalSpacing's result, one entry per point.
     void setLocalSpacing(const std::vector<glm::vec4>& spacing);
     bool hasLocalSpacing() const { return hasLocalSpacing_; }

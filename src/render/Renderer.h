@@ -71,8 +71,10 @@ class Renderer {
     const GlCapabilities& capabilities() const { return context_.capabilities(); }
     double spacing() const { return spacing_; }
     /// Gives the cloud the local spacing `spacing` (estimateLocalSpacing's form, one entry per
-    /// point) in place of the one the constructor estimated for an uneven cloud, or none.
+    /// point) in place of the one the constructor estimated, or none.
     void setLocalSpacing(const std::vector<glm::vec4>& spacing);
+    /// Replaces the points' colours (one per point, sRGB-encoded): another colouring.
+    void setColors(const std::vector<Rgba8>& colors) { cloud_.setColors(colors); }
     /// The camera of the last frame's pipeline images (all but "image"): the frame's own
     /// camera, or reducedCamera(it, divisor) when it reconstructed at reduced resolution.
     const Camera& pipelineCamera() const { return pipelineCamera_; }

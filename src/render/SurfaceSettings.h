@@ -24,8 +24,8 @@ struct SurfaceSettings {
     int fillDirections = 8;            // of 8 directions, how many must find points
     float normalRadius = 1.5f;         // normal smoothing (x h)
     bool restrictToPoints = true;      // passes skip the screen outside the points' bounds
-    // Radii scale with each point's local spacing where the renderer has it (clouds of uneven
-    // density, Renderer), instead of the one global h.
+    // Radii scale with each point's local spacing where the renderer has it
+    // (estimatePointSpacing), instead of the one global h.
     bool localSpacing = true;
 
     bool operator==(const SurfaceSettings&) const = default;

@@ -4,6 +4,7 @@
 // the canopy's wider gaps: background shows through as dark squares, each around an isolated
 // canopy point. With the local spacing the canopy's gaps fill.
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>

@@ -20,10 +20,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Camera.h"
+#include "io/CameraJson.h"
 #include "io/Image.h"
+#include "scan/SyntheticScenes.h"
+#include "scan/VirtualScanner.h"
 #include "support/TestSupport.h"
 
 extern char** environ;
@@ -261,6 +266,33 @@ TEST_F(ViewerTest, TheColouringChoiceRecoloursThePointsAsRenderDoes) {
     ASSERT_EQ(render.exitCode, 0) << render.err;
     // Both run on llvmpipe; a pixel may only differ where atomics resolve a tie differently.
     EXPECT_LT(differingFraction(height, readPng(path("rendered.png")), 8), 0.005);
+}
+
+TEST_F(ViewerTest, TheSensorActionLooksFromTheVirtualStation) {
+    const std::string station = "synthetic:outdoor-station?points=20000";
+    const auto script = writeScript(nlohmann::json::array({
+        {{"frame", 0}, {"action", "sensor"}},
+        {{"frame", 0}, {"action", "screenshot"}, {"path", path("sensor.png")}},
+        {{"frame", 0}, {"action", "exit"}},
+    }));
+    const CommandResult result =
+        view({station, "--mode", "surface", "--width", "160", "--height", "120", "--hide-panel",
+              "--script", script.string(), "--exit-after-frames", kFrameLimit});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    const Camera camera = readCameraFile(path("sensor.camera.json"));
+    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=20000");
+    // camera.json keeps the view matrix in double: the eye is the station to rounding.
+    EXPECT_LT(glm::length(camera.eye() - stationPosition(*source.scene, source.scanner.station)),
+              1e-6);
+    EXPECT_GT(foregroundFraction(readPng(path("sensor.png"))), 0.3);  // it sees the scene
+    // Looking where `render --view sensor` looks (the field of view is the viewer's own).
+    const CommandResult render =
+        runSubscan({"render", station, "--view", "sensor", "--mode", "points", "-o",
+                    path("render.png"), "--export-buffers", path("render")});
+    ASSERT_EQ(render.exitCode, 0) << render.err;
+    const Camera rendered = readCameraFile(path("render/camera.json"));
+    const auto forward = [](const Camera& c) { return glm::dvec3(glm::inverse(c.view)[2]); };
+    EXPECT_NEAR(glm::dot(forward(camera), forward(rendered)), 1.0, 1e-9);
 }
 
 TEST_F(ViewerTest, ResizingTheWindowReallocatesThePipeline) {

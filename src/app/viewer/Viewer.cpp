@@ -400,6 +400,8 @@ void Viewer::finishLoading() {
         }
         const UpAxis up =
             options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
+        // Before the cloud moves on: an organised grid's camera is fitted to its points.
+        std::optional<std::pair<glm::dvec3, glm::dvec3>> look = sensorLook(prepared.scan, up);
         std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
         prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, options_.coloring, up);
         // Built before the old one goes, so a failure keeps the scan on screen.
@@ -407,8 +409,8 @@ void Viewer::finishLoading() {
         renderer_ = std::move(renderer);
         scan_ = std::move(prepared.scan.cloud);
         scanColors_ = std::move(fileColors);
-        scanSpacing_ = std::move(prepared.spacing);
         scanUp_ = up;
+        sensorLook_ = std::move(look);
         status_.coloring = options_.coloring;
         const PointCloud& cloud = scan_;
         bounds_ = cloud.bounds;
@@ -421,7 +423,6 @@ void Viewer::finishLoading() {
         const glm::ivec2 size = viewportSize();
         camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
                                framingBounds(cloud));
-        sensorLook_ = sensorLook(prepared.scan, up);
         renderedCamera_.reset();
         renderedImage_ = false;
         glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());
@@ -503,7 +504,7 @@ void Viewer::applyColoring(Coloring coloring) {
     }
     scan_.colors = scanColors_;
     scan_.colors = pointColors(scan_, coloring, scanUp_);
-    renderer_ = std::make_unique<Renderer>(context_, scan_, scanSpacing_);
+    renderer_->setColors(scan_.colors);
     status_.coloring = coloring;
     renderedCamera_.reset();
     notify("points coloured by " + toString(coloring));

@@ -145,14 +145,13 @@ class Viewer {
     Navigation navigation_ = Navigation::Orbit;
 
     /// Colours the scan's points by `coloring` (the panel's choice; the file's own colours
-    /// stay in scanColors_) and uploads it again with its spacing.
+    /// stay in scanColors_) and uploads the new colours.
     void applyColoring(Coloring coloring);
 
-    // The scan on screen: its points as loaded, their own colours, the spacing and up axis
-    // they were prepared with (a new colouring uploads them again).
+    // The scan on screen: its points as loaded, their own colours and the up axis (what a new
+    // colouring is made from).
     PointCloud scan_;
     std::vector<Rgba8> scanColors_;
-    PointSpacing scanSpacing_;
     UpAxis scanUp_ = UpAxis::Y;
     std::unique_ptr<Renderer> renderer_;
     PanelStatus status_;

@@ -104,6 +104,7 @@ TEST(LocalSpacingTest, RandomPointsMatchABruteForceReference) {
             w = 1.0;
             ++snapped;
         }
+        // Float positions against double: ~1e-6 relative in each distance.
         EXPECT_NEAR(spacing[i].w, w, 1e-4 * w) << i;
         const glm::dvec3 expected =
             glm::length(across[i]) / h > 2.0 * w ? across[i] / h : glm::dvec3(0.0);
@@ -167,7 +168,7 @@ TEST(LocalSpacingTest, LinesTenStepsApartAreFound) {
 }
 
 TEST(LocalSpacingTest, LinesThirtyStepsApartAreFoundByTheWiderSearch) {
-    // 60 points of the own line lie nearer than the next one: past the first 24 neighbours.
+    // 60 points of the own line lie nearer than the next one: past the first 12 neighbours.
     expectLinesFound(30.0);
 }
 
@@ -191,6 +192,7 @@ TEST(LocalSpacingTest, RepeatedPointsAreLookedPast) {
             // Both copies find the same neighbours (at equal distances the order may differ,
             // the lengths not).
             for (const std::size_t copy : {i, i + single.size()}) {
+                // Float positions: ~1e-6 relative.
                 EXPECT_NEAR(doubled[copy].w, single[i].w, 1e-4f) << i;
                 EXPECT_NEAR(glm::length(glm::vec3(doubled[copy])),
                             glm::length(glm::vec3(single[i])), 1e-3f)
@@ -235,7 +237,7 @@ TEST(LocalSpacingTest, SpacingWithinAFactorOneAndAHalfOfHCountsAsH) {
     // 1.4 times sparser: an even scan's sampling noise, h itself; 1.6 times: a density.
     const PointCloud even = twoPatches(0.014);
     EXPECT_EQ(estimateLocalSpacing(even, estimateSpacing(even))[1600 + 10 * 20 + 10].w, 1.0f);
-    const PointCloud uneven = twoPatches(0.016);
+    const PointCloud uneven = twoPatches(0.016);  // float positions: ~1e-6 relative below
     EXPECT_NEAR(estimateLocalSpacing(uneven, estimateSpacing(uneven))[1600 + 10 * 20 + 10].w, 1.6f,
                 2e-4f);
 }
