@@ -10,6 +10,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include "core/LocalSpacing.h"
 #include "core/PointCloud.h"
 #include "core/SensorView.h"
 #include "render/RenderSettings.h"
@@ -30,6 +31,9 @@ class CloudData {
     /// estimateSpacing(cloud()), computed on the first call (call without the GIL: it may take
     /// a second on millions of points; std::call_once makes concurrent first calls wait).
     double spacing() const;
+    /// estimatePointSpacing with that h: the local spacing too where the renderer wants it,
+    /// computed once for every Renderer of this cloud (call without the GIL).
+    const PointSpacing& pointSpacing() const;
 
     /// Where the file says its sensor stood and an organised cloud's grid (subscan.load), for
     /// Camera.sensor; empty for clouds made from arrays.
@@ -41,6 +45,8 @@ class CloudData {
     std::string format_;
     mutable std::once_flag spacingOnce_;
     mutable double spacing_ = 0.0;
+    mutable std::once_flag pointSpacingOnce_;
+    mutable PointSpacing pointSpacing_;
 };
 
 using CloudHandle = std::shared_ptr<CloudData>;

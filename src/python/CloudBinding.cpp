@@ -27,6 +27,12 @@ double CloudData::spacing() const {
     return spacing_;
 }
 
+const PointSpacing& CloudData::pointSpacing() const {
+    std::call_once(pointSpacingOnce_,
+                   [this] { pointSpacing_ = estimatePointSpacing(cloud_, spacing()); });
+    return pointSpacing_;
+}
+
 std::string pathArgument(const py::handle& argument) {
     try {
         return py::module_::import("os").attr("fspath")(argument).cast<std::string>();

@@ -66,8 +66,9 @@ class RendererState {
         options.debugOutput = glDebugOutputRequested();
         context_ = createHeadlessContext(options);
         const CurrentContext current(*context_);
-        // The cloud's own estimate of h, the one the CLI's renderer makes: the same pictures.
-        renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->spacing());
+        // The cloud's own estimate of h and local spacing, the ones the CLI's renderer makes:
+        // the same pictures.
+        renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing());
     }
     ~RendererState() {
         try {
