@@ -179,20 +179,37 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
     return spacing;
 }
 
-PointSpacing estimatePointSpacing(const PointCloud& cloud, std::optional<double> global) {
+namespace {
+
+/// `h` and, by the rule of kAlwaysLocalSpacingPoints, the local spacing; `sampledNearest`
+/// gives sampled nearest distances when a large cloud needs them.
+template <class SampledNearest>
+PointSpacing withLocalSpacing(const PointCloud& cloud, double h, SampledNearest&& sampledNearest) {
     PointSpacing spacing;
-    // Not value_or: it would estimate even when the caller knows h.
-    spacing.global = global ? *global : estimateSpacing(cloud);
-    if (!(spacing.global > 0.0) || !std::isfinite(spacing.global)) {
+    spacing.global = h;
+    if (!(h > 0.0) || !std::isfinite(h)) {
         return spacing;
+    }
+    if (cloud.size() <= kAlwaysLocalSpacingPoints || spacingVaries(sampledNearest())) {
+        spacing.local = estimateLocalSpacing(cloud, h);
+    }
+    return spacing;
+}
+
+}  // namespace
+
+PointSpacing estimatePointSpacing(const PointCloud& cloud, std::optional<double> global) {
+    if (!global) {
+        return estimatePointSpacing(cloud, sampleSpacing(cloud));
     }
     // A few thousand nearest neighbours tell a station from an even scan.
     constexpr std::size_t kVariationSamples = 4000;
-    if (cloud.size() <= kAlwaysLocalSpacingPoints ||
-        spacingVaries(sampledNearestDistances(cloud, kVariationSamples))) {
-        spacing.local = estimateLocalSpacing(cloud, spacing.global);
-    }
-    return spacing;
+    return withLocalSpacing(cloud, *global,
+                            [&] { return sampledNearestDistances(cloud, kVariationSamples); });
+}
+
+PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample) {
+    return withLocalSpacing(cloud, sample.h, [&] { return sample.nearest; });
 }
 
 bool spacingVaries(std::vector<float> sampledNearest) {

@@ -7,6 +7,7 @@
 #include <glm/vec4.hpp>
 
 #include "core/PointCloud.h"
+#include "core/Spacing.h"
 
 namespace subscan {
 
@@ -35,9 +36,9 @@ bool spacingVaries(std::vector<float> sampledNearest);
 inline constexpr float kVaryingSpacingRatio = 6.0f;
 
 /// Up to this many points the local spacing is estimated for every cloud (about two seconds on
-/// two cores, bench/README.md): it changes little on even scans and much where density varies moderately (an
-/// airborne scan's tree canopy against its ground). Larger clouds get it only when their
-/// spacing varies a lot, as a station's does.
+/// two cores, bench/README.md): it changes little on even scans and much where density varies
+/// moderately (an airborne scan's tree canopy against its ground). Larger clouds get it only when
+/// their spacing varies a lot, as a station's does.
 inline constexpr std::size_t kAlwaysLocalSpacingPoints = 2'000'000;
 
 /// The spacing the renderer works with: h, and the local spacing (empty where not estimated).
@@ -50,5 +51,8 @@ struct PointSpacing {
 /// kAlwaysLocalSpacingPoints.
 PointSpacing estimatePointSpacing(const PointCloud& cloud,
                                   std::optional<double> global = std::nullopt);
+/// The same from sampleSpacing's result: its distances decide whether a large cloud's
+/// spacing varies, so that no second search is needed.
+PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample);
 
 }  // namespace subscan

@@ -1,6 +1,7 @@
 #include "core/PointCloud.h"
 
 #include <algorithm>
+#include <array>
 #include <vector>
 
 #include <fmt/format.h>
@@ -90,20 +91,27 @@ Bounds framingBounds(const PointCloud& cloud) {
         return cloud.bounds;
     }
     const std::size_t stride = std::max<std::size_t>(1, cloud.size() / kSample);
-    std::vector<float> values;
-    values.reserve(cloud.size() / stride + 1);
+    // One pass over the sample for all three axes: on 10 M points each sampled point is a
+    // cache miss, which one pass per axis paid three times.
+    std::array<std::vector<float>, 3> values;
+    for (std::vector<float>& axisValues : values) {
+        axisValues.reserve(cloud.size() / stride + 1);
+    }
+    for (std::size_t i = 0; i < cloud.size(); i += stride) {
+        for (int axis = 0; axis < 3; ++axis) {
+            values[static_cast<std::size_t>(axis)].push_back(cloud.positions[i][axis]);
+        }
+    }
     Bounds framed;
     for (int axis = 0; axis < 3; ++axis) {
-        values.clear();
-        for (std::size_t i = 0; i < cloud.size(); i += stride) {
-            values.push_back(cloud.positions[i][axis]);
-        }
-        const auto low = static_cast<std::ptrdiff_t>(kTail * static_cast<double>(values.size()));
-        const auto high = static_cast<std::ptrdiff_t>(values.size()) - 1 - low;
-        std::nth_element(values.begin(), values.begin() + low, values.end());
-        framed.min[axis] = cloud.origin[axis] + values[static_cast<std::size_t>(low)];
-        std::nth_element(values.begin(), values.begin() + high, values.end());
-        framed.max[axis] = cloud.origin[axis] + values[static_cast<std::size_t>(high)];
+        std::vector<float>& axisValues = values[static_cast<std::size_t>(axis)];
+        const auto low =
+            static_cast<std::ptrdiff_t>(kTail * static_cast<double>(axisValues.size()));
+        const auto high = static_cast<std::ptrdiff_t>(axisValues.size()) - 1 - low;
+        std::nth_element(axisValues.begin(), axisValues.begin() + low, axisValues.end());
+        framed.min[axis] = cloud.origin[axis] + axisValues[static_cast<std::size_t>(low)];
+        std::nth_element(axisValues.begin(), axisValues.begin() + high, axisValues.end());
+        framed.max[axis] = cloud.origin[axis] + axisValues[static_cast<std::size_t>(high)];
     }
     return framed;
 }

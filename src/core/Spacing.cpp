@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <span>
 #include <thread>
@@ -246,23 +247,31 @@ std::vector<float> sampledNearestSquared(const PointCloud& cloud, std::size_t ma
 
 }  // namespace
 
-std::vector<float> sampledNearestDistances(const PointCloud& cloud, std::size_t maxSamples) {
-    std::vector<float> nearest = sampledNearestSquared(cloud, maxSamples);
-    for (float& distance : nearest) {
-        distance = std::sqrt(distance);
+SpacingSample sampleSpacing(const PointCloud& cloud, std::size_t maxSamples) {
+    SpacingSample sample;
+    const std::vector<float> squared = sampledNearestSquared(cloud, maxSamples);
+    // h from the squared distances (sqrt in double), as it always was: the same h to the bit.
+    std::vector<float> known;
+    known.reserve(squared.size());
+    std::copy_if(squared.begin(), squared.end(), std::back_inserter(known),
+                 [](float distance) { return distance != kUnknown; });
+    if (!known.empty()) {
+        const auto middle = known.begin() + static_cast<std::ptrdiff_t>(known.size() / 2);
+        std::nth_element(known.begin(), middle, known.end());
+        sample.h = std::sqrt(static_cast<double>(*middle));
     }
-    return nearest;
+    sample.nearest.resize(squared.size());
+    std::transform(squared.begin(), squared.end(), sample.nearest.begin(),
+                   [](float distance) { return std::sqrt(distance); });
+    return sample;
+}
+
+std::vector<float> sampledNearestDistances(const PointCloud& cloud, std::size_t maxSamples) {
+    return sampleSpacing(cloud, maxSamples).nearest;
 }
 
 double estimateSpacing(const PointCloud& cloud, std::size_t maxSamples) {
-    std::vector<float> nearest = sampledNearestSquared(cloud, maxSamples);
-    std::erase(nearest, kUnknown);
-    if (nearest.empty()) {
-        return 0.0;
-    }
-    const auto middle = nearest.begin() + static_cast<std::ptrdiff_t>(nearest.size() / 2);
-    std::nth_element(nearest.begin(), middle, nearest.end());
-    return std::sqrt(static_cast<double>(*middle));
+    return sampleSpacing(cloud, maxSamples).h;
 }
 
 }  // namespace subscan

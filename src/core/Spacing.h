@@ -18,4 +18,12 @@ double estimateSpacing(const PointCloud& cloud, std::size_t maxSamples = 20000);
 /// is none.
 std::vector<float> sampledNearestDistances(const PointCloud& cloud, std::size_t maxSamples = 20000);
 
+/// estimateSpacing's h and the sampledNearestDistances it is the median of, from one search
+/// (what deciding on the local spacing needs too).
+struct SpacingSample {
+    double h = 0.0;
+    std::vector<float> nearest;
+};
+SpacingSample sampleSpacing(const PointCloud& cloud, std::size_t maxSamples = 20000);
+
 }  // namespace subscan

@@ -122,6 +122,31 @@ Buffer::Buffer(std::size_t bytes, const void* data, std::string_view labelText)
     label(GL_BUFFER, id, labelText);
 }
 
+Buffer Buffer::borrowing(const void* data, std::size_t bytes, std::string_view labelText) {
+    Buffer buffer;
+    if (bytes == 0 || !epoxy_has_gl_extension("GL_AMD_pinned_memory")) {
+        return buffer;
+    }
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    GLuint id = 0;
+    glCreateBuffers(1, &id);
+    buffer.name_ = GlName<BufferTraits>(id);
+    // The extension names a bind target only (no direct-state-access entry point).
+    glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, id);
+    glBufferData(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, static_cast<GLsizeiptr>(bytes), data,
+                 GL_STATIC_DRAW);
+    glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, 0);
+    if (glGetError() != GL_NO_ERROR) {
+        return Buffer();
+    }
+    buffer.size_ = bytes;
+    buffer.borrowed_ = true;
+    buffer.label_ = labelText;
+    label(GL_BUFFER, id, labelText);
+    return buffer;
+}
+
 void Buffer::upload(std::size_t offset, std::size_t bytes, const void* data) {
     glNamedBufferSubData(id(), static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
 }

@@ -82,9 +82,17 @@ class Buffer {
     static Buffer fromSpan(std::span<const T> values, std::string_view label) {
         return Buffer(values.size_bytes(), values.data(), label);
     }
+    /// A buffer over the caller's memory instead of a copy of it (GL_AMD_pinned_memory, which
+    /// Mesa's llvmpipe and radeonsi offer): the GPU reads `data` in place, so it must stay
+    /// alive and unchanged while the buffer lives, and the buffer must not be written. An empty
+    /// buffer (id 0) where the driver refuses: no such extension, or memory it cannot pin.
+    static Buffer borrowing(const void* data, std::size_t bytes, std::string_view label);
 
     GLuint id() const { return name_.id(); }
     std::size_t size() const { return size_; }
+    explicit operator bool() const { return static_cast<bool>(name_); }
+    /// Made by borrowing(): the GPU reads the caller's memory.
+    bool borrowed() const { return borrowed_; }
 
     void upload(std::size_t offset, std::size_t bytes, const void* data);
     void download(std::size_t offset, std::size_t bytes, void* data) const;
@@ -110,6 +118,7 @@ class Buffer {
   private:
     GlName<BufferTraits> name_;
     std::size_t size_ = 0;
+    bool borrowed_ = false;
     std::string label_;
     // A cache, not state: made by the first bindTexels (again when the format changes).
     mutable GlName<TextureTraits> texelView_;

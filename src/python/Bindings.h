@@ -29,11 +29,15 @@ class CloudData {
     /// "open3d" for clouds made from arrays.
     const std::string& format() const { return format_; }
     /// estimateSpacing(cloud()), computed on the first call (call without the GIL: it may take
-    /// a second on millions of points; std::call_once makes concurrent first calls wait).
+    /// half a second on millions of points; std::call_once makes concurrent first calls wait).
     double spacing() const;
     /// estimatePointSpacing with that h: the local spacing too where the renderer wants it,
     /// computed once for every Renderer of this cloud (call without the GIL).
     const PointSpacing& pointSpacing() const;
+
+    /// framingBounds(cloud()), computed on the first call (a pass over a sample of the points:
+    /// 10 ms for 10 M, which only a default camera needs).
+    const Bounds& framed() const;
 
     /// Where the file says its sensor stood and an organised cloud's grid (subscan.load), for
     /// Camera.sensor; empty for clouds made from arrays.
@@ -44,9 +48,11 @@ class CloudData {
     PointCloud cloud_;
     std::string format_;
     mutable std::once_flag spacingOnce_;
-    mutable double spacing_ = 0.0;
+    mutable SpacingSample sample_;  // h, and the distances that decide on the local spacing
     mutable std::once_flag pointSpacingOnce_;
     mutable PointSpacing pointSpacing_;
+    mutable std::once_flag framedOnce_;
+    mutable Bounds framed_;
 };
 
 using CloudHandle = std::shared_ptr<CloudData>;

@@ -105,7 +105,7 @@ Camera orbit(const CloudData& cloud, double yaw, double pitch, std::optional<dou
     }
     // As render frames a scan: its points' framing box fills the picture.
     view.framing = Framing::Box;
-    view.framed = framingBounds(cloud.cloud());
+    view.framed = cloud.framed();
     return checked(orbitCamera(cloud.cloud().bounds, view, width, height, fovy));
 }
 

@@ -56,10 +56,7 @@ py::array arrayOf(ImageF image) {
 
 class RendererState {
   public:
-    RendererState(const CloudHandle& cloud, bool software)
-        : bounds_(cloud->cloud().bounds),
-          framed_(framingBounds(cloud->cloud())),
-          format_(cloud->format()) {
+    RendererState(const CloudHandle& cloud, bool software) : cloud_(cloud) {
         const py::gil_scoped_release release;
         HeadlessContextOptions options;
         options.preferHardware = !software;
@@ -68,7 +65,10 @@ class RendererState {
         const CurrentContext current(*context_);
         // The cloud's own estimate of h and local spacing, the ones the CLI's renderer makes:
         // the same pictures.
-        renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing());
+        // The renderer reads the Cloud's points in place where the driver allows (the Cloud is
+        // immutable and kept alive here): a 10 M-point Renderer without a 160 MB copy.
+        renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing(), 0,
+                                               PointMemory::Borrow);
     }
     ~RendererState() {
         try {
@@ -111,7 +111,7 @@ class RendererState {
             settings.temporal.enabled = true;
             settings.temporal.maxFrames = std::max(settings.temporal.maxFrames, samples);
         }
-        const Camera camera = cameraArgument.value_or(defaultCamera());
+        const Camera camera = cameraArgument ? *cameraArgument : defaultCamera();
         const FrameOutputs outputs = buffers ? FrameOutputs::Everything : FrameOutputs::Picture;
 
         std::vector<std::uint8_t> rgba;
@@ -208,6 +208,7 @@ class RendererState {
             renderer_.reset();  // its GL objects need their context current
         }
         context_.reset();
+        cloud_.reset();  // only once nothing on the GPU reads its points
         keptBuffers_ = false;
     }
 
@@ -218,18 +219,22 @@ class RendererState {
         }
     }
     /// `subscan render`'s camera without --camera and options: 1280×720, yaw 30°, pitch 20°.
-    Camera defaultCamera() const {
+    Camera defaultCamera() {
+        CloudHandle cloud;
+        {
+            const std::lock_guard lock(mutex_);
+            requireOpen();
+            cloud = cloud_;
+        }
         OrbitView orbit;
-        orbit.up = format_ == "las" ? UpAxis::Z : UpAxis::Y;
+        orbit.up = cloud->format() == "las" ? UpAxis::Z : UpAxis::Y;
         orbit.framing = Framing::Box;  // as render frames a scan
-        orbit.framed = framed_;
-        return orbitCamera(bounds_, orbit, 1280, 720, 45.0);
+        orbit.framed = cloud->framed();
+        return orbitCamera(cloud->cloud().bounds, orbit, 1280, 720, 45.0);
     }
 
-    Bounds bounds_;
-    Bounds framed_;  // framingBounds() of the cloud
-    std::string format_;
-    std::mutex mutex_;  // one call at a time; the GIL is released while a call works
+    CloudHandle cloud_;  // outlives renderer_, which may read its points in place
+    std::mutex mutex_;   // one call at a time; the GIL is released while a call works
     std::unique_ptr<GlContext> context_;
     std::unique_ptr<Renderer> renderer_;
     RenderSettings settings_;  // the last frame's, for its buffers

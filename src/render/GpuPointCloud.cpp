@@ -42,7 +42,7 @@ std::vector<std::uint32_t> displayColors(const PointCloud& cloud) {
 }
 
 GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
-                             std::size_t maxChunkPoints)
+                             std::size_t maxChunkPoints, PointMemory memory)
     : size_(cloud.size()), origin_(cloud.origin) {
     // A chunk must fit one buffer texture (positions are the larger one: 3 texels a point) and
     // one dispatch.
@@ -63,25 +63,42 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
     if (!cloud.hasColors()) {
         converted = displayColors(cloud);
     }
-    const void* colors = cloud.hasColors() ? static_cast<const void*>(cloud.colors.data())
-                                           : static_cast<const void*>(converted.data());
+    const bool ownColors = cloud.hasColors();
+    const auto* colors = ownColors ? reinterpret_cast<const std::byte*>(cloud.colors.data())
+                                   : reinterpret_cast<const std::byte*>(converted.data());
+    // Borrowed where asked and the driver allows, else copied (`converted` dies with this
+    // constructor: always copied).
+    const auto buffer = [&](const void* data, std::size_t bytes, bool mayBorrow,
+                            const char* label) {
+        if (mayBorrow && memory == PointMemory::Borrow) {
+            if (Buffer inPlace = Buffer::borrowing(data, bytes, label)) {
+                return inPlace;
+            }
+        }
+        return Buffer(bytes, data, label);
+    };
     for (std::size_t first = 0; first < size_; first += chunkPoints) {
         Chunk chunk;
         chunk.firstPoint = static_cast<std::uint32_t>(first);
         chunk.pointCount = static_cast<std::uint32_t>(std::min(chunkPoints, size_ - first));
         try {
-            chunk.positions = Buffer(chunk.pointCount * 3 * sizeof(float), &cloud.positions[first],
-                                     "points.positions");
+            chunk.positions = buffer(&cloud.positions[first], chunk.pointCount * 3 * sizeof(float),
+                                     true, "points.positions");
             chunk.colors =
-                Buffer(chunk.pointCount * sizeof(std::uint32_t),
-                       static_cast<const std::byte*>(colors) + first * sizeof(std::uint32_t),
-                       "points.colors");
+                buffer(colors + first * sizeof(std::uint32_t),
+                       chunk.pointCount * sizeof(std::uint32_t), ownColors, "points.colors");
         } catch (const Error& error) {
             throw Error(fmt::format("the GPU cannot hold the {} points ({:.0f} MB): {}", size_,
                                     static_cast<double>(bytes()) / 1e6, error.what()));
         }
         chunks_.push_back(std::move(chunk));
     }
+}
+
+bool GpuPointCloud::borrowsPositions() const {
+    return !chunks_.empty() && std::all_of(chunks_.begin(), chunks_.end(), [](const Chunk& chunk) {
+        return chunk.positions.borrowed();
+    });
 }
 
 void GpuPointCloud::setColors(const std::vector<Rgba8>& colors) {

@@ -13,6 +13,16 @@
 
 namespace subscan {
 
+/// Whether a GpuPointCloud copies the cloud's points or reads the caller's arrays in place.
+enum class PointMemory {
+    Copy,
+    /// The caller keeps the cloud alive and unchanged while the GPU cloud lives: where the
+    /// driver reads client memory (Buffer::borrowing), the positions and colours are used where
+    /// they are — no copy of them (135 ms and 160 MB for 10 M points on llvmpipe); elsewhere
+    /// they are copied.
+    Borrow,
+};
+
 /// A point cloud on the GPU, split into chunks that each fit one buffer texture and one
 /// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8. The
 /// rasterizer reads both as buffer textures (Buffer::bindTexels), the GL_POINTS baseline as
@@ -31,13 +41,16 @@ class GpuPointCloud {
     /// `maxChunkPoints` 0 = as large as the driver allows; tests pass small values to exercise
     /// chunking. Throws subscan::Error when the GPU cannot hold the cloud.
     GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
-                  std::size_t maxChunkPoints = 0);
+                  std::size_t maxChunkPoints = 0, PointMemory memory = PointMemory::Copy);
 
     /// Replaces the points' colours (sRGB-encoded, one per point), e.g. for another colouring.
     void setColors(const std::vector<Rgba8>& colors);
     /// Uploads estimateLocalSpacing's result, one entry per point.
     void setLocalSpacing(const std::vector<glm::vec4>& spacing);
     bool hasLocalSpacing() const { return hasLocalSpacing_; }
+    /// True when the positions are read from the cloud's own memory (PointMemory::Borrow on a
+    /// driver that allows it).
+    bool borrowsPositions() const;
 
     const std::vector<Chunk>& chunks() const { return chunks_; }
     std::size_t size() const { return size_; }

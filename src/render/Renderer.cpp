@@ -37,13 +37,13 @@ double FrameResult::totalMilliseconds() const {
 }
 
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<double> spacing,
-                   std::size_t maxChunkPoints)
-    : Renderer(context, cloud, estimatePointSpacing(cloud, spacing), maxChunkPoints) {}
+                   std::size_t maxChunkPoints, PointMemory memory)
+    : Renderer(context, cloud, estimatePointSpacing(cloud, spacing), maxChunkPoints, memory) {}
 
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
-                   std::size_t maxChunkPoints)
+                   std::size_t maxChunkPoints, PointMemory memory)
     : context_(context),
-      cloud_(cloud, context.capabilities(), maxChunkPoints),
+      cloud_(cloud, context.capabilities(), maxChunkPoints, memory),
       spacing_(usableSpacing(cloud, spacing.global)),
       resolutionChooser_(cloud),
       cloudBounds_(cloud.bounds),

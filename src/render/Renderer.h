@@ -47,13 +47,15 @@ struct FrameResult {
 /// current.
 class Renderer {
   public:
-    /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` see GpuPointCloud.
-    /// The local spacing is estimated as estimatePointSpacing says.
+    /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` and `memory` see
+    /// GpuPointCloud (PointMemory::Borrow: `cloud` outlives the renderer unchanged). The local
+    /// spacing is estimated as estimatePointSpacing says.
     Renderer(GlContext& context, const PointCloud& cloud,
-             std::optional<double> spacing = std::nullopt, std::size_t maxChunkPoints = 0);
+             std::optional<double> spacing = std::nullopt, std::size_t maxChunkPoints = 0,
+             PointMemory memory = PointMemory::Copy);
     /// With the spacing estimated beforehand (off the render thread).
     Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
-             std::size_t maxChunkPoints = 0);
+             std::size_t maxChunkPoints = 0, PointMemory memory = PointMemory::Copy);
     ~Renderer();
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a

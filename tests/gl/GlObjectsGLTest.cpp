@@ -2,6 +2,8 @@
 // bound as their bits, integer textures cleared. (What the passes read through these views is
 // checked against CPU twins in SurfacePassesGLTest and RasterizePointsGLTest.)
 #include <cstdint>
+#include <numeric>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,26 @@ TEST(GlObjectsGLTest, BufferTexelsNeedThirtyTwoBitChannelsOrHalvesAndNameTheBuff
     EXPECT_NO_THROW(buffer.bindTexels(0, TextureFormat::RGBA16F));
     const std::string message = errorOf([&] { buffer.bindTexels(0, TextureFormat::RGBA8); });
     EXPECT_NE(message.find("'test.pyramid'"), std::string::npos) << message;
+}
+
+TEST(GlObjectsGLTest, ABorrowedBufferReadsTheCallersMemoryInPlace) {
+    test::glTestContext();
+    std::vector<float> memory(1003);
+    std::iota(memory.begin(), memory.end(), 0.5f);
+    const std::span<const float> values(memory.data() + 3, 1000);  // not page aligned
+    Buffer borrowed = Buffer::borrowing(values.data(), values.size_bytes(), "test.borrowed");
+    if (!epoxy_has_gl_extension("GL_AMD_pinned_memory")) {
+        EXPECT_FALSE(borrowed);  // the caller then copies
+        GTEST_SKIP() << "this driver reads no client memory (GL_AMD_pinned_memory)";
+    }
+    ASSERT_TRUE(borrowed);
+    EXPECT_TRUE(borrowed.borrowed());
+    EXPECT_EQ(borrowed.size(), values.size_bytes());
+    EXPECT_EQ(borrowed.read<float>(), std::vector<float>(values.begin(), values.end()));
+    memory[3 + 500] = -7.0f;  // seen by the GPU without an upload: no copy was made
+    EXPECT_EQ(borrowed.read<float>()[500], -7.0f);
+    EXPECT_NO_THROW(borrowed.bindTexels(0, TextureFormat::RGBA32F));
+    EXPECT_FALSE(Buffer(16, nullptr, "test.owned").borrowed());
 }
 
 TEST(GlObjectsGLTest, ClearUintFillsAnR32uiTextureAndRefusesOthers) {

@@ -1,5 +1,6 @@
 """subscan.Renderer against `subscan render`: the same pictures byte for byte, the same buffers
 as --export-buffers, several renderers and threads, the GIL released, every bad call refused."""
+import gc
 import threading
 import time
 
@@ -139,6 +140,22 @@ def test_several_renderers_in_one_process(torus, camera, renderer):
     second.close()
     with pytest.raises(subscan.Error, match="the renderer is closed"):
         second.render(camera)
+
+
+def test_a_renderer_keeps_its_cloud(camera):
+    # The renderer may read the cloud's points in place (no copy on Mesa): dropping the last
+    # Python reference to the cloud must not free them under it (a crash, or the garbage that
+    # reuses the memory drawn instead).
+    cloud = subscan.Cloud(subscan.load(SCAN).points.copy())
+    with subscan.Renderer(cloud) as kept:
+        before = kept.render(camera, mode="points")
+        del cloud
+        gc.collect()
+        garbage = [np.full((20000, 3), 1e3) for _ in range(8)]
+        after = kept.render(camera, mode="points")
+        del garbage
+    assert (before != before[0, 0]).any(axis=2).sum() > 500  # the torus, not a blank picture
+    np.testing.assert_array_equal(after, before)
 
 
 def test_renderers_on_threads(torus, camera, renderer):

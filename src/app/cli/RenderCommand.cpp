@@ -130,7 +130,8 @@ int runRender(const RenderOptions& options) {
     frame.applyColoring(scan);
     const Camera camera = frame.camera(scan);
     const std::unique_ptr<GlContext> context = frame.context();
-    Renderer renderer(*context, scan.cloud);
+    // `scan` outlives the renderer unchanged: the GPU may read its points in place.
+    Renderer renderer(*context, scan.cloud, std::nullopt, 0, PointMemory::Borrow);
     // The radiance of a linear picture is one of the buffers the picture alone does not keep.
     const FrameOutputs outputs = options.exportDirectory.empty() && !linearPicture
                                      ? FrameOutputs::Picture

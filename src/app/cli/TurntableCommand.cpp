@@ -160,7 +160,8 @@ int runTurntable(const TurntableOptions& options) {
     };
 
     const std::unique_ptr<GlContext> context = frame.context();
-    Renderer renderer(*context, scan.cloud);
+    // `scan` outlives the renderer unchanged: the GPU may read its points in place.
+    Renderer renderer(*context, scan.cloud, std::nullopt, 0, PointMemory::Borrow);
     std::optional<FrameFolder> temporary;
     std::filesystem::path folder = output;
     if (video) {

@@ -289,6 +289,9 @@ TEST(LocalSpacingTest, PointSpacingTakesAGivenHAndEstimatesTheLocalOneForSmallCl
     const PointSpacing estimated = estimatePointSpacing(cloud);
     EXPECT_NEAR(estimated.global, 0.01, 1e-7);  // float positions
     EXPECT_EQ(estimated.local.size(), cloud.size());
+    const PointSpacing fromSample = estimatePointSpacing(cloud, sampleSpacing(cloud));
+    EXPECT_EQ(fromSample.global, estimated.global);
+    EXPECT_EQ(fromSample.local, estimated.local);
     // No h, no scale for the local spacing.
     EXPECT_TRUE(estimatePointSpacing(lines(1, 1, 1.0, 1.0)).local.empty());
 }
