@@ -60,10 +60,10 @@ int runEval(const EvalOptions& options) {
         }
         truth = makeMeshScene(mesh.cloud, AlbedoSource::Grey);
         if (options.points == "scan") {
-            ScannerSettings scanner;
-            scanner.noise = 0.1;
-            scanner.noiseInSpacingUnits = true;
-            points = scanScene(*truth, scanner);
+            ScannerSettings objectScan;
+            objectScan.noise = 0.1;
+            objectScan.noiseInSpacingUnits = true;
+            points = scanScene(*truth, objectScan);
         } else {
             // The mesh's vertices, or a scan file in the mesh's frame (the range scans a mesh
             // was merged from: real noise and registration offsets, judged by the mesh).
