@@ -202,10 +202,8 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, std::optional<double>
     if (!global) {
         return estimatePointSpacing(cloud, sampleSpacing(cloud));
     }
-    // A few thousand nearest neighbours tell a station from an even scan.
-    constexpr std::size_t kVariationSamples = 4000;
-    return withLocalSpacing(cloud, *global,
-                            [&] { return sampledNearestDistances(cloud, kVariationSamples); });
+    // The sample estimateSpacing would take: the same decision as without a given h.
+    return withLocalSpacing(cloud, *global, [&] { return sampledNearestDistances(cloud); });
 }
 
 PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample) {

@@ -132,12 +132,19 @@ Buffer Buffer::borrowing(const void* data, std::size_t bytes, std::string_view l
     GLuint id = 0;
     glCreateBuffers(1, &id);
     buffer.name_ = GlName<BufferTraits>(id);
+    // A refusal is an answer here, not a failure: kept out of the debug output (the group's
+    // pop restores its filter) and taken from glGetError.
+    glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, "borrowing client memory");
+    glDebugMessageControl(GL_DEBUG_SOURCE_API, GL_DEBUG_TYPE_ERROR, GL_DONT_CARE, 0, nullptr,
+                          GL_FALSE);
     // The extension names a bind target only (no direct-state-access entry point).
     glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, id);
     glBufferData(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, static_cast<GLsizeiptr>(bytes), data,
                  GL_STATIC_DRAW);
+    const bool refused = glGetError() != GL_NO_ERROR;
     glBindBuffer(GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD, 0);
-    if (glGetError() != GL_NO_ERROR) {
+    glPopDebugGroup();
+    if (refused) {
         return Buffer();
     }
     buffer.size_ = bytes;
@@ -147,7 +154,15 @@ Buffer Buffer::borrowing(const void* data, std::size_t bytes, std::string_view l
     return buffer;
 }
 
+void Buffer::refuseWritesIfBorrowed() const {
+    if (borrowed_) {
+        throw Error(
+            fmt::format("the buffer '{}' is the caller's memory and is not written", label_));
+    }
+}
+
 void Buffer::upload(std::size_t offset, std::size_t bytes, const void* data) {
+    refuseWritesIfBorrowed();
     glNamedBufferSubData(id(), static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(bytes), data);
 }
 
@@ -157,6 +172,7 @@ void Buffer::download(std::size_t offset, std::size_t bytes, void* data) const {
 }
 
 void Buffer::fill(std::uint32_t value) {
+    refuseWritesIfBorrowed();
     glClearNamedBufferData(id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value);
 }
 

@@ -70,7 +70,8 @@ struct QueryTraits {
 
 enum class TextureFormat { R32F, RG32F, RGBA16F, RGBA32F, RGBA8, R32UI, R8, Depth32F };
 
-/// Immutable-storage buffer (glNamedBufferStorage) that can be updated and read back.
+/// Immutable-storage buffer (glNamedBufferStorage) that can be updated and read back; or a
+/// read-only view of the caller's memory (borrowing()).
 class Buffer {
   public:
     Buffer() = default;
@@ -82,10 +83,11 @@ class Buffer {
     static Buffer fromSpan(std::span<const T> values, std::string_view label) {
         return Buffer(values.size_bytes(), values.data(), label);
     }
-    /// A buffer over the caller's memory instead of a copy of it (GL_AMD_pinned_memory, which
-    /// Mesa's llvmpipe and radeonsi offer): the GPU reads `data` in place, so it must stay
-    /// alive and unchanged while the buffer lives, and the buffer must not be written. An empty
-    /// buffer (id 0) where the driver refuses: no such extension, or memory it cannot pin.
+    /// A buffer over the caller's memory instead of a copy of it (GL_AMD_pinned_memory, as
+    /// Mesa's llvmpipe offers it for any address; radeonsi only pins whole pages): the GPU
+    /// reads `data` in place, so it must stay alive and unchanged while the buffer lives;
+    /// upload() and fill() refuse it. An empty buffer (id 0) where the driver refuses: no such
+    /// extension, or memory it cannot pin (then no GL error or debug message remains).
     static Buffer borrowing(const void* data, std::size_t bytes, std::string_view label);
 
     GLuint id() const { return name_.id(); }
@@ -94,6 +96,7 @@ class Buffer {
     /// Made by borrowing(): the GPU reads the caller's memory.
     bool borrowed() const { return borrowed_; }
 
+    /// upload() and fill() throw subscan::Error for a borrowed buffer (the caller's memory).
     void upload(std::size_t offset, std::size_t bytes, const void* data);
     void download(std::size_t offset, std::size_t bytes, void* data) const;
     /// Fills every 32-bit word with `value`.
@@ -116,6 +119,8 @@ class Buffer {
     }
 
   private:
+    void refuseWritesIfBorrowed() const;
+
     GlName<BufferTraits> name_;
     std::size_t size_ = 0;
     bool borrowed_ = false;

@@ -202,8 +202,8 @@ void adviseHugePages(const void* data, std::size_t bytes) {
 /// core while the caller fills the array from its start: zeroing fresh pages is half the cost
 /// of a first write (numpy's copy pays it too), and this way the writer meets mapped pages
 /// after its first third, where it has spent about what mapping the rest takes. The thread
-/// is joined on destruction. Nothing happens without MADV_POPULATE_WRITE (Linux 5.14) or a
-/// second core.
+/// is joined on destruction. Nothing happens below 16 MiB (where the thread would cost more
+/// than it saves), without MADV_POPULATE_WRITE (Linux 5.14) or without a second core.
 class PagesMappedAhead {
   public:
     PagesMappedAhead(const void* data, std::size_t bytes) {

@@ -222,6 +222,7 @@ class RendererState {
     Camera defaultCamera() {
         CloudHandle cloud;
         {
+            const py::gil_scoped_release release;  // the lock may wait for a whole frame
             const std::lock_guard lock(mutex_);
             requireOpen();
             cloud = cloud_;

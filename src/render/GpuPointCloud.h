@@ -17,9 +17,9 @@ namespace subscan {
 enum class PointMemory {
     Copy,
     /// The caller keeps the cloud alive and unchanged while the GPU cloud lives: where the
-    /// driver reads client memory (Buffer::borrowing), the positions and colours are used where
-    /// they are — no copy of them (135 ms and 160 MB for 10 M points on llvmpipe); elsewhere
-    /// they are copied.
+    /// driver reads client memory (Buffer::borrowing), the positions and the scan's own
+    /// colours are used where they are — no copy of them (135 ms and 160 MB for 10 M points on
+    /// llvmpipe); elsewhere, and for colours made from intensities, they are copied.
     Borrow,
 };
 
