@@ -404,15 +404,19 @@ void Viewer::finishLoading() {
         std::optional<std::pair<glm::dvec3, glm::dvec3>> look = sensorLook(prepared.scan, up);
         std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
         prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, options_.coloring, up);
-        // Built before the old one goes, so a failure keeps the scan on screen.
-        auto renderer = std::make_unique<Renderer>(context_, prepared.scan.cloud, prepared.spacing);
+        // Built before the old one goes, so a failure keeps the scan on screen. The renderer
+        // reads the points where they are (no copy where the driver allows): the scan stays at
+        // its address until the renderer that reads it has gone.
+        auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
+        auto renderer =
+            std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
         renderer_ = std::move(renderer);
-        scan_ = std::move(prepared.scan.cloud);
+        scan_ = std::move(scan);
         scanColors_ = std::move(fileColors);
         scanUp_ = up;
         sensorLook_ = std::move(look);
         status_.coloring = options_.coloring;
-        const PointCloud& cloud = scan_;
+        const PointCloud& cloud = *scan_;
         bounds_ = cloud.bounds;
         status_.scanSource = prepared.source;
         status_.scanFormat =
@@ -502,9 +506,12 @@ void Viewer::applyColoring(Coloring coloring) {
     if (!renderer_) {
         return;
     }
-    scan_.colors = scanColors_;
-    scan_.colors = pointColors(scan_, coloring, scanUp_);
-    renderer_->setColors(scan_.colors);
+    // The renderer may read the shown colours in place: they stay alive and unchanged (moved
+    // out, not overwritten) until it has a copy of the new ones.
+    const std::vector<Rgba8> shown = std::exchange(scan_->colors, scanColors_);
+    std::vector<Rgba8> colors = pointColors(*scan_, coloring, scanUp_);
+    renderer_->setColors(colors);
+    scan_->colors = std::move(colors);
     status_.coloring = coloring;
     renderedCamera_.reset();
     notify("points coloured by " + toString(coloring));

@@ -149,8 +149,9 @@ class Viewer {
     void applyColoring(Coloring coloring);
 
     // The scan on screen: its points as loaded, their own colours and the up axis (what a new
-    // colouring is made from).
-    PointCloud scan_;
+    // colouring is made from). The renderer reads the points in place: declared before it, so
+    // that it goes first.
+    std::unique_ptr<PointCloud> scan_;
     std::vector<Rgba8> scanColors_;
     UpAxis scanUp_ = UpAxis::Y;
     std::unique_ptr<Renderer> renderer_;
