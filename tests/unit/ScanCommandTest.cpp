@@ -2,9 +2,12 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
 #include "io/PlyWriter.h"
@@ -109,6 +112,32 @@ TEST(ScanCommandTest, InputErrorsExitWithOneAndLeaveNoOutput) {
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
                             std::filesystem::directory_iterator()),
               1);  // only the input: no output, no temporary
+}
+
+TEST(ScanCommandTest, AStationIsPlacedAsXYZOrAsRendersXCommaYCommaZ) {
+    const test::TempDir dir;
+    std::vector<std::vector<glm::vec3>> scans;
+    for (const std::vector<std::string>& station :
+         {std::vector<std::string>{"5", "1.5", "3"}, std::vector<std::string>{"5,1.5,3"}}) {
+        const auto out = dir / fmt::format("station{}.ply", scans.size());
+        std::vector<std::string> arguments{
+            "scan", "synthetic:outdoor", "-o", out.string(), "--mode", "station", "--azimuth-steps",
+            "90",   "--elevation-steps", "20", "--station"};
+        arguments.insert(arguments.end(), station.begin(), station.end());
+        const test::CommandResult result = runSubscan(arguments);
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        scans.push_back(loadScan(out.string()).cloud.positions);
+    }
+    EXPECT_GT(scans[0].size(), 100u);
+    EXPECT_EQ(scans[0], scans[1]);
+    // Two coordinates, or one that is not a number: usage errors.
+    for (const std::string& bad : {"5,1.5", "5,x,3"}) {
+        const test::CommandResult result =
+            runSubscan({"scan", "synthetic:outdoor", "-o", (dir / "bad.ply").string(), "--mode",
+                        "station", "--station", bad});
+        EXPECT_EQ(result.exitCode, 2) << bad;
+        EXPECT_FALSE(std::filesystem::exists(dir / "bad.ply"));
+    }
 }
 
 TEST(ScanCommandTest, BadOptionsExitWithTwo) {

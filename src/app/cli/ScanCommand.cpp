@@ -177,9 +177,10 @@ Command addScanCommand(CLI::App& parent) {
         ->capture_default_str();
     StationSettings& station = options->settings.station;
     scan->add_option("--station", options->stationPosition,
-                     "Station position X Y Z; default: the instrument height above the first "
-                     "surface below the scene's middle")
-        ->expected(3);
+                     "Station position X Y Z or X,Y,Z (as render's --sensor); default: the "
+                     "instrument height above the first surface below the scene's middle")
+        ->expected(3)
+        ->delimiter(',');
     scan->add_option("--instrument-height", station.instrumentHeight,
                      "Station height above the ground below it (metres)")
         ->capture_default_str();
