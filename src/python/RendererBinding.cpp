@@ -64,9 +64,8 @@ class RendererState {
         context_ = createHeadlessContext(options);
         const CurrentContext current(*context_);
         // The cloud's own estimate of h and local spacing, the ones the CLI's renderer makes:
-        // the same pictures.
-        // The renderer reads the Cloud's points in place where the driver allows (the Cloud is
-        // immutable and kept alive here): a 10 M-point Renderer without a 160 MB copy.
+        // the same pictures. The renderer reads the Cloud's points in place where the driver
+        // allows (the Cloud is immutable and kept alive here): no 160 MB copy for 10 M points.
         renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing(), 0,
                                                PointMemory::Borrow);
     }

@@ -41,10 +41,10 @@ struct FrameResult {
     double totalMilliseconds() const;
 };
 
-/// The frame pipeline for one cloud: puts it on the GPU once, then renders frames for any camera and
-/// settings with the passes of the chosen mode (and stage) followed by Present. The same code
-/// serves the headless CLI, the viewer, the evaluation and the benchmark. Needs its context
-/// current.
+/// The frame pipeline for one cloud: puts it on the GPU once, then renders frames for any
+/// camera and settings with the passes of the chosen mode (and stage) followed by Present. The
+/// same code serves the headless CLI, the viewer, the evaluation and the benchmark. Needs its
+/// context current.
 class Renderer {
   public:
     /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` and `memory` see

@@ -32,6 +32,20 @@ PointCloud lines(int rows, int perRow, double along, double across, int copies =
     return builder.finish(warnings);
 }
 
+/// `count` uniformly random points on the unit square of the plane z = 0.
+PointCloud randomPlane(int count, unsigned seed) {
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    PointCloudBuilder builder({}, static_cast<std::size_t>(count));
+    for (int i = 0; i < count; ++i) {
+        PointRecord record;
+        record.position = {unit(random), unit(random), 0.0};
+        builder.add(record);
+    }
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
 /// Whether point `index` of lines(rows, perRow, ...) lies `rowMargin` rows and `pointMargin`
 /// points from every edge (where neighbourhoods are whole).
 bool interior(std::size_t index, int rows, int perRow, int rowMargin, int pointMargin) {
@@ -42,16 +56,7 @@ bool interior(std::size_t index, int rows, int perRow, int rowMargin, int pointM
 TEST(LocalSpacingTest, RandomPointsMatchABruteForceReference) {
     // Uniform random points on a plane (whose spacings vary enough to leave the band around h
     // that counts as h) against the definition, evaluated by sorting every distance.
-    std::mt19937 random(9);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    PointCloudBuilder builder({}, 1500);
-    for (int i = 0; i < 1500; ++i) {
-        PointRecord record;
-        record.position = {unit(random), unit(random), 0.0};
-        builder.add(record);
-    }
-    std::vector<std::string> warnings;
-    const PointCloud cloud = builder.finish(warnings);
+    const PointCloud cloud = randomPlane(1500, 9);
     const double h = estimateSpacing(cloud, cloud.size());
     const std::vector<glm::vec4> spacing = estimateLocalSpacing(cloud, h);
 
@@ -257,16 +262,7 @@ TEST(LocalSpacingTest, VariationIsFoundInAStationsRangeNotInEvenOrRandomScans) {
     EXPECT_FALSE(spacingVaries(sampledNearestDistances(lines(100, 100, 0.01, 0.01))));
     // Uniformly random points on a plane: nearest distances follow a Rayleigh law, whose 90th
     // percentile is 4.7 times its 10th: the most uneven an even scan gets.
-    std::mt19937 random(3);
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    PointCloudBuilder builder({}, 20000);
-    for (int i = 0; i < 20000; ++i) {
-        PointRecord record;
-        record.position = {unit(random), unit(random), 0.0};
-        builder.add(record);
-    }
-    std::vector<std::string> warnings;
-    EXPECT_FALSE(spacingVaries(sampledNearestDistances(builder.finish(warnings))));
+    EXPECT_FALSE(spacingVaries(sampledNearestDistances(randomPlane(20000, 3))));
     // Rows whose spacing grows 30-fold from first to last, as a station's with range.
     PointCloudBuilder station({}, 20000);
     for (int r = 0; r < 100; ++r) {
@@ -277,6 +273,7 @@ TEST(LocalSpacingTest, VariationIsFoundInAStationsRangeNotInEvenOrRandomScans) {
             station.add(record);
         }
     }
+    std::vector<std::string> warnings;
     EXPECT_TRUE(spacingVaries(sampledNearestDistances(station.finish(warnings))));
 }
 
