@@ -1,7 +1,10 @@
 #version 450
 // Normals from the filled depth (Bouchiba 2018): on every push level, back-project a texel and
 // its neighbours, take per axis the tangent towards the neighbour with the smaller depth jump
-// (so silhouettes do not bend normals), cross them and face the result to the camera. Each
+// (so silhouettes do not bend normals), cross them and face the result to the camera. Where
+// only one of the two neighbours is fully covered by points (pull weight 1), its side is taken
+// instead: the other is fill, which continues the surface past its silhouette flatter than it
+// is and made the rims of round objects face the camera (too bright under a head light). Each
 // pixel then blends the normals of the two levels around its fractional smoothing level.
 //   STAGE_LEVEL  normals of level `level` into the normal pyramid
 //   STAGE_BLEND  the per-pixel blend into the "normals" image (view space), unless
@@ -27,7 +30,10 @@ vec3 positionOf(ivec2 texel) {
                           pushValueAt(texelIndex(level, texel)).x);
 }
 
-/// The tangent along `axis`: towards whichever existing neighbour has the smaller depth jump.
+bool fullyCovered(ivec2 texel) { return pullWeightAt(texelIndex(level, texel)) >= 1.0; }
+
+/// The tangent along `axis`: towards the existing neighbour that points cover fully where only
+/// one is, else towards the one with the smaller depth jump.
 vec3 tangent(ivec2 texel, vec3 centre, ivec2 axis) {
     bool hasNext = insideLevel(level, texel + axis);
     bool hasPrevious = insideLevel(level, texel - axis);
@@ -38,6 +44,10 @@ vec3 tangent(ivec2 texel, vec3 centre, ivec2 axis) {
     }
     if (!hasNext) {
         return previous;
+    }
+    bool nextCovered = fullyCovered(texel + axis);
+    if (nextCovered != fullyCovered(texel - axis)) {
+        return nextCovered ? next : previous;
     }
     return abs(next.z) <= abs(previous.z) ? next : previous;
 }

@@ -1,18 +1,26 @@
 // The per-pixel blend of the normal pyramid, for Normals.comp and FinishSurface.comp (which
 // blends level 0 itself). The pyramid is written as a storage buffer and read as a buffer
 // texture (see Buffer::bindTexels).
+#include "render/PullPush.glsl"
 #include "shared/pyramid.glsl"
 #include "shared/surface.glsl"
 
 layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
+const float kFillNormalWeight = 1e-3;
 
+/// The bilinear tap of a level's normals at `window`, each texel weighed also by how much of it
+/// points cover (its pull weight), so that a silhouette pixel takes its normal from the surface
+/// rather than from the fill beyond it. The floor keeps taps that all lie in fill an even
+/// bilinear mix.
 vec3 normalOnLevel(uint normalLevel, LevelLayout place, vec2 window) {
     ivec2 texels[4];
     float weights[4];
     bilinearTexels(normalLevel, place, window, texels, weights);
     vec3 sum = vec3(0.0);
     for (int i = 0; i < 4; ++i) {
-        sum += weights[i] * texelFetch(normalTexels, int(texelIndex(place, texels[i]))).xyz;
+        uint index = texelIndex(place, texels[i]);
+        float covered = max(pullWeightAt(index), kFillNormalWeight);
+        sum += weights[i] * covered * texelFetch(normalTexels, int(index)).xyz;
     }
     return sum;
 }

@@ -528,16 +528,21 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
     const FrameResources& resources = harness.resources();
     const auto push = resources.buffer("pushValues").read<glm::vec4>();
     const auto normals = resources.buffer("normalPyramid").read<glm::vec4>();
+    const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
     const auto all = levels();
 
-    // Per level: both tangent choices are candidates where the depth jumps tie.
-    std::vector<glm::dvec3> expected(normals.size());
+    // Per level: a neighbour fully covered by points wins over one that is not; else both
+    // tangent choices are candidates where the depth jumps tie.
+    int decidedByCoverage = 0;
     for (std::size_t l = 1; l < all.size(); ++l) {  // level 0 is never blended, so not made
         const Level& level = all[l];
         const double scale = 1 << l;
         auto position = [&](int x, int y) {
             return harness.viewPosition((x + 0.5) * scale, (y + 0.5) * scale,
                                         push[level.offset + y * level.width + x].x);
+        };
+        auto fullyCovered = [&](int x, int y) {
+            return pulled[level.offset + y * level.width + x].x >= 1.0f;
         };
         for (int y = 0; y < level.height; ++y) {
             for (int x = 0; x < level.width; ++x) {
@@ -554,6 +559,11 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
                     }
                     if (!next) {
                         return std::vector<glm::dvec3>{p};
+                    }
+                    const bool nextCovered = fullyCovered(x + ax, y + ay);
+                    if (nextCovered != fullyCovered(x - ax, y - ay)) {
+                        ++decidedByCoverage;
+                        return std::vector<glm::dvec3>{nextCovered ? n : p};
                     }
                     // A relative 1e-5 between the two jumps is within float rounding.
                     if (std::abs(std::abs(n.z) - std::abs(p.z)) <=
@@ -583,6 +593,7 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
             }
         }
     }
+    EXPECT_GT(decidedByCoverage, 20);  // the frame's silhouettes exercise the coverage rule
 }
 
 TEST_P(SurfacePassesSpacingGLTest, NormalBlendFollowsTheSmoothingLevel) {
@@ -609,8 +620,11 @@ TEST_P(SurfacePassesSpacingGLTest, NormalBlendFollowsTheSmoothingLevel) {
                 std::clamp(std::log2(radius * ratio * harness.focal() / surfaceDepth[i]), 1.0,
                            static_cast<double>(all.size() - 1));
             auto bilinear = [&](int l) {
-                return bilinearOnLevel(all[l], l, x, y,
-                                       [&](int texel) { return glm::dvec3(pyramid[texel]); });
+                // Each texel also weighed by its pull weight, at least Normals.glsl's floor.
+                return bilinearOnLevel(all[l], l, x, y, [&](int texel) {
+                    return std::max(static_cast<double>(pulled[texel].x), 1e-3) *
+                           glm::dvec3(pyramid[texel]);
+                });
             };
             const int lower = static_cast<int>(level);
             const int upper = std::min(lower + 1, static_cast<int>(all.size() - 1));
