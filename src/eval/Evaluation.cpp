@@ -306,8 +306,9 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
                                 const TemporalEvaluationSettings& temporal,
                                 const RenderSettings& render) {
     Renderer renderer(context, points);
-    // Its own renderer, so the filter's history runs on undisturbed by the other methods.
+    // Their own renderers, so the filter's histories run on undisturbed by the other methods.
     Renderer filtered(context, points);
+    Renderer converged(context, points);
     ImageShader shader(context, renderer.gpuCloud());
     RenderSettings surfaceSettings = render;
     surfaceSettings.raster.mode = RenderMode::Surface;
@@ -317,7 +318,17 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
     filteredSettings.temporal.enabled = true;
 
     TemporalReport report;
-    std::vector<SequenceFrame> truthFrames, pointFrames, splatFrames, surfaceFrames, filteredFrames;
+    std::vector<SequenceFrame> truthFrames, pointFrames, splatFrames, surfaceFrames, filteredFrames,
+        convergedFrames;
+    // The filter's picture, its mask where the history's coverage reaches a half.
+    auto filteredFrame = [](Renderer& renderer, const Camera& camera) {
+        const std::vector<float> coverage = atOutputPixels(renderer, "history", 4, camera);
+        SequenceFrame frame{renderer.readImage(), {}};
+        for (std::size_t i = 3; i < coverage.size(); i += 4) {
+            frame.mask.push_back(coverage[i] >= 0.5f ? 1 : 0);
+        }
+        return frame;
+    };
     for (int t = 0; t < temporal.frames; ++t) {
         OrbitView orbit;
         orbit.yawDegrees = 20.0 + t * temporal.stepDegrees;
@@ -343,12 +354,14 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
         for (int still = 0; still < (t == 0 ? temporal.stillSamples : 1); ++still) {
             filtered.render(camera, filteredSettings);
         }
-        const std::vector<float> coverage = atOutputPixels(filtered, "history", 4, camera);
-        SequenceFrame frame{filtered.readImage(), {}};
-        for (std::size_t i = 3; i < coverage.size(); i += 4) {
-            frame.mask.push_back(coverage[i] >= 0.5f ? 1 : 0);
+        filteredFrames.push_back(filteredFrame(filtered, camera));
+
+        // A frame without the filter restarts the history, which then converges at this pose.
+        converged.render(camera, surfaceSettings);
+        for (int still = 0; still < temporal.stillSamples; ++still) {
+            converged.render(camera, filteredSettings);
         }
-        filteredFrames.push_back(std::move(frame));
+        convergedFrames.push_back(filteredFrame(converged, camera));
         if (!settings.exportDirectory.empty()) {
             std::filesystem::create_directories(settings.exportDirectory);
             for (const auto& [name, frames] :
@@ -375,6 +388,7 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
     report.splats = compareSequences(splatFrames, truthFrames);
     report.surface = compareSequences(surfaceFrames, truthFrames);
     report.surfaceTemporal = compareSequences(filteredFrames, truthFrames);
+    report.surfaceSupersampled = compareSequences(convergedFrames, truthFrames);
     return report;
 }
 
@@ -402,7 +416,8 @@ nlohmann::json toJson(const TemporalReport& report) {
          {{"points", method(report.points1px)},
           {"splats", splats},
           {"surface", surface},
-          {"surface_temporal", filtered}}},
+          {"surface_temporal", filtered},
+          {"surface_supersampled", method(report.surfaceSupersampled)}}},
     };
 }
 

@@ -95,6 +95,9 @@ struct TemporalReport {
     float splatSize = 0.0f;  // RasterSettings::pointSize
     TemporalMetrics surface;
     TemporalMetrics surfaceTemporal;  // one continuous sequence through the temporal filter
+    // The surface converged afresh at every pose (stillSamples jittered frames): what a temporal
+    // filter without lag or blur would reach, so the bound of what filtering can do for E_t.
+    TemporalMetrics surfaceSupersampled;
     // The first pose as a still: one frame of the surface, and the filter's converged picture.
     double stillPsnrSurfaceDb = 0.0;
     double stillPsnrTemporalDb = 0.0;

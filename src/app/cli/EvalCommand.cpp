@@ -107,6 +107,8 @@ int runEval(const EvalOptions& options) {
         row("surface", report.surface, fmt::format("{:.2f}", report.stillPsnrSurfaceDb));
         row("surface+temporal", report.surfaceTemporal,
             fmt::format("{:.2f}", report.stillPsnrTemporalDb));
+        row(fmt::format("surface, {}x each", options.temporalEvaluation.stillSamples),
+            report.surfaceSupersampled, "-");
         return 0;
     }
     const EvaluationReport report = evaluate(*context, *truth, points, evaluation, render);
