@@ -61,11 +61,14 @@ struct RasterSettings {
 /// frame is blended into the previous result reprojected to it, so a still camera converges to
 /// a supersampled picture and a moving one does not flicker.
 struct TemporalSettings {
-    bool enabled = false;         // off for one-frame stills; the viewer and turntable turn it on
-    float newFrameWeight = 0.1f;  // the least weight of the new frame while the camera moves
-    float clipSigma = 1.0f;       // the reprojected history is clipped to mean ± this many
-                                  // standard deviations of the new frame's 3x3 neighbourhood
-    int maxFrames = 256;          // a still camera averages this many frames evenly, then slides
+    bool enabled = false;  // off for one-frame stills; the viewer and turntable turn it on
+    // The least weight of the new frame while the camera moves. 0.2 rather than the usual 0.1:
+    // along eval --temporal's orbits it is as steady (E_t equal or lower) and 0.3-0.4 dB
+    // closer to the truth, since each frame's bilinear resampling of the history blurs less.
+    float newFrameWeight = 0.2f;
+    float clipSigma = 1.0f;  // the reprojected history is clipped to mean ± this many
+                             // standard deviations of the new frame's 3x3 neighbourhood
+    int maxFrames = 256;     // a still camera averages this many frames evenly, then slides
 
     bool operator==(const TemporalSettings&) const = default;
 };
