@@ -331,9 +331,13 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
     };
     for (int t = 0; t < temporal.frames; ++t) {
         OrbitView orbit;
-        orbit.yawDegrees = 20.0 + t * temporal.stepDegrees;
-        orbit.pitchDegrees = 25.0;
-        orbit.distance = settings.distance;
+        if (settings.scannerView) {
+            orbit = settings.scannerView(t * temporal.stepDegrees);
+        } else {
+            orbit.yawDegrees = 20.0 + t * temporal.stepDegrees;
+            orbit.pitchDegrees = 25.0;
+            orbit.distance = settings.distance;
+        }
         const Camera camera = orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
                                           settings.fovyDegrees);
         truthFrames.push_back(
@@ -476,31 +480,33 @@ void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
         return;
     }
     constexpr double kFirstAzimuthDegrees = 45.0;
-    settings.viewpoints.clear();
     ScannerSettings fixed = scanner;
     if (scanner.mode == ScannerSettings::Mode::Station) {
         const glm::dvec3 station = stationPosition(scene, scanner.station);
         fixed.station.position = station;  // found once, not per pixel
-        constexpr double kAbove = 1.0, kBehind = 1.0, kLookDistance = 20.0, kDownDegrees = 10.0;
-        for (int view = 0; view < settings.views; ++view) {
-            const double azimuth =
-                glm::radians(kFirstAzimuthDegrees + 360.0 * view / settings.views);
+        settings.scannerView = [station](double degrees) {
+            constexpr double kAbove = 1.0, kBehind = 1.0, kLookDistance = 20.0, kDownDegrees = 10.0;
+            const double azimuth = glm::radians(kFirstAzimuthDegrees + degrees);
             const glm::dvec3 outward(std::sin(azimuth), 0.0, std::cos(azimuth));
             const glm::dvec3 eye = station + glm::dvec3(0.0, kAbove, 0.0) - kBehind * outward;
             const double down = glm::radians(kDownDegrees);
             const glm::dvec3 target = eye + kLookDistance * (std::cos(down) * outward +
                                                              glm::dvec3(0.0, -std::sin(down), 0.0));
-            settings.viewpoints.push_back(lookingAt(eye, target));
-        }
+            return lookingAt(eye, target);
+        };
     } else {
-        constexpr double kPitchDegrees = 45.0;
-        for (int view = 0; view < settings.views; ++view) {
+        settings.scannerView = [distance = settings.distance](double degrees) {
+            constexpr double kPitchDegrees = 45.0;
             OrbitView orbit;
-            orbit.yawDegrees = kFirstAzimuthDegrees + 360.0 * view / settings.views;
+            orbit.yawDegrees = kFirstAzimuthDegrees + degrees;
             orbit.pitchDegrees = kPitchDegrees;
-            orbit.distance = settings.distance;
-            settings.viewpoints.push_back(orbit);
-        }
+            orbit.distance = distance;
+            return orbit;
+        };
+    }
+    settings.viewpoints.clear();
+    for (int view = 0; view < settings.views; ++view) {
+        settings.viewpoints.push_back(settings.scannerView(360.0 * view / settings.views));
     }
     settings.sampled = [&scene, fixed](const glm::dvec3& p, const glm::dvec3& normal) {
         return scannerCanSample(scene, fixed, p, normal);

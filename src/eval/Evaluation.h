@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -36,6 +37,9 @@ struct EvaluationSettings {
     std::filesystem::path exportDirectory;
     /// When not empty, the views instead of the orbit (`views` is then ignored).
     std::vector<OrbitView> viewpoints;
+    /// When set (adaptToScanner), the scanner's view turned `degrees` of azimuth on from the
+    /// first of `viewpoints`: the path eval --temporal follows instead of the orbit.
+    std::function<OrbitView(double degrees)> scannerView;
     /// When set, which true surface points the scan could sample: coverage and leakage count
     /// only those (DESIGN.md §7: coverage is of the ground truth the scan sampled).
     SampledTest sampled;
@@ -48,6 +52,8 @@ struct EvaluationSettings {
 /// orbit's usual distance, in the same azimuths. Both count only surfaces the scan could sample
 /// (scannerCanSample): the backs of buildings, the ground behind a wall, walls parallel to the
 /// flight's scan planes are no reconstruction's to fill. `scene` must outlive `settings`.
+/// Also sets `scannerView`, so that eval --temporal turns at the station (or about the strip)
+/// instead of orbiting the whole scene from outside.
 void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
                     const ScannerSettings& scanner);
 

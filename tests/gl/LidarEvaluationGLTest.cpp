@@ -100,5 +100,46 @@ TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {
     EXPECT_LT(share, 0.2);
 }
 
+TEST(LidarEvaluationGLTest, TemporalEvaluationFollowsTheScannersPath) {
+    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    EvaluationSettings settings = viewsNearTheScanner(source, 4, 48);
+    const Bounds bounds = source.scene->bounds();
+    auto eyeOf = [&](const OrbitView& view) {
+        return orbitCamera(bounds, view, 48, 48, 45.0).eye();
+    };
+    // The path turns at the station: every turn keeps the eye there, and a quarter turn is the
+    // second of the four views.
+    for (const double degrees : {0.0, 7.0, 200.0}) {
+        EXPECT_LT(
+            glm::length(eyeOf(settings.scannerView(degrees)) - *source.scanner.station.position),
+            1.5)
+            << degrees;
+    }
+    // Views are placed to the millimetre by the same formula; 1e-9 m allows for rounding.
+    EXPECT_LT(glm::length(eyeOf(settings.scannerView(90.0)) - eyeOf(settings.viewpoints[1])), 1e-9);
+
+    // evaluateTemporal takes its cameras from the path: one that looks straight up from above
+    // the scene sees only sky, which every method shows exactly as the truth does (the orbit
+    // around the scene would not).
+    settings.scannerView = [&bounds](double degrees) {
+        OrbitView upwards;
+        upwards.center = glm::dvec3(bounds.center().x, bounds.max.y + 100.0, bounds.center().z);
+        upwards.distance = 50.0;
+        upwards.pitchDegrees = -89.0;
+        upwards.yawDegrees = degrees;
+        return upwards;
+    };
+    TemporalEvaluationSettings temporal;
+    temporal.frames = 3;
+    temporal.stillSamples = 2;
+    temporal.stepDegrees = 5.0;
+    const TemporalReport sky = evaluateTemporal(test::glTestContext(), *source.scene, source.points,
+                                                settings, temporal, RenderSettings{});
+    for (const TemporalMetrics& m : {sky.points1px, sky.surface, sky.surfaceTemporal}) {
+        EXPECT_EQ(m.temporalError, 0.0);
+        EXPECT_EQ(m.psnrDb, 100.0);  // psnr()'s value for identical pictures
+    }
+}
+
 }  // namespace
 }  // namespace subscan
