@@ -370,7 +370,8 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
             std::filesystem::create_directories(settings.exportDirectory);
             for (const auto& [name, frames] :
                  {std::pair{"truth", &truthFrames}, std::pair{"points", &pointFrames},
-                  std::pair{"surface", &surfaceFrames}, std::pair{"temporal", &filteredFrames}}) {
+                  std::pair{"surface", &surfaceFrames}, std::pair{"temporal", &filteredFrames},
+                  std::pair{"supersampled", &convergedFrames}}) {
                 writePng(settings.exportDirectory / fmt::format("frame{:04}_{}.png", t, name),
                          {camera.width, camera.height, 4, frames->back().image});
             }

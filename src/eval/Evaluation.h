@@ -33,7 +33,7 @@ struct EvaluationSettings {
     /// When set, each view's pictures go here: truth.png and surface.png (shaded), coverage.png
     /// (grey: both, red: missed, blue: leaked, yellow: a surface behind the true one shows
     /// through) and normal_error.png (black 0° to white 45°). With --temporal, each frame's
-    /// frameNNNN_{truth,points,surface,temporal}.png (the truth supersampled).
+    /// frameNNNN_{truth,points,surface,temporal,supersampled}.png (the truth supersampled).
     std::filesystem::path exportDirectory;
     /// When not empty, the views instead of the orbit (`views` is then ignored).
     std::vector<OrbitView> viewpoints;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "eval/Evaluation.h"
+#include "io/Image.h"
 #include "scan/SyntheticScenes.h"
 #include "support/GlTestSupport.h"
 #include "support/QualityTargets.h"
@@ -157,8 +159,20 @@ TEST(EvaluationGLTest, TemporalEvaluationSeesMotionAndStillness) {
     // A camera that does not move: the truth and every unfiltered method repeat their
     // frames exactly, so no change is counted.
     temporal.stepDegrees = 0.0;
+    const test::TempDir exported;
+    settings.exportDirectory = exported.path();
     const TemporalReport still = evaluateTemporal(test::glTestContext(), *truth, points, settings,
                                                   temporal, RenderSettings{});
+    // Every frame of every sequence is written, at the evaluation's size.
+    for (int frame = 0; frame < temporal.frames; ++frame) {
+        for (const char* name : {"truth", "points", "surface", "temporal", "supersampled"}) {
+            const Image8 picture =
+                readPng(exported / fmt::format("frame{:04}_{}.png", frame, name));
+            EXPECT_EQ(picture.width, settings.width) << name;
+            EXPECT_EQ(picture.height, settings.height) << name;
+        }
+    }
+    settings.exportDirectory.clear();
     EXPECT_EQ(still.surface.temporalError, 0.0);
     EXPECT_EQ(still.surface.maskFlicker, 0.0);
     EXPECT_EQ(still.points1px.temporalError, 0.0);
