@@ -10,7 +10,6 @@
 //   STAGE_BLEND  the per-pixel blend into the "normals" image (view space), unless
 //                FinishSurface.comp blends level 0 itself
 #include "render/Normals.glsl"
-#include "render/PullPush.glsl"
 #include "shared/region.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;

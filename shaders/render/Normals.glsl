@@ -11,7 +11,8 @@ const float kFillNormalWeight = 1e-3;
 /// The bilinear tap of a level's normals at `window`, each texel weighed also by how much of it
 /// points cover (its pull weight), so that a silhouette pixel takes its normal from the surface
 /// rather than from the fill beyond it. The floor keeps taps that all lie in fill an even
-/// bilinear mix.
+/// bilinear mix. Unnormalised on purpose: in the mix of two levels, the one whose taps points
+/// cover more counts more.
 vec3 normalOnLevel(uint normalLevel, LevelLayout place, vec2 window) {
     ivec2 texels[4];
     float weights[4];

@@ -360,8 +360,7 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
         }
         filteredFrames.push_back(filteredFrame(filtered, camera));
 
-        // A frame without the filter restarts the history, which then converges at this pose.
-        converged.render(camera, surfaceSettings);
+        converged.restartTemporalFilter();
         for (int still = 0; still < temporal.stillSamples; ++still) {
             converged.render(camera, filteredSettings);
         }

@@ -84,7 +84,9 @@ struct TemporalEvaluationSettings {
     int frames = 24;
     double stepDegrees = 1.0;
     int supersampling = 4;  // ground-truth rays per pixel and side
-    int stillSamples = 16;  // frames the filtered sequence converges over at its first pose
+    // Frames the filtered sequence converges over at its first pose, and the converged
+    // sequence (surfaceSupersampled) at every pose.
+    int stillSamples = 16;
 };
 
 /// DESIGN.md §7's temporal measures per method, against the supersampled truth.
@@ -102,7 +104,8 @@ struct TemporalReport {
     TemporalMetrics surface;
     TemporalMetrics surfaceTemporal;  // one continuous sequence through the temporal filter
     // The surface converged afresh at every pose (stillSamples jittered frames): what a temporal
-    // filter without lag or blur would reach, so the bound of what filtering can do for E_t.
+    // filter that anti-aliases without lag or blur would show. A filter that blurred more
+    // could change less from frame to frame, but only by losing detail the truth has.
     TemporalMetrics surfaceSupersampled;
     // The first pose as a still: one frame of the surface, and the filter's converged picture.
     double stillPsnrSurfaceDb = 0.0;

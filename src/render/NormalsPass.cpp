@@ -9,7 +9,7 @@ NormalsPass::NormalsPass(const ShaderSources& sources)
 
 std::vector<std::string_view> NormalsPass::inputs() const {
     if (levelZero_ == LevelZero::Fused) {
-        return {"pushValues"};
+        return {"pushValues", "pullWeights"};
     }
     return {"pushValues", "pullWeights", "surfaceDepth"};
 }
@@ -28,6 +28,9 @@ void NormalsPass::execute(FrameContext& frame) {
     normalPyramid.bindStorage(SUBSCAN_SSBO_NORMALS);
     normalPyramid.bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
+    // Which texels points cover (the tangents' and the blend's preference), and the local
+    // spacing that scales the smoothing radius (PullPush.glsl's spacingRatioAt).
+    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     // From level 1: the blend never reads level 0 (its smoothing level is at least 1), and the
     // push leaves level 0 in the filled images only.
     for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
@@ -40,8 +43,6 @@ void NormalsPass::execute(FrameContext& frame) {
     Texture& normals =
         resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    // The local spacing scales the smoothing radius (PullPush.glsl's spacingRatioAt).
-    resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {
         normals.clear();

@@ -593,7 +593,9 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
             }
         }
     }
-    EXPECT_GT(decidedByCoverage, 20);  // the frame's silhouettes exercise the coverage rule
+    // The frame's silhouettes exercise the coverage rule: 102 tangents on llvmpipe; a fifth of
+    // that leaves room for another driver's rounding of the pull weights.
+    EXPECT_GT(decidedByCoverage, 20);
 }
 
 TEST_P(SurfacePassesSpacingGLTest, NormalBlendFollowsTheSmoothingLevel) {
