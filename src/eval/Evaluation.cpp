@@ -56,8 +56,8 @@ class ImageShader {
         resources_.ensureTexture("surfaceDepth", TextureFormat::R32F, w, h).uploadFloats(depth);
         upload("normals", normals);
         upload("filledColor", albedo);
-        FrameContext frame{camera,     cloud_, settings, context_.capabilities(),
-                           resources_, layout, 1.0};
+        FrameContext frame{camera,     cloud_,  settings, context_.capabilities(),
+                           resources_, clears_, layout,   1.0};
         shade_.execute(frame);
         present_.execute(frame);
         return resources_.texture("image").readRgba8();
@@ -69,6 +69,7 @@ class ImageShader {
     ShaderSources sources_;
     FrameUniforms uniforms_;
     FrameResources resources_;
+    GpuClear clears_{sources_, context_.capabilities()};
     ShadePass shade_;
     PresentPass present_;
 };

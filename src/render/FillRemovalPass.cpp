@@ -43,13 +43,13 @@ void FillRemovalPass::execute(FrameContext& frame) {
         resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
+    if (frame.restricted()) {
+        frame.clear(mask);
+        frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
+    }
     resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    if (frame.restricted()) {
-        mask.clear();
-        surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
-    }
     stages_.runOverRegion(Mask, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);

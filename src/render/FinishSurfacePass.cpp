@@ -71,9 +71,8 @@ void FinishSurfacePass::execute(FrameContext& frame) {
 
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
-    surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        surfaceDepth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
+        frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
     }
     int finishOutput = kFinishPicture;
     TemporalHistory::Mode mode = TemporalHistory::Mode::Restart;
@@ -90,13 +89,14 @@ void FinishSurfacePass::execute(FrameContext& frame) {
                                                            frame.width(), frame.height())
                                  : resources.ensureTexture("radiance", TextureFormat::RGBA16F,
                                                            frame.width(), frame.height());
-        color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
         // Radiance off the surface is never read: surfaceDepth marks it.
         if (picture && frame.restricted()) {
-            PresentPass::clearToBackground(color, frame.settings.raster);
+            PresentPass::clearToBackground(frame, color);
         }
+        color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
         finishOutput = picture ? kFinishPicture : kFinishRadiance;
     }
+    surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     const Program& shader = program(shade.lightCount.x > 0, finishOutput);
     shader.use();
     const TexelRegion region = frame.region(0);

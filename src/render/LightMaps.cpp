@@ -84,9 +84,9 @@ Camera lightCamera(const Bounds& bounds, const glm::dvec3& towardsLight, int res
     return camera;
 }
 
-LightMaps::LightMaps(GlContext& context, const ShaderSources& sources,
+LightMaps::LightMaps(GlContext& context, const ShaderSources& sources, GpuClear& clears,
                      Reconstruction& reconstruction)
-    : context_(context), sources_(sources), reconstruction_(reconstruction) {}
+    : context_(context), sources_(sources), clears_(clears), reconstruction_(reconstruction) {}
 
 std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Bounds& cloudBounds,
                                           const Camera& camera, const RenderSettings& settings,
@@ -117,8 +117,8 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
                             view.width, view.height, limit));
         }
         const gpu::PyramidLayout& layout = uniforms_.update(view, lightSettings, spacing, cloud);
-        FrameContext frame{view,       cloud,  lightSettings, context_.capabilities(),
-                           resources_, layout, spacing};
+        FrameContext frame{view,       cloud,   lightSettings, context_.capabilities(),
+                           resources_, clears_, layout,        spacing};
         frame.cloudPixels = projectedPixelBounds(view, cloudBounds);
         std::vector<RenderPass*> passes;
         reconstruction_.appendAll(passes);

@@ -52,7 +52,8 @@ class LightMaps {
         Texture texture;  // RGBA32F (LightMapPass), row 0 at the top
     };
 
-    LightMaps(GlContext& context, const ShaderSources& sources, Reconstruction& reconstruction);
+    LightMaps(GlContext& context, const ShaderSources& sources, GpuClear& clears,
+              Reconstruction& reconstruction);
 
     /// Brings the maps up to date with `settings.shading` (one per directional light; those
     /// fixed to the view as `camera` turns them) and returns the timings of the passes that
@@ -84,6 +85,7 @@ class LightMaps {
 
     GlContext& context_;
     const ShaderSources& sources_;
+    GpuClear& clears_;
     Reconstruction& reconstruction_;
     FrameResources resources_;  // the pipeline images of the map being built
     FrameUniforms uniforms_;

@@ -26,7 +26,7 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
     frame.resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     // Levels 0 and 1 are copied only where the cloud's bounding box projects: elsewhere the
     // depth is +inf, as the fill leaves it.
-    pyramid.fill(kInfinityBits);
+    frame.fill(pyramid, kInfinityBits);
     // One invocation per level-1 texel (also for a one-pixel image, which has no level 1).
     const TexelRegion pixels = frame.cloudRegion();
     const glm::ivec2 first = pixels.origin / 2;

@@ -42,11 +42,11 @@ void NormalsPass::execute(FrameContext& frame) {
     }
     Texture& normals =
         resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
+    if (frame.restricted()) {
+        frame.clear(normals);
+    }
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    if (frame.restricted()) {
-        normals.clear();
-    }
     stages_.runOverRegion(Blend, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);

@@ -32,12 +32,12 @@ TexelRegion outputRegion(const FrameContext& frame) {
 
 }  // namespace
 
-void PresentPass::clearToBackground(Texture& image, const RasterSettings& raster) {
+void PresentPass::clearToBackground(const FrameContext& frame, Texture& image) {
     // Linear (the frame uniform) to sRGB, as the shader does.
-    const glm::vec3& background = raster.backgroundSrgb;
-    image.clear(glm::vec4(linearToSrgb(srgbToLinear(background.r)),
-                          linearToSrgb(srgbToLinear(background.g)),
-                          linearToSrgb(srgbToLinear(background.b)), 1.0f));
+    const glm::vec3& background = frame.settings.raster.backgroundSrgb;
+    frame.clear(image, glm::vec4(linearToSrgb(srgbToLinear(background.r)),
+                                 linearToSrgb(srgbToLinear(background.g)),
+                                 linearToSrgb(srgbToLinear(background.b)), 1.0f));
 }
 
 PresentPass::PresentPass(const ShaderSources& sources, std::string colorInput,
@@ -56,16 +56,19 @@ std::vector<std::string_view> PresentPass::inputs() const {
 void PresentPass::execute(FrameContext& frame) {
     const glm::ivec2 size = frame.outputSize();
     Texture& image = frame.resources.ensureTexture("image", TextureFormat::RGBA8, size.x, size.y);
+    const bool whole = depthInput_.empty() || !frame.restricted();
+    if (!whole) {
+        clearToBackground(frame, image);
+    }
     frame.resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     if (!depthInput_.empty()) {
         frame.resources.texture(depthInput_).bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     }
     image.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     glProgramUniform1i(stages_[0].id(), SUBSCAN_UNIFORM_DIVISOR, frame.divisor);
-    if (depthInput_.empty() || !frame.restricted()) {
+    if (whole) {
         stages_.runOverImage(0, size.x, size.y);
     } else {
-        clearToBackground(image, frame.settings.raster);
         stages_.runOverRegion(0, outputRegion(frame));
     }
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

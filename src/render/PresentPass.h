@@ -20,7 +20,7 @@ class PresentPass final : public RenderPass {
     void execute(FrameContext& frame) override;
 
     /// Fills `image` with the frame's background exactly as the shader encodes it.
-    static void clearToBackground(Texture& image, const RasterSettings& raster);
+    static void clearToBackground(const FrameContext& frame, Texture& image);
 
   private:
     std::string colorInput_;

@@ -25,7 +25,7 @@ void PullPushPass::execute(FrameContext& frame) {
     pullWeights.bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     if (frame.restricted()) {
         // Pull and fill removal read weights around their region: there they must be zero.
-        pullWeights.fill(0);
+        frame.fill(pullWeights, 0);
     }
     Buffer& pushValues = resources.ensureBuffer("pushValues", texels * 4 * sizeof(float));
     pushValues.bindStorage(SUBSCAN_SSBO_PUSH_VALUES);

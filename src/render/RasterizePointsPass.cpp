@@ -122,14 +122,14 @@ void RasterizePointsPass::execute(FrameContext& frame) {
 
     // Empty pixels: +inf and no colour. The resolve then visits only the pixels the cloud's
     // bounding box projects to, and writes those that hold a point.
-    depth.clear(glm::vec4(std::numeric_limits<float>::infinity()));
-    color.clear();
+    frame.clear(depth, glm::vec4(std::numeric_limits<float>::infinity()));
+    frame.clear(color);
     if (int64) {
         const std::size_t pixels =
             static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
         Buffer& depthIndex =
             frame.resources.ensureBuffer("depthIndex", pixels * sizeof(std::uint64_t));
-        depthIndex.fill(kEmptyIndex);  // both halves all ones: no depth, no point
+        frame.fill(depthIndex, kEmptyIndex);  // both halves all ones: no depth, no point
         depthIndex.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
         runPerChunk(int64Stage_, frame, false);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -137,7 +137,7 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     } else {
         Texture& pointIndex =
             frame.resources.ensureTexture("pointIndex", TextureFormat::R32UI, width, height);
-        pointIndex.clearUint(kEmptyIndex);
+        frame.clearUint(pointIndex, kEmptyIndex);
         depth.bindImageBits(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
         runPerChunk(depthStage_, frame, false);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
@@ -154,7 +154,7 @@ void RasterizePointsPass::execute(FrameContext& frame) {
             static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
         Buffer& sums =
             frame.resources.ensureBuffer("colorSums", pixels * 4 * sizeof(std::uint32_t));
-        sums.fill(0u);
+        frame.fill(sums, 0u);
         sums.bindStorage(SUBSCAN_SSBO_COLOR_SUMS);
         if (!int64) {
             depth.bindImageBits(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);

@@ -8,6 +8,7 @@
 
 #include "core/Camera.h"
 #include "gpu/GlContext.h"
+#include "gpu/GpuClear.h"
 #include "render/ComputeStages.h"
 #include "render/FrameResources.h"
 #include "render/GpuPointCloud.h"
@@ -34,6 +35,7 @@ struct FrameContext {
     const RenderSettings& settings;
     const GlCapabilities& capabilities;
     FrameResources& resources;
+    GpuClear& clears;
     const gpu::PyramidLayout& pyramid;
     double spacing;  // the point spacing h, scene units
     /// Pixels [x, y, z, w) holding rasterized points, measured by MinDepthPyramidPass when
@@ -49,6 +51,17 @@ struct FrameContext {
     FrameOutputs outputs = FrameOutputs::Everything;
     /// The directional lights' maps, current for this frame's settings; null: no shadows.
     const LightMaps* lightMaps = nullptr;
+
+    /// Clears by the path the settings name (GpuClear).
+    void clear(Texture& texture, const glm::vec4& value = glm::vec4(0.0f)) const {
+        clears.texture(texture, value, settings.raster.clears);
+    }
+    void clearUint(Texture& texture, std::uint32_t value) const {
+        clears.textureUint(texture, value, settings.raster.clears);
+    }
+    void fill(Buffer& buffer, std::uint32_t value) const {
+        clears.buffer(buffer, value, settings.raster.clears);
+    }
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }

@@ -26,6 +26,11 @@ constexpr std::pair<RasterPath, std::string_view> kPaths[] = {
     {RasterPath::Int64, "int64"},
     {RasterPath::TwoPass32, "two-pass"},
 };
+constexpr std::pair<ClearPath, std::string_view> kClearPaths[] = {
+    {ClearPath::Auto, "auto"},
+    {ClearPath::Driver, "driver"},
+    {ClearPath::Compute, "compute"},
+};
 constexpr std::pair<TimingMode, std::string_view> kTimings[] = {
     {TimingMode::Auto, "auto"},
     {TimingMode::GpuQueries, "gpu-queries"},
@@ -90,6 +95,7 @@ void to_json(nlohmann::json& json, const RasterSettings& settings) {
         {"point_size", settings.pointSize},
         {"background_srgb", toJson(settings.backgroundSrgb)},
         {"timing", nameOf(kTimings, settings.timing)},
+        {"clears", nameOf(kClearPaths, settings.clears)},
         {"stage", toString(settings.stage)},
         {"stage_level", settings.stageLevel},
         {"resolution", toString(settings.resolution)},
@@ -99,13 +105,14 @@ void to_json(nlohmann::json& json, const RasterSettings& settings) {
 
 void from_json(const nlohmann::json& json, RasterSettings& settings) {
     rejectUnknownKeys(json, "raster",
-                      {"mode", "raster_path", "point_size", "background_srgb", "timing", "stage",
-                       "stage_level", "resolution", "color_blend"});
+                      {"mode", "raster_path", "point_size", "background_srgb", "timing", "clears",
+                       "stage", "stage_level", "resolution", "color_blend"});
     readEnum(json, "mode", settings.mode, kModes, "render mode");
     readEnum(json, "raster_path", settings.path, kPaths, "raster path");
     readSetting(json, "point_size", settings.pointSize, 1.0f, 64.0f);
     readSetting(json, "background_srgb", settings.backgroundSrgb, 0.0f, 1.0f);
     readEnum(json, "timing", settings.timing, kTimings, "timing mode");
+    readEnum(json, "clears", settings.clears, kClearPaths, "clear path");
     readEnum(json, "stage", settings.stage, kStages, "stage");
     readSetting(json, "stage_level", settings.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
     readEnum(json, "resolution", settings.resolution, kResolutions, "resolution");

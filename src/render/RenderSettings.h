@@ -7,6 +7,7 @@
 #include <glm/vec3.hpp>
 #include <nlohmann/json_fwd.hpp>
 
+#include "gpu/GpuClear.h"
 #include "gpu/PassTimer.h"
 #include "render/ScatteringSettings.h"
 #include "render/SurfaceSettings.h"
@@ -45,6 +46,7 @@ struct RasterSettings {
     float pointSize = 4.0f;                         // splats, in pixels
     glm::vec3 backgroundSrgb{0.19f, 0.19f, 0.19f};  // sRGB-encoded 0..1, like colour pickers
     TimingMode timing = TimingMode::Auto;
+    ClearPath clears = ClearPath::Auto;
     Stage stage = Stage::Final;
     int stageLevel = 3;  // the pyramid level the pyramid and pull stages show
     Resolution resolution = Resolution::Full;

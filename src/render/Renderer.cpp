@@ -43,12 +43,13 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
                    std::size_t maxChunkPoints, PointMemory memory)
     : context_(context),
+      clears_(sources_, context.capabilities()),
       cloud_(cloud, context.capabilities(), maxChunkPoints, memory),
       spacing_(usableSpacing(cloud, spacing.global)),
       resolutionChooser_(cloud),
       cloudBounds_(cloud.bounds),
       reconstruction_(sources_, context.capabilities()),
-      lightMaps_(context, sources_, reconstruction_) {
+      lightMaps_(context, sources_, clears_, reconstruction_) {
     if (!spacing.local.empty()) {
         setLocalSpacing(spacing.local);
     }
@@ -205,8 +206,8 @@ FrameResult Renderer::render(const Camera& camera, const RenderSettings& setting
     const std::vector<RenderPass*> passes =
         passesFor(settings, divisor, fused ? LevelZero::Fused : LevelZero::PerPass);
     lastDivisor_ = divisor;
-    FrameContext context{pipelineCamera_,       cloud_, settings, capabilities(),
-                         resourcesFor(divisor), layout, spacing_};
+    FrameContext context{pipelineCamera_,       cloud_,  settings, capabilities(),
+                         resourcesFor(divisor), clears_, layout,   spacing_};
     context.cloudPixels = projectedPixelBounds(pipelineCamera_, cloudBounds_);
     context.outputs = outputs;
     context.lightMaps = lightMaps ? &lightMaps_ : nullptr;

@@ -114,6 +114,7 @@ class Renderer {
 
     GlContext& context_;
     ShaderSources sources_;
+    GpuClear clears_;
     GpuPointCloud cloud_;
     double spacing_;
     ResolutionChooser resolutionChooser_;

@@ -79,6 +79,10 @@ void ShadePass::execute(FrameContext& frame) {
     const int width = frame.width();
     const int height = frame.height();
     Texture& radiance = resources.ensureTexture("radiance", TextureFormat::RGBA16F, width, height);
+    if (frame.restricted()) {
+        // The other outputs are read only on the surface; the radiance is exported whole.
+        frame.clear(radiance);
+    }
     params_.set(parameters(frame));
     params_.bind(SUBSCAN_UBO_PASS);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
@@ -93,10 +97,6 @@ void ShadePass::execute(FrameContext& frame) {
             .bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
     }
     radiance.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
-    if (frame.restricted()) {
-        // The other outputs are read only on the surface; the radiance is exported whole.
-        radiance.clear();
-    }
     stages_.runOverRegion(0, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);

@@ -72,6 +72,19 @@ void SingleScatteringPass::execute(FrameContext& frame) {
     Texture& sigmaSPrime =
         resources.ensureTexture("sigmaSPrime", TextureFormat::RGBA32F, width, height);
     Texture& sigmaA = resources.ensureTexture("sigmaA", TextureFormat::RGBA32F, width, height);
+    Texture& scattered =
+        base_ == SingleScatteringBase::Radiance
+            ? resources.ensureTexture("scatteredRadiance", TextureFormat::RGBA16F, width, height)
+            : resources.texture("scatteredRadiance");
+    if (frame.restricted() && frame.outputs == FrameOutputs::Everything) {
+        // Exported whole; the pass writes only the points' region.
+        frame.clear(single);
+        frame.clear(sigmaSPrime);
+        frame.clear(sigmaA);
+    }
+    if (frame.restricted() && base_ == SingleScatteringBase::Radiance) {
+        frame.clear(scattered);
+    }
     params_.set(params);
     params_.bind(SUBSCAN_UBO_PASS);
     const gpu::ShadeParams lights = ShadePass::parameters(frame);
@@ -83,23 +96,13 @@ void SingleScatteringPass::execute(FrameContext& frame) {
     resources.texture("albedo").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
     if (base_ == SingleScatteringBase::Radiance) {
         resources.texture("radiance").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
-        resources.ensureTexture("scatteredRadiance", TextureFormat::RGBA16F, width, height)
-            .bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+        scattered.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     } else {
-        resources.texture("scatteredRadiance").bindImage(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
+        scattered.bindImage(SUBSCAN_IMAGE_OUT0, GL_READ_WRITE);
     }
     single.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     sigmaSPrime.bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
     sigmaA.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
-    if (frame.restricted() && frame.outputs == FrameOutputs::Everything) {
-        // Exported whole; the pass writes only the points' region.
-        single.clear();
-        sigmaSPrime.clear();
-        sigmaA.clear();
-    }
-    if (frame.restricted() && base_ == SingleScatteringBase::Radiance) {
-        resources.texture("scatteredRadiance").clear();
-    }
     const LightStage stage =
         lights.lightCount.x == 0                                                  ? HeadLight
         : frame.lightMaps != nullptr && settings.lightPath == LightPath::LightMap ? MappedLights

@@ -110,10 +110,10 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     sum.bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     resources.texture("albedo").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
     resources.texture("specular").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
-    radiance.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (frame.restricted()) {
-        radiance.clear();
+        frame.clear(radiance);
     }
+    radiance.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     stages_.runOverRegion(Combine, region);
     glMemoryBarrier(kImageBarriers);
 }

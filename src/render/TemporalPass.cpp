@@ -104,11 +104,11 @@ TemporalHistory::Mode TemporalHistory::begin(FrameContext& frame, bool picture) 
     if (frame.region(0).size != glm::ivec2(width, height)) {
         // Off the region this frame shows the background (surfaceDepth is +inf there).
         const glm::vec3& background = frame.settings.raster.backgroundSrgb;
-        history.clear(glm::vec4(srgbToLinear(background.r), srgbToLinear(background.g),
-                                srgbToLinear(background.b), 0.0f));
-        state.clear(glm::vec4(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f));
+        frame.clear(history, glm::vec4(srgbToLinear(background.r), srgbToLinear(background.g),
+                                       srgbToLinear(background.b), 0.0f));
+        frame.clear(state, glm::vec4(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f));
         if (image) {
-            PresentPass::clearToBackground(*image, frame.settings.raster);
+            PresentPass::clearToBackground(frame, *image);
         }
     }
     if (image) {

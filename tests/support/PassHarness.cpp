@@ -37,7 +37,7 @@ PassHarness::PassHarness(int width, int height, const RenderSettings& settings, 
 
 FrameContext PassHarness::context() {
     return {camera_,    cloud_,  settings_, glTestContext().capabilities(),
-            resources_, layout_, spacing_};
+            resources_, clears_, layout_,   spacing_};
 }
 
 void PassHarness::setCamera(const Camera& camera) {

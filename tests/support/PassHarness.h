@@ -9,6 +9,7 @@
 #include "render/GpuPointCloud.h"
 #include "render/RenderPass.h"
 #include "render/RenderSettings.h"
+#include "support/GlTestSupport.h"
 
 namespace subscan::test {
 
@@ -43,6 +44,7 @@ class PassHarness {
     gpu::PyramidLayout layout_{};
     FrameResources resources_;
     ShaderSources sources_;
+    GpuClear clears_{sources_, glTestContext().capabilities()};
 };
 
 }  // namespace subscan::test
