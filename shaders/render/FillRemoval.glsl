@@ -28,18 +28,16 @@ uint reachOf(uint onLevel, ivec2 texel) {
     return reach;
 }
 
-/// Whether `pixel`, filled to `depth` by pull-push, belongs to the surface (the "mask").
-/// `spacingRatio`: spacingRatioAt(pixel), which scales the expected gap.
-bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
-    if (!(depth > 0.0 && !isinf(depth) && !isnan(depth))) {
-        return false;
-    }
-    if (pullWeightAt(texelIndex(0u, pixel)) > 0.0) {
-        return true;
-    }
+layout(std430, binding = SUBSCAN_SSBO_OCCUPANCY) readonly buffer Occupancy {
+    uint occupancy[];
+};
+
+/// Whether the pixel `pixel` without a visible point of its own, at depth `depth`, lies in a
+/// gap the fill closes: enough directions find points within the expected gap.
+bool fillsGap(ivec2 pixel, float depth, float spacingRatio) {
     // Level 1 at least: its texels bridge one-pixel gaps between dense points.
-    uint levels = uint(
-        ceil(clamp(levelForRadius(surface.fill.x * spacingRatio, depth), 1.0, float(levelCount() - 1u))));
+    uint levels = uint(ceil(
+        clamp(levelForRadius(surface.fill.x * spacingRatio, depth), 1.0, float(levelCount() - 1u))));
     // kNoReach never counts: it could only mean the top level, whose one texel has no
     // neighbours.
     levels = min(levels, kNoReach - 1u);
@@ -49,4 +47,53 @@ bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
         enclosed += ((reach >> (4 * k)) & 0xFu) <= levels ? 1 : 0;
     }
     return float(enclosed) >= surface.fill.y;
+}
+
+/// How many of the 4x4 sub-cells of `pixel` hold a point (hidden ones too).
+uint occupiedCells(ivec2 pixel) {
+    return uint(bitCount(occupancy[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)]));
+}
+
+/// Whether `pixel`, holding a visible point, lies on the outline of a dense cloud with its
+/// centre outside it. A straight outline leaves more than half of a pixel inside exactly when
+/// it passes the centre; the points' cells show that area plus the cells the outline cuts,
+/// half a column of them on average (1/8 of a pixel): so the centre lies outside when at most
+/// 1/2 + 1/8 of the densest neighbour's cells hold points. Only beside a pixel without any
+/// point that the fill leaves empty (the background: an outline, not a gap between points),
+/// and only where the cloud fills 3/4 of the cells (sparser clouds do not show the area).
+bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
+    uint own = occupiedCells(pixel);
+    uint densest = own;
+    ivec2 size = imageSizeOfFrame();
+    for (int k = 0; k < 8; ++k) {
+        ivec2 neighbour = pixel + kDirections[k];
+        if (all(greaterThanEqual(neighbour, ivec2(0))) && all(lessThan(neighbour, size))) {
+            densest = max(densest, occupiedCells(neighbour));
+        }
+    }
+    if (densest < 12u || float(own) > 0.625 * float(densest)) {
+        return false;
+    }
+    // Off the image's border the surface goes on. The neighbour's gap is judged at this
+    // pixel's depth.
+    for (int k = 0; k < 8; k += 2) {  // the 4-neighbours
+        ivec2 neighbour = pixel + kDirections[k];
+        if (all(greaterThanEqual(neighbour, ivec2(0))) && all(lessThan(neighbour, size)) &&
+            occupiedCells(neighbour) == 0u && !fillsGap(neighbour, depth, spacingRatio)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/// Whether `pixel`, filled to `depth` by pull-push, belongs to the surface (the "mask").
+/// `spacingRatio`: spacingRatioAt(pixel), which scales the expected gap.
+bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
+    if (!(depth > 0.0 && !isinf(depth) && !isnan(depth))) {
+        return false;
+    }
+    if (pullWeightAt(texelIndex(0u, pixel)) > 0.0) {
+        return surface.fill.w == 0.0 || !centreBeyondOutline(pixel, depth, spacingRatio);
+    }
+    return fillsGap(pixel, depth, spacingRatio);
 }

@@ -44,6 +44,11 @@ layout(std430, binding = SUBSCAN_SSBO_DEPTH_INDEX) buffer DepthIndex {
     uint64_t depthIndex[];
 };
 #endif
+#if STAGE_DEPTH || STAGE_INT64
+layout(std430, binding = SUBSCAN_SSBO_OCCUPANCY) buffer Occupancy {
+    uint occupancy[];
+};
+#endif
 #if STAGE_BLEND || (STAGE_RESOLVE && USE_BLEND)
 layout(std430, binding = SUBSCAN_SSBO_COLOR_SUMS) buffer ColorSums {
     uvec4 colorSums[];
@@ -127,6 +132,18 @@ void main() {
     }
     uint bits = floatBitsToUint(depth);
     uint index = raster.firstPoint + local;
+#if STAGE_DEPTH || STAGE_INT64
+    if (surface.fill.w > 0.0) {
+        // The point's 4x4 sub-cell (FillRemoval.glsl's outline); the atomic only for a cell
+        // not yet marked, which in a dense cloud most points find marked.
+        ivec2 cell = clamp(ivec2(floor(fract(windowPosition(viewPosition)) * 4.0)), 0, 3);
+        uint word = 1u << uint(cell.y * 4 + cell.x);
+        uint at = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
+        if ((occupancy[at] & word) == 0u) {
+            atomicOr(occupancy[at], word);
+        }
+    }
+#endif
 #if STAGE_DEPTH
     // The atomic only where a plain read says the point could win: where many points share a
     // pixel most lose, and on llvmpipe an image atomic costs about twice a read. A stale read

@@ -43,6 +43,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 #define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
 #define SUBSCAN_SSBO_COLOR_SUMS 12    // uvec4 per pixel: fixed-point linear RGB sums, point count
+#define SUBSCAN_SSBO_OCCUPANCY 14     // uint per pixel: which of its 4x4 sub-cells hold points
 #define SUBSCAN_SSBO_CLEAR 13         // uint words GpuClear fills (its own binding: no pass's)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
@@ -129,7 +130,8 @@ struct PyramidLayout {
 struct SurfaceParams {
     vec4 visibility;  // x: HPR radius, y: threshold tau, z: edge rule (1 or 0), w: unused
     vec4 fill;        // x: radius of the expected gap, y: directions that must find points,
-                      // z: pull depth slope (texel widths), w: unused
+                      // z: pull depth slope (texel widths), w: 1 to place a dense
+                      // cloud's outline by its points' sub-pixel cells (SUBSCAN_SSBO_OCCUPANCY)
     vec4 normals;     // x: smoothing radius
     vec4 spacing;     // x: 1 when the points carry their local spacing, else 0
 };

@@ -47,6 +47,9 @@ void FillRemovalPass::execute(FrameContext& frame) {
         frame.clear(mask);
         frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
     }
+    if (placesOutlineBySubpixels(frame.settings)) {
+        resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
+    }
     resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);

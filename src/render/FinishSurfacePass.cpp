@@ -65,6 +65,9 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
     resources.buffer("normalPyramid").bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
+    if (placesOutlineBySubpixels(frame.settings)) {
+        resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
+    }
     const gpu::ShadeParams shade = ShadePass::parameters(frame);
     params_.set(shade);
     params_.bind(SUBSCAN_UBO_PASS);

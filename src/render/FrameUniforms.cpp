@@ -35,7 +35,7 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
     params.visibility = {surface.visibilityRadius * h, surface.visibilityThreshold,
                          surface.edgeRule ? 1.0f : 0.0f, 0.0f};
     params.fill = {surface.fillRadius * h, static_cast<float>(surface.fillDirections),
-                   surface.pullDepthSlope, 0.0f};
+                   surface.pullDepthSlope, placesOutlineBySubpixels(settings) ? 1.0f : 0.0f};
     params.normals = {surface.normalRadius * h, 0.0f, 0.0f, 0.0f};
     params.spacing = {surface.localSpacing && cloud.hasLocalSpacing() ? 1.0f : 0.0f, 0.0f, 0.0f,
                       0.0f};

@@ -124,6 +124,14 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     // bounding box projects to, and writes those that hold a point.
     frame.clear(depth, glm::vec4(std::numeric_limits<float>::infinity()));
     frame.clear(color);
+    if (placesOutlineBySubpixels(frame.settings)) {
+        // Which 4x4 sub-cells of each pixel hold points (FillRemoval.glsl's outline).
+        Buffer& occupancy = frame.resources.ensureBuffer(
+            "occupancy", static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
+                             sizeof(std::uint32_t));
+        frame.fill(occupancy, 0u);
+        occupancy.bindStorage(SUBSCAN_SSBO_OCCUPANCY);
+    }
     if (int64) {
         const std::size_t pixels =
             static_cast<std::size_t>(width) * static_cast<std::size_t>(height);

@@ -83,6 +83,10 @@ bool isFinalImage(Stage stage) {
     return stage == Stage::Final || stage == Stage::Shaded;
 }
 
+bool placesOutlineBySubpixels(const RenderSettings& settings) {
+    return settings.surface.subpixelOutline && reconstructsSurface(settings.raster.mode);
+}
+
 bool filtersTemporally(const RenderSettings& settings) {
     return settings.temporal.enabled && reconstructsSurface(settings.raster.mode) &&
            settings.raster.stage == Stage::Final;

@@ -118,6 +118,9 @@ bool isFinalImage(Stage stage);
 /// Whether a frame runs the temporal filter: enabled, in a mode that reconstructs, for its
 /// final picture.
 bool filtersTemporally(const RenderSettings& settings);
+/// Whether the frame records its points' sub-pixel cells and places the outline by them
+/// (SurfaceSettings::subpixelOutline in a mode that reconstructs the surface).
+bool placesOutlineBySubpixels(const RenderSettings& settings);
 /// Frames a camera at rest renders through the temporal filter before its picture counts as
 /// finished (the viewer then idles; `render` with the filter on averages this many): 32 jitter
 /// offsets put an edge pixel's coverage within 1/32 of its supersampled value.

@@ -27,6 +27,10 @@ struct SurfaceSettings {
     // Radii scale with each point's local spacing where the renderer has it
     // (estimatePointSpacing), instead of the one global h.
     bool localSpacing = true;
+    // A dense cloud's outline runs through its outermost pixels where their points' 4x4
+    // sub-pixel cells say it does (more than about half covered: kept), instead of every pixel
+    // a point falls in being surface (half a pixel too far out on average).
+    bool subpixelOutline = true;
 
     bool operator==(const SurfaceSettings&) const = default;
 };

@@ -4,6 +4,7 @@
 // except where the CPU finds a value within rounding distance of the threshold (a tie).
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -379,13 +380,18 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
     return result;
 }
 
-void runUpToPullPush(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
-                     bool spacingRatios = false) {
-    uploadInputs(harness, depth, color, spacingRatios);
+/// The pyramid, hidden point removal and pull-push on the inputs already uploaded.
+void runPullPushPasses(PassHarness& harness) {
     FrameContext frame = harness.context();
     MinDepthPyramidPass(harness.sources()).execute(frame);
     HiddenPointRemovalPass(harness.sources()).execute(frame);
     PullPushPass(harness.sources()).execute(frame);
+}
+
+void runUpToPullPush(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
+                     bool spacingRatios = false) {
+    uploadInputs(harness, depth, color, spacingRatios);
+    runPullPushPasses(harness);
 }
 
 void runUpToNormals(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
@@ -459,6 +465,46 @@ double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, 
     return 1.0;
 }
 
+/// The CPU twin of FillRemoval.glsl's fillsGap: whether the pixel (x, y), without a visible
+/// point, lies in a gap the fill closes when judged at `depth` with the spacing ratio `ratio`;
+/// nullopt for a tie (float vs double: an unclamped level this close to an integer may round
+/// up either way).
+std::optional<bool> cpuFillsGap(const PassHarness& harness, const std::vector<float>& weights,
+                                int x, int y, double depth, double ratio) {
+    const auto all = levels();
+    const SurfaceSettings& surface = harness.settings().surface;
+    const double raw = std::log2(surface.fillRadius * kSpacing * ratio * harness.focal() / depth);
+    const double level = std::clamp(raw, 1.0, static_cast<double>(all.size() - 1));
+    if (level == raw && std::abs(level - std::round(level)) < 1e-4) {
+        return std::nullopt;
+    }
+    const int maxLevel = static_cast<int>(std::ceil(level));
+    const int directions[8][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
+                                  {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+    int enclosed = 0;
+    for (const auto& direction : directions) {
+        bool found = false;
+        for (int l = 0; l <= maxLevel && !found; ++l) {
+            const Level& lv = all[l];
+            const int qx = (x >> l) + direction[0], qy = (y >> l) + direction[1];
+            // Beyond the image counts as found: the surface goes on past it.
+            found = qx < 0 || qy < 0 || qx >= lv.width || qy >= lv.height ||
+                    weights[lv.offset + qy * lv.width + qx] > 0.0f;
+        }
+        enclosed += found;
+    }
+    return enclosed >= surface.fillDirections;
+}
+
+/// The pull weights w (level 0: the visibility) of every level.
+std::vector<float> pullWeightsOf(const FrameResources& resources) {
+    const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
+    std::vector<float> weights(pulled.size());
+    std::transform(pulled.begin(), pulled.end(), weights.begin(),
+                   [](const glm::vec2& texel) { return texel.x; });
+    return weights;
+}
+
 TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
     PassHarness harness = makeHarness(3, GetParam());
     std::vector<float> depth, color;
@@ -467,46 +513,23 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
     FillRemovalPass(harness.sources()).execute(frame);
     const FrameResources& resources = harness.resources();
     const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
-    std::vector<float> weights(pulled.size());
-    std::transform(pulled.begin(), pulled.end(), weights.begin(),
-                   [](const glm::vec2& texel) { return texel.x; });
+    const std::vector<float> weights = pullWeightsOf(resources);
     const std::vector<float> filled = resources.texture("filledDepth").readFloats();
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const std::vector<float> surfaceDepth = resources.texture("surfaceDepth").readFloats();
-    const auto all = levels();
-    const SurfaceSettings& surface = harness.settings().surface;
-    const int directions[8][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
-                                  {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
     int ties = 0, kept = 0, filledGaps = 0, removed = 0;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
             bool expected = weights[i] > 0.0f;  // a visible point of its own
             if (!expected) {
-                const double raw = std::log2(surface.fillRadius * kSpacing *
-                                             cpuSpacingRatio(pulled, GetParam(), x, y) *
-                                             harness.focal() / filled[i]);
-                const double level = std::clamp(raw, 1.0, static_cast<double>(all.size() - 1));
-                // float vs double: an unclamped level this close to an integer may round up
-                // either way.
-                if (level == raw && std::abs(level - std::round(level)) < 1e-4) {
+                const std::optional<bool> gap = cpuFillsGap(
+                    harness, weights, x, y, filled[i], cpuSpacingRatio(pulled, GetParam(), x, y));
+                if (!gap) {
                     ++ties;
                     continue;
                 }
-                const int maxLevel = static_cast<int>(std::ceil(level));
-                int enclosed = 0;
-                for (const auto& direction : directions) {
-                    bool found = false;
-                    for (int l = 0; l <= maxLevel && !found; ++l) {
-                        const Level& lv = all[l];
-                        const int qx = (x >> l) + direction[0], qy = (y >> l) + direction[1];
-                        // Beyond the image counts as found: the surface goes on past it.
-                        found = qx < 0 || qy < 0 || qx >= lv.width || qy >= lv.height ||
-                                weights[lv.offset + qy * lv.width + qx] > 0.0f;
-                    }
-                    enclosed += found;
-                }
-                expected = enclosed >= surface.fillDirections;
+                expected = *gap;
                 (expected ? filledGaps : removed)++;
             } else {
                 ++kept;
@@ -519,6 +542,93 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
     EXPECT_GT(kept, 80);  // all three outcomes occur in this frame
     EXPECT_GT(filledGaps, 20);
     EXPECT_GT(removed, 0);
+}
+
+TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
+    // The surface mode places a dense cloud's outline by its points' sub-pixel cells. Random
+    // cells per pixel: pixels with a point hold 1..16 of them (most all 16, so that the
+    // densest neighbour usually passes 12), pixels without none.
+    RenderSettings settings = makeHarness().settings();
+    settings.raster.mode = RenderMode::Surface;
+    PassHarness harness(kWidth, kHeight, settings, kSpacing, 50.0, GetParam());
+    std::vector<float> depth, color;
+    uploadInputs(harness, depth, color, GetParam());
+    // The right quarter empty: background beside the cloud, an outline along x = 27, with
+    // points on the front surface in every pixel of the four columns before it.
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 24; x < kWidth; ++x) {
+            const float u = static_cast<float>(x) / kWidth, v = static_cast<float>(y) / kHeight;
+            depth[y * kWidth + x] = x < 28 ? 4.0f + 1.5f * u + 0.8f * std::sin(6.0f * v) * u
+                                           : std::numeric_limits<float>::infinity();
+        }
+    }
+    harness.resources().texture("depth").uploadFloats(depth);
+    std::mt19937 random(11);
+    std::vector<std::uint32_t> cells(kWidth * kHeight, 0u);
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+        // Near the outline two in three pixels partly covered, elsewhere one in three.
+        const bool partly = random() % 3 < (i % kWidth >= 24 ? 2u : 1u);
+        if (std::isfinite(depth[i])) {
+            cells[i] = partly ? static_cast<std::uint32_t>(random() % 0xFFFF) + 1u : 0xFFFFu;
+        }
+    }
+    harness.resources()
+        .ensureBuffer("occupancy", cells.size() * sizeof(std::uint32_t))
+        .upload(0, cells.size() * sizeof(std::uint32_t), cells.data());
+    runPullPushPasses(harness);
+    FrameContext frame = harness.context();
+    FillRemovalPass(harness.sources()).execute(frame);
+    const FrameResources& resources = harness.resources();
+    const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
+    const std::vector<float> weights = pullWeightsOf(resources);
+    const std::vector<float> filled = resources.texture("filledDepth").readFloats();
+    const std::vector<float> mask = resources.texture("mask").readFloats();
+    const auto cellsAt = [&](int x, int y) { return std::popcount(cells[y * kWidth + x]); };
+    const auto inside = [](int x, int y) { return x >= 0 && y >= 0 && x < kWidth && y < kHeight; };
+    int ties = 0, beyond = 0, besideFilledGap = 0, kept = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const int i = y * kWidth + x;
+            if (!(weights[i] > 0.0f)) {
+                continue;  // the gap rule, tested above
+            }
+            int densest = cellsAt(x, y);
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    if (inside(x + dx, y + dy)) {
+                        densest = std::max(densest, cellsAt(x + dx, y + dy));
+                    }
+                }
+            }
+            bool outside = false, tie = false, emptyBeside = false;
+            // At most 1/2 + 1/8 of the densest neighbour's cells, where the cloud is dense.
+            if (densest >= 12 && cellsAt(x, y) <= 0.625 * densest) {
+                for (const auto [dx, dy] : {std::pair{1, 0}, {0, 1}, {-1, 0}, {0, -1}}) {
+                    if (!inside(x + dx, y + dy) || cellsAt(x + dx, y + dy) != 0) {
+                        continue;
+                    }
+                    emptyBeside = true;
+                    // The neighbour's gap judged at this pixel's depth and spacing ratio.
+                    const std::optional<bool> gap =
+                        cpuFillsGap(harness, weights, x + dx, y + dy, filled[i],
+                                    cpuSpacingRatio(pulled, GetParam(), x, y));
+                    tie = tie || !gap;
+                    outside = outside || (gap && !*gap);
+                }
+            }
+            if (tie && !outside) {
+                ++ties;
+                continue;
+            }
+            (outside ? beyond : emptyBeside ? besideFilledGap : kept)++;
+            EXPECT_EQ(mask[i] > 0.5f, !outside) << x << "," << y;
+        }
+    }
+    EXPECT_LT(ties, 3);
+    // Each way the rule can go occurs in this frame.
+    EXPECT_GT(beyond, 3);
+    EXPECT_GT(besideFilledGap, 3);
+    EXPECT_GT(kept, 80);
 }
 
 TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {

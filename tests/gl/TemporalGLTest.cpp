@@ -326,12 +326,14 @@ PointCloud square(int perSide) {
 }
 
 TEST(TemporalGLTest, JitteredFramesConvergeToTheSupersampledCoverageOfAnEdge) {
-    // The square seen face on, 32 pixels wide, its left and right edges 1/64 pixel past pixel
-    // boundaries (8 and 40; exact boundaries would leave the outermost points to rounding).
-    // A pixel holding any point is surface, so the reconstruction's silhouette lies half a
-    // pixel outside the points: pixels 7 and 40 are covered when the jitter moves the edge
-    // into them, half of the offsets; one frame shows them covered or not (error 0.5), and
-    // the mean over 16 Halton offsets, whose x are 16 evenly spread values, gives 8/16.
+    // The square seen face on, 32 pixels wide, its left and right edges 1/64 pixel past the
+    // middle of pixels 8 and 40 (not exactly there, which would leave the outermost points to
+    // rounding). A frame's pixel is surface when the jittered pixel centre lies inside the
+    // outline the points' sub-pixel cells show (SurfaceSettings::subpixelOutline), so each
+    // frame shows the edge pixels covered or not (error 0.5), and the mean over 16 Halton
+    // offsets, whose x are 16 evenly spread values, is the fraction of offsets that put the
+    // centre inside: 8/16 for both, against the true areas 31/64 and 33/64. Were every pixel
+    // holding a point surface, pixel 8 would be covered in every frame.
     constexpr int kSize = 48;
     Camera camera;
     camera.width = kSize;
@@ -340,21 +342,28 @@ TEST(TemporalGLTest, JitteredFramesConvergeToTheSupersampledCoverageOfAnEdge) {
     const double distance = 2.0 / (32.0 / camera.focalLengthPixels());  // 2 units = 32 px
     camera.nearPlane = 0.1;
     camera.farPlane = 10.0;
-    const double offset = distance / camera.focalLengthPixels() / 64.0;
-    camera.view = glm::translate(glm::dmat4(1.0), glm::dvec3(offset, 0.0, -distance));
+    const double pixel = distance / camera.focalLengthPixels();  // scene units per pixel
+    camera.view =
+        glm::translate(glm::dmat4(1.0), glm::dvec3((0.5 + 1.0 / 64.0) * pixel, 0.0, -distance));
 
-    const PointCloud cloud = square(257);  // 8 points per pixel: the edge is sharp to 1/8 px
+    const PointCloud cloud = square(257);  // 8 points per pixel: every 4x4 cell holds points
     Renderer renderer(test::glTestContext(), cloud);
     RenderSettings settings;
     settings.raster.mode = RenderMode::Surface;
     settings.temporal.enabled = true;
-    auto edgeError = [&](const std::vector<float>& coverage) {
+    // Along the edges, away from the corners: the two edge pixels of each row at 1/2, their
+    // outer neighbours at 0 and inner ones at 1.
+    const std::pair<int, double> expected[] = {{7, 0.0},  {8, 0.5},  {9, 1.0},
+                                               {39, 1.0}, {40, 0.5}, {41, 0.0}};
+    auto edgeError = [&](const std::vector<float>& coverage, bool edgesOnly) {
         double error = 0.0;
         int pixels = 0;
-        for (int y = 10; y < 38; ++y) {  // along the edges, away from the corners
-            for (const glm::ivec2 pixel : {glm::ivec2(7, y), glm::ivec2(40, y)}) {
-                error += std::abs(coverage[pixel.y * kSize + pixel.x] - 0.5);
-                ++pixels;
+        for (int y = 10; y < 38; ++y) {
+            for (const auto& [x, value] : expected) {
+                if (!edgesOnly || value == 0.5) {
+                    error += std::abs(coverage[y * kSize + x] - value);
+                    ++pixels;
+                }
             }
         }
         return error / pixels;
@@ -368,11 +377,11 @@ TEST(TemporalGLTest, JitteredFramesConvergeToTheSupersampledCoverageOfAnEdge) {
         return alpha;
     };
     renderer.render(camera, settings);
-    const double oneFrame = edgeError(alphaOf());
+    const double oneFrame = edgeError(alphaOf(), true);
     for (int frame = 1; frame < 16; ++frame) {
         renderer.render(camera, settings);
     }
-    const double sixteenFrames = edgeError(alphaOf());
+    const double sixteenFrames = edgeError(alphaOf(), false);
     EXPECT_GT(oneFrame, 0.45) << "one frame decides each edge pixel whole";
     // 8 of 16 exactly, up to the half-float result; points 1/8 pixel apart leave no room
     // for a miss.

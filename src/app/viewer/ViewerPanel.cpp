@@ -403,6 +403,10 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
     helpTooltip(
         "Radii scale with each point's own spacing where the scan's density varies (a LiDAR "
         "station); off: the one global h.");
+    ImGui::Checkbox("sub-pixel outline", &surface.subpixelOutline);
+    helpTooltip(
+        "A dense scan's outline runs where its points' sub-pixel cells put it, instead of "
+        "through every pixel a point falls in (half a pixel too far out).");
     ImGui::Checkbox("skip the screen around the points", &surface.restrictToPoints);
     helpTooltip(
         "Passes after rasterization work only inside the points' bounds (the same "
