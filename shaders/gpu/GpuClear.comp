@@ -5,6 +5,7 @@
 //                 however large the buffer)
 //   CLEAR_UINT    the r32ui image at SUBSCAN_IMAGE_OUT0
 //   otherwise     the float image at SUBSCAN_IMAGE_OUT0, of format IMAGE_FORMAT
+// An image's texels [origin, origin + size) only.
 #include "shared/bindings.h"
 
 #if CLEAR_BUFFER
@@ -30,11 +31,13 @@ layout(location = 0) uniform uvec4 value;
 layout(binding = SUBSCAN_IMAGE_OUT0, IMAGE_FORMAT) writeonly uniform image2D target;
 layout(location = 0) uniform vec4 value;
 #endif
+layout(location = 1) uniform ivec2 origin;
+layout(location = 2) uniform ivec2 size;
 
 void main() {
-    ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
-    if (all(lessThan(texel, imageSize(target)))) {
-        imageStore(target, texel, value);
+    ivec2 offset = ivec2(gl_GlobalInvocationID.xy);
+    if (all(lessThan(offset, size))) {
+        imageStore(target, origin + offset, value);
     }
 }
 #endif

@@ -253,6 +253,11 @@ void Texture::clear(const glm::vec4& value) {
     glClearTexImage(id(), 0, info(format_).pixelFormat, GL_FLOAT, &value.x);
 }
 
+void Texture::clearRegion(glm::ivec2 origin, glm::ivec2 size, const glm::vec4& value) {
+    glClearTexSubImage(id(), 0, origin.x, origin.y, 0, size.x, size.y, 1, info(format_).pixelFormat,
+                       GL_FLOAT, &value.x);
+}
+
 void Texture::clearUint(std::uint32_t value) {
     if (format_ != TextureFormat::R32UI) {
         throw Error("clearUint needs an R32UI texture");

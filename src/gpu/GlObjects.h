@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <epoxy/gl.h>
+#include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
 namespace subscan {
@@ -162,6 +163,8 @@ class Texture {
     void bindSampler(GLuint unit) const;
     /// Sets every texel to `value` (as many components as the format has).
     void clear(const glm::vec4& value = glm::vec4(0.0f));
+    /// Sets the texels [origin, origin + size) to `value`.
+    void clearRegion(glm::ivec2 origin, glm::ivec2 size, const glm::vec4& value);
     /// Sets every texel of an R32UI texture to `value`.
     void clearUint(std::uint32_t value);
 

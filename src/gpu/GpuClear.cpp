@@ -72,14 +72,23 @@ const Program& GpuClear::bufferProgram() {
 }
 
 void GpuClear::texture(Texture& texture, const glm::vec4& value, ClearPath path) {
+    textureRegion(texture, glm::ivec2(0), glm::ivec2(texture.width(), texture.height()), value,
+                  path);
+}
+
+void GpuClear::textureRegion(Texture& texture, glm::ivec2 origin, glm::ivec2 size,
+                             const glm::vec4& value, ClearPath path) {
+    if (size.x <= 0 || size.y <= 0) {
+        return;
+    }
     if (!byCompute(path) || !imageFormatQualifier(texture.format()) ||
         texture.format() == TextureFormat::R32UI) {
-        texture.clear(value);
+        texture.clearRegion(origin, size, value);
         return;
     }
     program(texture.format()).use();
     glUniform4fv(0, 1, &value.x);
-    storeEverywhere(texture);
+    store(texture, origin, size);
 }
 
 void GpuClear::textureUint(Texture& texture, std::uint32_t value, ClearPath path) {
@@ -93,13 +102,14 @@ void GpuClear::textureUint(Texture& texture, std::uint32_t value, ClearPath path
     program(TextureFormat::R32UI).use();
     const glm::uvec4 values(value);
     glUniform4uiv(0, 1, &values.x);
-    storeEverywhere(texture);
+    store(texture, glm::ivec2(0), glm::ivec2(texture.width(), texture.height()));
 }
 
-void GpuClear::storeEverywhere(Texture& texture) {
+void GpuClear::store(Texture& texture, glm::ivec2 origin, glm::ivec2 size) {
+    glUniform2i(1, origin.x, origin.y);
+    glUniform2i(2, size.x, size.y);
     texture.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-    Program::dispatch2D(texture.width(), texture.height(), SUBSCAN_IMAGE_GROUP_SIZE,
-                        SUBSCAN_IMAGE_GROUP_SIZE);
+    Program::dispatch2D(size.x, size.y, SUBSCAN_IMAGE_GROUP_SIZE, SUBSCAN_IMAGE_GROUP_SIZE);
     glMemoryBarrier(kAfterClear);
 }
 

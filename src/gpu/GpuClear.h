@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <map>
 
+#include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
 #include "gpu/GlContext.h"
@@ -30,6 +31,9 @@ class GpuClear {
 
     /// Every texel of `texture` to `value` (as many components as its format has).
     void texture(Texture& texture, const glm::vec4& value, ClearPath path);
+    /// The texels [origin, origin + size) of `texture` to `value` (inside the texture).
+    void textureRegion(Texture& texture, glm::ivec2 origin, glm::ivec2 size, const glm::vec4& value,
+                       ClearPath path);
     /// Every texel of an R32UI texture to `value`.
     void textureUint(Texture& texture, std::uint32_t value, ClearPath path);
     /// Every 32-bit word of `buffer` to `value`.
@@ -41,8 +45,8 @@ class GpuClear {
   private:
     const Program& program(TextureFormat format);
     const Program& bufferProgram();
-    /// Runs the image program in use over every texel of `texture`.
-    void storeEverywhere(Texture& texture);
+    /// Runs the image program in use over the texels [origin, origin + size) of `texture`.
+    void store(Texture& texture, glm::ivec2 origin, glm::ivec2 size);
 
     ShaderSources sources_;
     bool software_;

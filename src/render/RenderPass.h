@@ -56,6 +56,9 @@ struct FrameContext {
     void clear(Texture& texture, const glm::vec4& value = glm::vec4(0.0f)) const {
         clears.texture(texture, value, settings.raster.clears);
     }
+    void clear(Texture& texture, const TexelRegion& region, const glm::vec4& value) const {
+        clears.textureRegion(texture, region.origin, region.size, value, settings.raster.clears);
+    }
     void clearUint(Texture& texture, std::uint32_t value) const {
         clears.textureUint(texture, value, settings.raster.clears);
     }

@@ -1,6 +1,8 @@
 #include "render/TemporalPass.h"
 
+#include <algorithm>
 #include <limits>
+#include <vector>
 
 #include <glm/matrix.hpp>
 
@@ -33,6 +35,26 @@ bool sameView(const Camera& a, const Camera& b) {
            a.nearPlane == b.nearPlane && a.farPlane == b.farPlane && a.view == b.view &&
            a.orthographicHeight == b.orthographicHeight &&
            a.principalOffsetPixels == b.principalOffsetPixels;
+}
+
+/// The texels of `old` outside `current`: up to four rectangles (above, below, left, right).
+std::vector<TexelRegion> outside(const TexelRegion& old, const TexelRegion& current) {
+    const glm::ivec2 oldEnd = old.origin + old.size, end = current.origin + current.size;
+    std::vector<TexelRegion> parts;
+    auto add = [&](glm::ivec2 from, glm::ivec2 to) {
+        if (to.x > from.x && to.y > from.y) {
+            parts.push_back({from, to - from});
+        }
+    };
+    const int top = std::min(oldEnd.y, current.origin.y);
+    const int bottom = std::max(old.origin.y, end.y);
+    add(old.origin, {oldEnd.x, top});
+    add({old.origin.x, bottom}, oldEnd);
+    const int bandTop = std::max(old.origin.y, current.origin.y);
+    const int bandBottom = std::min(oldEnd.y, end.y);
+    add({old.origin.x, bandTop}, {std::min(oldEnd.x, current.origin.x), bandBottom});
+    add({std::max(old.origin.x, end.x), bandTop}, {oldEnd.x, bandBottom});
+    return parts;
 }
 
 Camera withoutJitter(const Camera& camera) {
@@ -101,12 +123,26 @@ TemporalHistory::Mode TemporalHistory::begin(FrameContext& frame, bool picture) 
     Texture& state = resources.texture("historyState");
     Texture* image =
         picture ? &resources.ensureTexture("image", TextureFormat::RGBA8, width, height) : nullptr;
-    if (frame.region(0).size != glm::ivec2(width, height)) {
-        // Off the region this frame shows the background (surfaceDepth is +inf there).
+    const TexelRegion region = frame.region(0);
+    if (mode == Mode::Restart) {
+        writtenBefore_.reset();
+        writtenLast_.reset();
+    }
+    if (region.size != glm::ivec2(width, height)) {
+        // Off the region this frame shows the background (surfaceDepth is +inf there). The
+        // history images hold it already except where they held an earlier frame: a full clear
+        // of them costs more than the filter itself (RGBA32F; bench/README, "On a GPU").
         const glm::vec3& background = frame.settings.raster.backgroundSrgb;
-        frame.clear(history, glm::vec4(srgbToLinear(background.r), srgbToLinear(background.g),
-                                       srgbToLinear(background.b), 0.0f));
-        frame.clear(state, glm::vec4(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f));
+        const glm::vec4 backgroundHistory(srgbToLinear(background.r), srgbToLinear(background.g),
+                                          srgbToLinear(background.b), 0.0f);
+        const glm::vec4 backgroundState(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f);
+        const std::vector<TexelRegion> stale =
+            writtenBefore_ ? outside(*writtenBefore_, region)
+                           : std::vector<TexelRegion>{{glm::ivec2(0), glm::ivec2(width, height)}};
+        for (const TexelRegion& part : stale) {
+            frame.clear(history, part, backgroundHistory);
+            frame.clear(state, part, backgroundState);
+        }
         if (image) {
             PresentPass::clearToBackground(frame, *image);
         }
@@ -122,6 +158,8 @@ TemporalHistory::Mode TemporalHistory::begin(FrameContext& frame, bool picture) 
 }
 
 void TemporalHistory::end(const FrameContext& frame, Mode mode) {
+    writtenBefore_ = writtenLast_;
+    writtenLast_ = frame.region(0);
     previous_ = PreviousFrame{withoutJitter(frame.camera), frame.settings, frame.divisor,
                               mode == Mode::Moving};
 }

@@ -42,9 +42,10 @@ class TemporalHistory {
     /// The mode of the next frame through the pipeline camera `camera` (with its jitter).
     Mode modeFor(const Camera& camera, const RenderSettings& settings, int divisor) const;
     /// Readies this frame's blend and returns its mode: swaps the history images, sets what
-    /// lies outside the frame's region to the background (with the picture "image", when
-    /// `picture`), and binds the parameters (SUBSCAN_UBO_TEMPORAL), the previous result
-    /// (IN2, IN3), the new one (OUT2, OUT3) and the picture (OUT0).
+    /// lies outside the frame's region to the background (where the image held an earlier
+    /// frame's values; the picture "image", when `picture`, whole), and binds the parameters
+    /// (SUBSCAN_UBO_TEMPORAL), the previous result (IN2, IN3), the new one (OUT2, OUT3) and the
+    /// picture (OUT0).
     Mode begin(FrameContext& frame, bool picture);
     /// After the dispatch: this frame becomes the one the next reprojects from.
     void end(const FrameContext& frame, Mode mode);
@@ -59,6 +60,11 @@ class TemporalHistory {
 
     UniformBlock<gpu::TemporalParams> params_{"Temporal.params"};
     std::optional<PreviousFrame> previous_;
+    // The texels the history image about to be written held this frame's values for (two
+    // frames ago, the images alternating), and those the other one holds; off them both hold
+    // the background. Unknown after a restart: then the whole image is cleared.
+    std::optional<TexelRegion> writtenBefore_;
+    std::optional<TexelRegion> writtenLast_;
     unsigned frameIndex_ = 0;
 };
 

@@ -57,6 +57,29 @@ TEST(GpuClearGLTest, EveryFloatFormatHoldsTheDriversValuesEverywhere) {
     }
 }
 
+TEST(GpuClearGLTest, ARegionIsClearedAndNothingElse) {
+    GlContext& context = test::glTestContext();
+    GpuClear clears(ShaderSources(), context.capabilities());
+    const glm::ivec2 origin(5, 3), size(17, 9);  // crossing work groups, off their grid
+    for (ClearPath path : {ClearPath::Driver, ClearPath::Compute}) {
+        Texture texture(TextureFormat::RGBA32F, kWidth, kHeight, "test.region");
+        texture.clear(glm::vec4(0.125f));
+        clears.textureRegion(texture, origin, size, glm::vec4(1.0f, 2.0f, 3.0f, 4.0f), path);
+        const std::vector<float> values = texture.readFloats();
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                const bool inside = x >= origin.x && y >= origin.y && x < origin.x + size.x &&
+                                    y < origin.y + size.y;
+                for (int c = 0; c < 4; ++c) {
+                    ASSERT_EQ(values[4 * (y * kWidth + x) + c], inside ? c + 1.0f : 0.125f)
+                        << (path == ClearPath::Compute ? "compute" : "driver") << " at " << x << ","
+                        << y;
+                }
+            }
+        }
+    }
+}
+
 TEST(GpuClearGLTest, IntegerTexturesAndLargeBuffersHoldTheValueEverywhere) {
     GlContext& context = test::glTestContext();
     GpuClear clears(ShaderSources(), context.capabilities());

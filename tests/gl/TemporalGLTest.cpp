@@ -388,6 +388,69 @@ TEST(TemporalGLTest, JitteredFramesConvergeToTheSupersampledCoverageOfAnEdge) {
     EXPECT_LT(sixteenFrames, 0.01) << "after one frame: " << oneFrame;
 }
 
+TEST(TemporalGLTest, OffTheSurfaceTheHistoryHoldsTheBackgroundWhereverTheRegionWent) {
+    // The filter clears only what an earlier frame left outside this frame's region: pan a
+    // small sphere across the picture (its region moves every frame), then far from this
+    // frame's surface the history must be the background and its state "no surface", exactly.
+    const PointCloud cloud = makeSyntheticScene("sphere");
+    Renderer renderer(test::glTestContext(), cloud);
+    RenderSettings settings;
+    settings.raster.mode = RenderMode::Surface;
+    settings.temporal.enabled = true;
+    constexpr int kSize = 96;
+    auto poseAt = [&](double panFraction) {
+        OrbitView orbit;
+        orbit.distance = 4.0 * glm::length(cloud.bounds.extent());  // a third of the picture
+        Camera camera = orbitCamera(cloud.bounds, orbit, kSize, kSize, 45.0);
+        camera.view = glm::translate(glm::dmat4(1.0),
+                                     glm::dvec3(panFraction * cloud.bounds.extent().x, 0, 0)) *
+                      camera.view;
+        return camera;
+    };
+    for (int frame = 0; frame < 4; ++frame) {  // still: the history converges at one place
+        renderer.render(poseAt(-1.5), settings);
+    }
+    for (int step = 1; step <= 7; ++step) {  // then it moves right, a tenth of the way a frame
+        renderer.render(poseAt(-1.5 + 0.4 * step), settings, FrameOutputs::Everything);
+    }
+    const FrameResources& resources = renderer.resources();
+    const std::vector<float> depth = resources.texture("surfaceDepth").readFloats();
+    const std::vector<float> history = resources.texture("history").readFloats();
+    const std::vector<float> state = resources.texture("historyState").readFloats();
+    const glm::vec3& background = settings.raster.backgroundSrgb;
+    const glm::vec3 linear(srgbToLinear(background.r), srgbToLinear(background.g),
+                           srgbToLinear(background.b));
+    int checked = 0, surface = 0;
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            // Two pixels from any surface: beyond what a blend of neighbours could reach.
+            bool nearSurface = false;
+            for (int dy = -2; dy <= 2; ++dy) {
+                for (int dx = -2; dx <= 2; ++dx) {
+                    const int qx = std::clamp(x + dx, 0, kSize - 1);
+                    const int qy = std::clamp(y + dy, 0, kSize - 1);
+                    nearSurface = nearSurface || std::isfinite(depth[qy * kSize + qx]);
+                }
+            }
+            const int i = y * kSize + x;
+            surface += std::isfinite(depth[i]);
+            if (nearSurface) {
+                continue;
+            }
+            ++checked;
+            for (int c = 0; c < 3; ++c) {
+                // A blend of the background with itself may round in the last bits; what an
+                // earlier frame left would be the sphere's colour.
+                ASSERT_NEAR(history[4 * i + c], linear[c], 1e-6f) << x << "," << y;
+            }
+            ASSERT_NEAR(history[4 * i + 3], 0.0f, 1e-6f) << x << "," << y;
+            ASSERT_TRUE(std::isinf(state[2 * i])) << x << "," << y;
+        }
+    }
+    EXPECT_GT(surface, 200);  // the sphere is in the picture
+    EXPECT_GT(checked, kSize * kSize / 2);
+}
+
 TEST(TemporalGLTest, AFastMoveLeavesNoGhostOnceTheCameraStops) {
     const PointCloud cloud = makeSyntheticScene("sphere");
     Renderer renderer(test::glTestContext(), cloud);
