@@ -126,6 +126,8 @@ int run(int width, int height, int repeats) {
                    repeats));
     }
 
+    glDeleteFramebuffers(1, &framebuffer);
+
     std::vector<std::uint32_t> small(16);
     report("read back 64 bytes", 64,
            measure([&] { buffer.download(0, 64, small.data()); }, repeats));
@@ -140,7 +142,7 @@ int main(int argc, char** argv) {
         const int width = argc > 2 ? std::atoi(argv[1]) : 1920;
         const int height = argc > 2 ? std::atoi(argv[2]) : 1080;
         const int repeats = argc > 3 ? std::atoi(argv[3]) : 50;
-        if (width <= 0 || height <= 0 || repeats <= 0) {
+        if (argc == 2 || argc > 4 || width <= 0 || height <= 0 || repeats <= 0) {
             std::fprintf(stderr, "usage: subscan_gl_ops_bench [WIDTH HEIGHT [REPEATS]]\n");
             return 2;
         }

@@ -5,6 +5,8 @@
 //                  "depth" image (viewed as r32ui; cleared to +inf, whose bits are the largest)
 //   STAGE_INDEX    one thread per point: among points at the winning depth, atomicMin of index
 //   STAGE_INT64    one thread per point: one 64-bit atomicMin of depthBits << 32 | index
+//                  (DEPTH and INT64 also mark the point's 4x4 sub-cell of its pixel, hidden or
+//                  not, when the surface places its outline by them: surface.fill.w)
 //   STAGE_BLEND    one thread per point: a point within the relative depth raster.colorBlend
 //                  of its pixel's nearest adds its linear colour (fixed point) and 1 to the
 //                  pixel's sums (Schuetz et al. 2021's high-quality shading)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <string>
 
+#include <glm/vector_relational.hpp>
+
 #include "core/Error.h"
 #include "shared/bindings.h"
 
@@ -81,8 +83,12 @@ void GpuClear::textureRegion(Texture& texture, glm::ivec2 origin, glm::ivec2 siz
     if (size.x <= 0 || size.y <= 0) {
         return;
     }
-    if (!byCompute(path) || !imageFormatQualifier(texture.format()) ||
-        texture.format() == TextureFormat::R32UI) {
+    if (texture.format() == TextureFormat::R32UI ||
+        glm::any(glm::lessThan(origin, glm::ivec2(0))) || origin.x + size.x > texture.width() ||
+        origin.y + size.y > texture.height()) {
+        throw Error("GpuClear::textureRegion needs a float texture and a region inside it");
+    }
+    if (!byCompute(path) || !imageFormatQualifier(texture.format())) {
         texture.clearRegion(origin, size, value);
         return;
     }

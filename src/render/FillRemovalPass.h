@@ -5,7 +5,8 @@
 
 namespace subscan {
 
-/// Separates surface from filled background (DESIGN.md §5.4, "fill removal"): "mask" is 1 where
+/// Separates surface from filled background (DESIGN.md §5.4, "fill removal"; beyond it, the
+/// sub-pixel outline of SurfaceSettings::subpixelOutline): "mask" is 1 where
 /// visible points surround the pixel up to the level of the expected point gap (looked up in
 /// the per-direction "fillReach" pyramid), and "surfaceDepth" holds the filled depth there
 /// (+inf elsewhere). With LevelZero::Fused only "fillReach" above level 0.

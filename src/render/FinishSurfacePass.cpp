@@ -80,11 +80,13 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     int finishOutput = kFinishPicture;
     TemporalHistory::Mode mode = TemporalHistory::Mode::Restart;
     if (output_ == Output::Temporal) {
-        // Binds the picture too, cleared to the background off the region.
-        mode = history_->begin(frame, true);
-        if (mode == TemporalHistory::Mode::Moving) {
+        // Before begin(), which swaps and clears the history for a frame that must then end.
+        if (history_->modeFor(frame.camera, frame.settings, frame.divisor) ==
+            TemporalHistory::Mode::Moving) {
             throw Error("FinishSurface blends a moving camera's frame only in TemporalPass");
         }
+        // Binds the picture too, cleared to the background off the region.
+        mode = history_->begin(frame, true);
         finishOutput = kFinishRestart + static_cast<int>(mode);
     } else {
         const bool picture = output_ == Output::Picture;

@@ -178,8 +178,10 @@ void RasterizePointsPass::execute(FrameContext& frame) {
                 : int64 ? resolve64_
                         : resolve32_,
                 frame, true);
+    // The storage bit for the sub-pixel cells, which fill removal reads.
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+                    GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
+                    GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
 }  // namespace subscan

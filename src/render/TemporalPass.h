@@ -60,9 +60,9 @@ class TemporalHistory {
 
     UniformBlock<gpu::TemporalParams> params_{"Temporal.params"};
     std::optional<PreviousFrame> previous_;
-    // The texels the history image about to be written held this frame's values for (two
-    // frames ago, the images alternating), and those the other one holds; off them both hold
-    // the background. Unknown after a restart: then the whole image is cleared.
+    // Where the history image written next holds a frame's values (written two frames ago:
+    // the two images alternate) and where the other one does; elsewhere both hold the
+    // background. Unknown after a restart, when the whole image is cleared instead.
     std::optional<TexelRegion> writtenBefore_;
     std::optional<TexelRegion> writtenLast_;
     unsigned frameIndex_ = 0;

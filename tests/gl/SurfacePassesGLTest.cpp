@@ -624,8 +624,11 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
             EXPECT_EQ(mask[i] > 0.5f, !outside) << x << "," << y;
         }
     }
+    // A tie (a fill level this close to an integer) is rare: a few in this frame would mean
+    // the levels are computed differently.
     EXPECT_LT(ties, 3);
-    // Each way the rule can go occurs in this frame.
+    // Each way the rule can go occurs in this frame, often enough that a wrong threshold or a
+    // missing fill check changes some (both do: 1/2 for 5/8, or no fill check, fail here).
     EXPECT_GT(beyond, 3);
     EXPECT_GT(besideFilledGap, 3);
     EXPECT_GT(kept, 80);
