@@ -127,22 +127,23 @@ void main() {
     vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
                          texelFetch(positions, first + 2).r);
     vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+    vec2 window;
     ivec2 pixel;
     float depth;
-    if (!projectToPixel(viewPosition, pixel, depth)) {
+    if (!projectToWindow(viewPosition, window, pixel, depth)) {
         return;
     }
     uint bits = floatBitsToUint(depth);
     uint index = raster.firstPoint + local;
+    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);  // the pixel's word
 #if STAGE_DEPTH || STAGE_INT64
     if (surface.fill.w > 0.0) {
         // The point's 4x4 sub-cell (FillRemoval.glsl's outline); the atomic only for a cell
         // not yet marked, which in a dense cloud most points find marked.
-        ivec2 cell = clamp(ivec2(floor(fract(windowPosition(viewPosition)) * 4.0)), 0, 3);
+        ivec2 cell = clamp(ivec2(floor(fract(window) * 4.0)), 0, 3);
         uint word = 1u << uint(cell.y * 4 + cell.x);
-        uint at = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
-        if ((occupancy[at] & word) == 0u) {
-            atomicOr(occupancy[at], word);
+        if ((occupancy[linear] & word) == 0u) {
+            atomicOr(occupancy[linear], word);
         }
     }
 #endif
@@ -158,10 +159,8 @@ void main() {
         imageAtomicMin(pointIndex, pixel, index);
     }
 #elif STAGE_INT64
-    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
     atomicMin(depthIndex[linear], (uint64_t(bits) << 32) | uint64_t(index));
 #elif STAGE_BLEND
-    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);
 #if USE_INT64
     float nearest = uintBitsToFloat(uint(depthIndex[linear] >> 32));
 #else

@@ -27,15 +27,22 @@ vec2 windowPosition(vec3 viewPosition) {
     return vec2((ndc.x + 1.0) * 0.5, (1.0 - ndc.y) * 0.5) * frame.viewport.xy;
 }
 
-/// Projects a view-space point to the pixel containing it (row 0 at the top) and its linear
-/// depth; false when it falls outside the image or the near/far range.
-bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
+/// Projects a view-space point to its window position, the pixel containing it (row 0 at the
+/// top) and its linear depth; false when it falls outside the image or the near/far range.
+bool projectToWindow(vec3 viewPosition, out vec2 window, out ivec2 pixel, out float depth) {
     depth = -viewPosition.z;
     if (!(depth >= frame.depthRange.x && depth <= frame.depthRange.y)) {
         return false;
     }
-    pixel = ivec2(floor(windowPosition(viewPosition)));
+    window = windowPosition(viewPosition);
+    pixel = ivec2(floor(window));
     return all(greaterThanEqual(pixel, ivec2(0))) && all(lessThan(pixel, imageSizeOfFrame()));
+}
+
+/// projectToWindow without the window position.
+bool projectToPixel(vec3 viewPosition, out ivec2 pixel, out float depth) {
+    vec2 window;
+    return projectToWindow(viewPosition, window, pixel, depth);
 }
 
 vec3 unpackColor(uint rgba8) { return srgbToLinear(unpackUnorm4x8(rgba8).rgb); }
