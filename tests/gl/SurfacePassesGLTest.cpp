@@ -545,9 +545,11 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
 }
 
 TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
-    // The surface mode places a dense cloud's outline by its points' sub-pixel cells. Random
-    // cells per pixel: pixels with a point hold 1..16 of them (most all 16, so that the
-    // densest neighbour usually passes 12), pixels without none.
+    // The surface mode places a cloud's outline by its points' sub-pixel cells. Random cells
+    // per pixel: pixels with a point hold 1..16 of them (most all 16), pixels without none;
+    // except along the outline of the rows whose outline points are visible (14-20), where the
+    // cloud is sparse (rows 13-17: one cell at the outline, two beside it, too few for the
+    // rule) or of middling density (rows 18-22: three cells at the outline, eight beside it).
     RenderSettings settings = makeHarness().settings();
     settings.raster.mode = RenderMode::Surface;
     PassHarness harness(kWidth, kHeight, settings, kSpacing, 50.0, GetParam());
@@ -568,8 +570,13 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     for (int i = 0; i < kWidth * kHeight; ++i) {
         // Near the outline two in three pixels partly covered, elsewhere one in three.
         const bool partly = random() % 3 < (i % kWidth >= 24 ? 2u : 1u);
-        if (std::isfinite(depth[i])) {
-            cells[i] = partly ? static_cast<std::uint32_t>(random() % 0xFFFF) + 1u : 0xFFFFu;
+        if (!std::isfinite(depth[i])) {
+            continue;
+        }
+        cells[i] = partly ? static_cast<std::uint32_t>(random() % 0xFFFF) + 1u : 0xFFFFu;
+        const int x = i % kWidth, y = i / kWidth;
+        if (y >= 13 && x >= 26) {
+            cells[i] = y < 18 ? (x == 27 ? 0x1u : 0x3u) : (x == 27 ? 0x7u : 0xFFu);
         }
     }
     harness.resources()
@@ -585,7 +592,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const auto cellsAt = [&](int x, int y) { return std::popcount(cells[y * kWidth + x]); };
     const auto inside = [](int x, int y) { return x >= 0 && y >= 0 && x < kWidth && y < kHeight; };
-    int ties = 0, beyond = 0, besideFilledGap = 0, kept = 0;
+    int ties = 0, beyond = 0, beyondWhereSparse = 0, besideFilledGap = 0, tooSparse = 0, kept = 0;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
@@ -601,9 +608,10 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
                 }
             }
             bool outside = false, tie = false, emptyBeside = false;
-            // At most 1/2 + 1/8 of the densest neighbour's cells, where the cloud is dense.
-            if (densest >= 12 && cellsAt(x, y) <= 0.625 * densest) {
-                for (const auto [dx, dy] : {std::pair{1, 0}, {0, 1}, {-1, 0}, {0, -1}}) {
+            // At most 1/2 + 1/8 of the densest neighbour's cells, where that one holds 3 or
+            // more.
+            if (cellsAt(x, y) <= 0.625 * densest) {
+                for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {-1, 0}, {0, -1}}) {
                     if (!inside(x + dx, y + dy) || cellsAt(x + dx, y + dy) != 0) {
                         continue;
                     }
@@ -620,17 +628,26 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
                 ++ties;
                 continue;
             }
-            (outside ? beyond : emptyBeside ? besideFilledGap : kept)++;
+            if (outside && densest < 3) {
+                outside = false;
+                ++tooSparse;
+            } else {
+                (outside ? beyond : emptyBeside ? besideFilledGap : kept)++;
+                beyondWhereSparse += outside && densest < 12 ? 1 : 0;
+            }
             EXPECT_EQ(mask[i] > 0.5f, !outside) << x << "," << y;
         }
     }
     // A tie (a fill level this close to an integer) is rare: a few in this frame would mean
     // the levels are computed differently.
     EXPECT_LT(ties, 3);
-    // Each way the rule can go occurs in this frame, often enough that a wrong threshold or a
-    // missing fill check changes some (both do: 1/2 for 5/8, or no fill check, fail here).
+    // Each way the rule can go occurs in this frame, often enough that a wrong threshold, a
+    // missing fill check or a wrong least density changes some (1/2 for 5/8, no fill check, no
+    // least density, or the 12 cells it once took, fail here).
     EXPECT_GT(beyond, 3);
+    EXPECT_GE(beyondWhereSparse, 3);
     EXPECT_GT(besideFilledGap, 3);
+    EXPECT_GE(tooSparse, 3);
     EXPECT_GT(kept, 80);
 }
 
