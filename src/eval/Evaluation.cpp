@@ -322,9 +322,9 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
     std::vector<SequenceFrame> truthFrames, pointFrames, splatFrames, surfaceFrames, filteredFrames,
         convergedFrames;
     // The filter's picture, its mask where the history's coverage reaches a half.
-    auto filteredFrame = [](Renderer& renderer, const Camera& camera) {
-        const std::vector<float> coverage = atOutputPixels(renderer, "history", 4, camera);
-        SequenceFrame frame{renderer.readImage(), {}};
+    auto filteredFrame = [](Renderer& withFilter, const Camera& camera) {
+        const std::vector<float> coverage = atOutputPixels(withFilter, "history", 4, camera);
+        SequenceFrame frame{withFilter.readImage(), {}};
         for (std::size_t i = 3; i < coverage.size(); i += 4) {
             frame.mask.push_back(coverage[i] >= 0.5f ? 1 : 0);
         }

@@ -13,14 +13,32 @@
 
 namespace subscan {
 
-ShaderSources::ShaderSources() {
+namespace {
+
+std::optional<std::filesystem::path> overrideFromEnvironment() {
     if (const char* directory = std::getenv("SUBSCAN_SHADER_DIR"); directory && *directory) {
-        overrideDirectory_ = directory;
+        return std::filesystem::path(directory);
     }
+    return std::nullopt;
 }
 
+/// A mistyped override would otherwise leave every shader embedded without a word.
+std::optional<std::filesystem::path> checked(std::optional<std::filesystem::path> directory) {
+    std::error_code error;
+    if (directory && !std::filesystem::is_directory(*directory, error)) {
+        throw Error(fmt::format(
+            "the shader override directory '{}' (SUBSCAN_SHADER_DIR) is not a directory",
+            directory->string()));
+    }
+    return directory;
+}
+
+}  // namespace
+
+ShaderSources::ShaderSources() : ShaderSources(overrideFromEnvironment()) {}
+
 ShaderSources::ShaderSources(std::optional<std::filesystem::path> overrideDirectory)
-    : overrideDirectory_(std::move(overrideDirectory)) {}
+    : overrideDirectory_(checked(std::move(overrideDirectory))) {}
 
 std::string ShaderSources::raw(std::string_view path) const {
     if (overrideDirectory_) {

@@ -15,6 +15,7 @@ class ShaderSources {
   public:
     /// Uses $SUBSCAN_SHADER_DIR as override directory when it is set.
     ShaderSources();
+    /// Throws subscan::Error when `overrideDirectory` is given but is not a directory.
     explicit ShaderSources(std::optional<std::filesystem::path> overrideDirectory);
 
     /// The complete source of `path`, includes expanded, `defines` inserted after #version.

@@ -1,3 +1,4 @@
+#include <cstdlib>
 #include <fstream>
 
 #include <gmock/gmock.h>
@@ -41,6 +42,32 @@ TEST(ShaderSourcesTest, OverrideDirectoryIncludesOnceAndNamesMissingFiles) {
         FAIL() << "missing include accepted";
     } catch (const Error& error) {
         EXPECT_THAT(error.what(), HasSubstr("'lib/none.glsl' is not part of this build"));
+    }
+}
+
+TEST(ShaderSourcesTest, AnOverrideThatIsNoDirectoryIsOneSentence) {
+    const test::TempDir dir;
+    dir.write("file.comp", "#version 450\n");
+    for (const std::filesystem::path& path : {dir / "missing", dir / "file.comp"}) {
+        try {
+            const ShaderSources sources(path);
+            FAIL() << path << " accepted";
+        } catch (const Error& error) {
+            EXPECT_THAT(error.what(), HasSubstr("'" + path.string() + "'"));
+            EXPECT_THAT(error.what(), HasSubstr("is not a directory"));
+        }
+    }
+    // The environment's override goes through the same check.
+    const char* before = std::getenv("SUBSCAN_SHADER_DIR");
+    const std::string saved = before ? before : "";
+    setenv("SUBSCAN_SHADER_DIR", (dir / "missing").c_str(), 1);
+    EXPECT_THROW(ShaderSources(), Error);
+    setenv("SUBSCAN_SHADER_DIR", dir.path().c_str(), 1);
+    EXPECT_NO_THROW(ShaderSources());
+    if (before) {
+        setenv("SUBSCAN_SHADER_DIR", saved.c_str(), 1);
+    } else {
+        unsetenv("SUBSCAN_SHADER_DIR");
     }
 }
 
