@@ -60,10 +60,10 @@ uint occupiedCells(ivec2 pixel) {
 /// half a column of them on average (1/8 of a pixel): so the centre lies outside when at most
 /// 1/2 + 1/8 of the densest neighbour's cells hold points. Only beside a pixel without any
 /// point that the fill leaves empty (the background: an outline, not a gap between points),
-/// and only where the densest neighbour holds points in 3 cells or more: with 1 or 2, a cell
-/// more or less is half of the count, noise rather than area. Sparser clouds show the area
-/// less exactly (a cell holds one point or several alike), yet the rule still moves their
-/// outlines closer to the truth (README, "Measured quality").
+/// and only where the densest neighbour holds points in 3 cells or more: with 2, one cell more
+/// or less is half of the count, noise rather than area. Sparse clouds show the area less
+/// exactly (a cell holds one point or several alike), yet the rule still moves their outlines
+/// closer to the truth (README, "Measured quality").
 bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
     uint own = occupiedCells(pixel);
     uint densest = own;

@@ -27,8 +27,8 @@ std::optional<std::filesystem::path> checked(std::optional<std::filesystem::path
     std::error_code error;
     if (directory && !std::filesystem::is_directory(*directory, error)) {
         throw Error(fmt::format(
-            "the shader override directory '{}' (SUBSCAN_SHADER_DIR) is not a directory",
-            directory->string()));
+            "the shader override directory '{}' (SUBSCAN_SHADER_DIR) is not a directory{}",
+            directory->string(), error ? " (" + error.message() + ")" : std::string()));
     }
     return directory;
 }

@@ -547,9 +547,10 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
 TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     // The surface mode places a cloud's outline by its points' sub-pixel cells. Random cells
     // per pixel: pixels with a point hold 1..16 of them (most all 16), pixels without none;
-    // except along the outline of the rows whose outline points are visible (14-20), where the
-    // cloud is sparse (rows 13-17: one cell at the outline, two beside it, too few for the
-    // rule) or of middling density (rows 18-22: three cells at the outline, eight beside it).
+    // except in the last two columns of the rows whose outline points are visible (14-20),
+    // where the rule's limits are set: one cell at the outline beside 2 (row 14: too sparse
+    // for the rule) or 3 (rows 15 and 16: the sparsest it acts on), and from row 18 on 5 beside
+    // 8 (exactly 5/8: background).
     RenderSettings settings = makeHarness().settings();
     settings.raster.mode = RenderMode::Surface;
     PassHarness harness(kWidth, kHeight, settings, kSpacing, 50.0, GetParam());
@@ -576,7 +577,8 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
         cells[i] = partly ? static_cast<std::uint32_t>(random() % 0xFFFF) + 1u : 0xFFFFu;
         const int x = i % kWidth, y = i / kWidth;
         if (y >= 13 && x >= 26) {
-            cells[i] = y < 18 ? (x == 27 ? 0x1u : 0x3u) : (x == 27 ? 0x7u : 0xFFu);
+            const std::uint32_t beside = y < 16 ? 0x3u : y < 18 ? 0x7u : 0xFFu;
+            cells[i] = x == 27 ? (y < 18 ? 0x1u : 0x1Fu) : beside;
         }
     }
     harness.resources()
@@ -592,7 +594,8 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const auto cellsAt = [&](int x, int y) { return std::popcount(cells[y * kWidth + x]); };
     const auto inside = [](int x, int y) { return x >= 0 && y >= 0 && x < kWidth && y < kHeight; };
-    int ties = 0, beyond = 0, beyondWhereSparse = 0, besideFilledGap = 0, tooSparse = 0, kept = 0;
+    int ties = 0, beyond = 0, besideFilledGap = 0, kept = 0;
+    int tooSparse = 0, sparsestActed = 0, exactlyFiveEighths = 0;  // the limits' rows
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
@@ -633,7 +636,8 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
                 ++tooSparse;
             } else {
                 (outside ? beyond : emptyBeside ? besideFilledGap : kept)++;
-                beyondWhereSparse += outside && densest < 12 ? 1 : 0;
+                sparsestActed += outside && densest == 3 ? 1 : 0;
+                exactlyFiveEighths += outside && 8 * cellsAt(x, y) == 5 * densest ? 1 : 0;
             }
             EXPECT_EQ(mask[i] > 0.5f, !outside) << x << "," << y;
         }
@@ -641,14 +645,15 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     // A tie (a fill level this close to an integer) is rare: a few in this frame would mean
     // the levels are computed differently.
     EXPECT_LT(ties, 3);
-    // Each way the rule can go occurs in this frame, often enough that a wrong threshold, a
-    // missing fill check or a wrong least density changes some (1/2 for 5/8, no fill check, no
-    // least density, or the 12 cells it once took, fail here).
+    // Each way the rule can go occurs in this frame, often enough that a wrong threshold or a
+    // missing fill check changes some; and each limit is met exactly somewhere, so that the
+    // least density 2 or 4 (or the 12 cells it once took), 1/2 for 5/8 or < for <= fail here.
     EXPECT_GT(beyond, 3);
-    EXPECT_GE(beyondWhereSparse, 3);
     EXPECT_GT(besideFilledGap, 3);
-    EXPECT_GE(tooSparse, 3);
     EXPECT_GT(kept, 80);
+    EXPECT_GE(tooSparse, 1);           // row 14
+    EXPECT_GE(sparsestActed, 2);       // rows 15 and 16
+    EXPECT_GE(exactlyFiveEighths, 3);  // rows 18-20
 }
 
 TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
