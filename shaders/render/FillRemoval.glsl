@@ -68,12 +68,10 @@ bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
     // The 4-neighbours without points first: off the outline (nearly every pixel) none is, and
     // the counts and the fill's reach below are skipped (llvmpipe skips a loop only where
     // none of its lanes enters it). Off the image's border the surface goes on.
-    ivec2 size = imageSizeOfFrame();
     uint emptyBeside = 0u;  // bit k / 2 for the 4-neighbour k
     for (int k = 0; k < 8; k += 2) {
         ivec2 neighbour = pixel + kDirections[k];
-        if (all(greaterThanEqual(neighbour, ivec2(0))) && all(lessThan(neighbour, size)) &&
-            occupiedCells(neighbour) == 0u) {
+        if (insideLevel(0u, neighbour) && occupiedCells(neighbour) == 0u) {
             emptyBeside |= 1u << (k / 2);
         }
     }
@@ -84,7 +82,7 @@ bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
     uint densest = own;
     for (int k = 0; k < 8; ++k) {
         ivec2 neighbour = pixel + kDirections[k];
-        if (all(greaterThanEqual(neighbour, ivec2(0))) && all(lessThan(neighbour, size))) {
+        if (insideLevel(0u, neighbour)) {
             densest = max(densest, occupiedCells(neighbour));
         }
     }

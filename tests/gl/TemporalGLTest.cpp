@@ -122,6 +122,14 @@ glm::vec3 checker(glm::dvec3, int x, int y) {
     return glm::vec3(float((x + y) % 2), float(x % 2), float(y % 2));
 }
 
+/// `camera` moved sideways by `fraction` of the cloud's width: the picture pans across.
+Camera pannedAcross(Camera camera, const PointCloud& cloud, double fraction) {
+    camera.view =
+        glm::translate(glm::dmat4(1.0), glm::dvec3(fraction * cloud.bounds.extent().x, 0, 0)) *
+        camera.view;
+    return camera;
+}
+
 /// A second camera turned and moved against the harness's, both jittered differently.
 Camera movedCamera(const Camera& first) {
     Camera moved = first;
@@ -401,11 +409,8 @@ TEST(TemporalGLTest, OffTheSurfaceTheHistoryHoldsTheBackgroundWhereverTheRegionW
     auto poseAt = [&](double panFraction) {
         OrbitView orbit;
         orbit.distance = 4.0 * glm::length(cloud.bounds.extent());  // about 17 pixels across
-        Camera camera = orbitCamera(cloud.bounds, orbit, kSize, kSize, 45.0);
-        camera.view = glm::translate(glm::dmat4(1.0),
-                                     glm::dvec3(panFraction * cloud.bounds.extent().x, 0, 0)) *
-                      camera.view;
-        return camera;
+        return pannedAcross(orbitCamera(cloud.bounds, orbit, kSize, kSize, 45.0), cloud,
+                            panFraction);
     };
     for (int frame = 0; frame < 4; ++frame) {  // still: the history converges at one place
         renderer.render(poseAt(-1.5), settings);
@@ -465,12 +470,9 @@ TEST(TemporalGLTest, AFastMoveLeavesNoGhostOnceTheCameraStops) {
         OrbitView orbit;
         orbit.yawDegrees = yaw;
         orbit.pitchDegrees = 10.0;
-        Camera camera = orbitCamera(cloud.bounds, orbit, kSize, kSize, 45.0);
         // Panning sweeps the silhouette across the picture.
-        camera.view = glm::translate(glm::dmat4(1.0),
-                                     glm::dvec3(panFraction * cloud.bounds.extent().x, 0, 0)) *
-                      camera.view;
-        return camera;
+        return pannedAcross(orbitCamera(cloud.bounds, orbit, kSize, kSize, 45.0), cloud,
+                            panFraction);
     };
     auto picture = [&] { return renderer.readImage(); };
     auto meanDifference = [](const std::vector<std::uint8_t>& a,
