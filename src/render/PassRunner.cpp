@@ -1,6 +1,8 @@
 #include "render/PassRunner.h"
 
 #include <string>
+#include <string_view>
+#include <unordered_set>
 
 #include <fmt/format.h>
 
@@ -12,10 +14,13 @@ PassRunner::PassRunner(GlContext& context, TimingMode timing)
     : context_(context), timer_(context.capabilities(), timing) {}
 
 std::vector<PassTiming> PassRunner::run(std::span<RenderPass* const> passes, FrameContext& frame) {
+    // What this frame's passes have written so far: an image an earlier frame left behind does
+    // not count (it would be read stale).
+    std::unordered_set<std::string_view> written;
     for (RenderPass* pass : passes) {
         const std::string_view name = pass->name();
         for (const std::string_view input : pass->inputs()) {
-            if (!frame.resources.has(input)) {
+            if (!written.contains(input)) {
                 throw Error(
                     fmt::format("the pass {} needs the image '{}', which no earlier pass "
                                 "writes",
@@ -37,6 +42,7 @@ std::vector<PassTiming> PassRunner::run(std::span<RenderPass* const> passes, Fra
             if (!frame.resources.has(output)) {
                 throw Error(fmt::format("the pass {} did not write its output '{}'", name, output));
             }
+            written.insert(output);
         }
     }
     return timer_.collect();

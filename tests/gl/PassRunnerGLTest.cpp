@@ -96,6 +96,23 @@ TEST(PassRunnerGLTest, AnInputNoEarlierPassWritesIsNamed) {
     EXPECT_THAT(message, HasSubstr("the pass Reader needs the image 'missing'"));
 }
 
+TEST(PassRunnerGLTest, AnImageAnEarlierFrameLeftIsNoInput) {
+    test::PassHarness harness(8, 6, RenderSettings{}, 0.1);
+    FrameContext frame = harness.context();
+    FakePass writer("Writer", "", "kept");
+    FakePass reader("Reader", "kept", "b");
+    PassRunner runner(test::glTestContext(), TimingMode::FinishAndClock);
+    runner.run(std::array<RenderPass*, 2>{&writer, &reader}, frame);
+    ASSERT_TRUE(frame.resources.has("kept"));
+    // The next frame leaves the writer out: the reader would read the last frame's image.
+    try {
+        runner.run(std::array<RenderPass*, 1>{&reader}, frame);
+        ADD_FAILURE() << "the runner accepted a stale input";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), HasSubstr("the pass Reader needs the image 'kept'"));
+    }
+}
+
 TEST(PassRunnerGLTest, AnOutputThePassDidNotWriteIsNamed) {
     FakePass lazy("Lazy", "", "promised", false);
     EXPECT_THAT(runError({&lazy}), HasSubstr("the pass Lazy did not write its output 'promised'"));
