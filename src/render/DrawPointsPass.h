@@ -15,8 +15,10 @@ class DrawPointsPass final : public RenderPass {
     explicit DrawPointsPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "DrawPoints"; }
-    std::vector<std::string_view> inputs() const override { return {}; }
-    std::vector<std::string_view> outputs() const override { return {"depth", "color"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override { return {}; }
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return {"depth", "color"};
+    }
     void execute(FrameContext& frame) override;
 
   private:

@@ -10,14 +10,17 @@ namespace subscan {
 FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
     : stages_(sources, "render/FillRemoval.comp", {"REACH", "MASK"}) {}
 
-std::vector<std::string_view> FillRemovalPass::inputs() const {
+std::vector<std::string_view> FillRemovalPass::inputs(const RenderSettings& settings) const {
     if (levelZero_ == LevelZero::Fused) {
         return {"pullWeights"};
+    }
+    if (placesOutlineBySubpixels(settings)) {
+        return {"filledDepth", "pullWeights", "occupancy"};
     }
     return {"filledDepth", "pullWeights"};
 }
 
-std::vector<std::string_view> FillRemovalPass::outputs() const {
+std::vector<std::string_view> FillRemovalPass::outputs(const RenderSettings&) const {
     if (levelZero_ == LevelZero::Fused) {
         return {"fillReach"};
     }

@@ -15,8 +15,8 @@ class FillRemovalPass final : public RenderPass {
     explicit FillRemovalPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "FillRemoval"; }
-    std::vector<std::string_view> inputs() const override;
-    std::vector<std::string_view> outputs() const override;
+    std::vector<std::string_view> inputs(const RenderSettings&) const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
     void setLevelZero(LevelZero levelZero) { levelZero_ = levelZero; }
 

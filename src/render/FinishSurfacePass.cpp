@@ -29,7 +29,16 @@ FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources, Output output
     }
 }
 
-std::vector<std::string_view> FinishSurfacePass::outputs() const {
+std::vector<std::string_view> FinishSurfacePass::inputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names{"pullValues", "pullWeights", "pushValues", "fillReach",
+                                        "normalPyramid"};
+    if (placesOutlineBySubpixels(settings)) {
+        names.push_back("occupancy");
+    }
+    return names;
+}
+
+std::vector<std::string_view> FinishSurfacePass::outputs(const RenderSettings&) const {
     switch (output_) {
         case Output::Picture:
             return {"image", "surfaceDepth"};

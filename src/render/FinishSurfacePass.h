@@ -31,10 +31,8 @@ class FinishSurfacePass final : public RenderPass {
                       TemporalHistory* history = nullptr);
 
     std::string_view name() const override { return "FinishSurface"; }
-    std::vector<std::string_view> inputs() const override {
-        return {"pullValues", "pullWeights", "pushValues", "fillReach", "normalPyramid"};
-    }
-    std::vector<std::string_view> outputs() const override;
+    std::vector<std::string_view> inputs(const RenderSettings& settings) const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
 
     /// Whether a frame can finish here: at full resolution (reduced frames scale up in

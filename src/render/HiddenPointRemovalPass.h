@@ -13,8 +13,12 @@ class HiddenPointRemovalPass final : public RenderPass {
     explicit HiddenPointRemovalPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "HiddenPointRemoval"; }
-    std::vector<std::string_view> inputs() const override { return {"pyramid", "color"}; }
-    std::vector<std::string_view> outputs() const override { return {"visibility"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override {
+        return {"pyramid", "color"};
+    }
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return {"visibility"};
+    }
     void execute(FrameContext& frame) override;
 
   private:

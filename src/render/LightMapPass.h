@@ -14,8 +14,12 @@ class LightMapPass final : public RenderPass {
     explicit LightMapPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "LightMap"; }
-    std::vector<std::string_view> inputs() const override { return {"surfaceDepth", "normals"}; }
-    std::vector<std::string_view> outputs() const override { return {"lightMap"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override {
+        return {"surfaceDepth", "normals"};
+    }
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return {"lightMap"};
+    }
     void execute(FrameContext& frame) override;
 
   private:

@@ -13,8 +13,10 @@ class MinDepthPyramidPass final : public RenderPass {
     explicit MinDepthPyramidPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "MinDepthPyramid"; }
-    std::vector<std::string_view> inputs() const override { return {"depth"}; }
-    std::vector<std::string_view> outputs() const override { return {"pyramid"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override { return {"depth"}; }
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return {"pyramid"};
+    }
     void execute(FrameContext& frame) override;
 
   private:

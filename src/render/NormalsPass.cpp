@@ -7,14 +7,14 @@ namespace subscan {
 NormalsPass::NormalsPass(const ShaderSources& sources)
     : stages_(sources, "render/Normals.comp", {"LEVEL", "BLEND"}) {}
 
-std::vector<std::string_view> NormalsPass::inputs() const {
+std::vector<std::string_view> NormalsPass::inputs(const RenderSettings&) const {
     if (levelZero_ == LevelZero::Fused) {
         return {"pushValues", "pullWeights"};
     }
     return {"pushValues", "pullWeights", "surfaceDepth"};
 }
 
-std::vector<std::string_view> NormalsPass::outputs() const {
+std::vector<std::string_view> NormalsPass::outputs(const RenderSettings&) const {
     if (levelZero_ == LevelZero::Fused) {
         return {"normalPyramid"};
     }

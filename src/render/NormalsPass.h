@@ -13,8 +13,8 @@ class NormalsPass final : public RenderPass {
     explicit NormalsPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "Normals"; }
-    std::vector<std::string_view> inputs() const override;
-    std::vector<std::string_view> outputs() const override;
+    std::vector<std::string_view> inputs(const RenderSettings&) const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
     void setLevelZero(LevelZero levelZero) { levelZero_ = levelZero; }
 

@@ -19,7 +19,7 @@ std::vector<PassTiming> PassRunner::run(std::span<RenderPass* const> passes, Fra
     std::unordered_set<std::string_view> written;
     for (RenderPass* pass : passes) {
         const std::string_view name = pass->name();
-        for (const std::string_view input : pass->inputs()) {
+        for (const std::string_view input : pass->inputs(frame.settings)) {
             if (!written.contains(input)) {
                 throw Error(
                     fmt::format("the pass {} needs the image '{}', which no earlier pass "
@@ -38,7 +38,7 @@ std::vector<PassTiming> PassRunner::run(std::span<RenderPass* const> passes, Fra
             throw Error(
                 fmt::format("OpenGL reported an error in the pass {}: {}", name, errors.front()));
         }
-        for (const std::string_view output : pass->outputs()) {
+        for (const std::string_view output : pass->outputs(frame.settings)) {
             if (!frame.resources.has(output)) {
                 throw Error(fmt::format("the pass {} did not write its output '{}'", name, output));
             }

@@ -46,7 +46,7 @@ PresentPass::PresentPass(const ShaderSources& sources, std::string colorInput,
       depthInput_(std::move(depthInput)),
       stages_(sources, "render/Present.comp", {depthInput_.empty() ? "COLOR" : "DEPTH"}) {}
 
-std::vector<std::string_view> PresentPass::inputs() const {
+std::vector<std::string_view> PresentPass::inputs(const RenderSettings&) const {
     if (depthInput_.empty()) {
         return {colorInput_};
     }

@@ -15,8 +15,10 @@ class PresentPass final : public RenderPass {
     PresentPass(const ShaderSources& sources, std::string colorInput, std::string depthInput);
 
     std::string_view name() const override { return "Present"; }
-    std::vector<std::string_view> inputs() const override;
-    std::vector<std::string_view> outputs() const override { return {"image"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return {"image"};
+    }
     void execute(FrameContext& frame) override;
 
     /// Fills `image` with the frame's background exactly as the shader encodes it.

@@ -7,7 +7,7 @@ namespace subscan {
 PullPushPass::PullPushPass(const ShaderSources& sources)
     : stages_(sources, "render/PullPush.comp", {"PULL_INIT", "PULL", "PUSH_TOP", "PUSH"}) {}
 
-std::vector<std::string_view> PullPushPass::outputs() const {
+std::vector<std::string_view> PullPushPass::outputs(const RenderSettings&) const {
     if (levelZero_ == LevelZero::Fused) {
         return {"pullValues", "pullWeights", "pushValues"};
     }

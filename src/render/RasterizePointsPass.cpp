@@ -111,6 +111,13 @@ std::vector<std::uint32_t> RasterizePointsPass::readWinners(const FrameResources
     return winners;
 }
 
+std::vector<std::string_view> RasterizePointsPass::outputs(const RenderSettings& settings) const {
+    if (placesOutlineBySubpixels(settings)) {
+        return {"depth", "color", "occupancy"};
+    }
+    return {"depth", "color"};
+}
+
 void RasterizePointsPass::execute(FrameContext& frame) {
     const int width = frame.camera.width;
     const int height = frame.camera.height;

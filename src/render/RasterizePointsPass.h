@@ -25,8 +25,8 @@ class RasterizePointsPass final : public RenderPass {
     RasterizePointsPass(const ShaderSources& sources, const GlCapabilities& capabilities);
 
     std::string_view name() const override { return "RasterizePoints"; }
-    std::vector<std::string_view> inputs() const override { return {}; }
-    std::vector<std::string_view> outputs() const override { return {"depth", "color"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override { return {}; }
+    std::vector<std::string_view> outputs(const RenderSettings& settings) const override;
     void execute(FrameContext& frame) override;
 
     /// The path `requested` resolves to on this driver; throws subscan::Error when Int64 is

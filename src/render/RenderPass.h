@@ -95,14 +95,14 @@ enum class LevelZero { PerPass, Fused };
 bool surfaceBoundsAllowed(const RenderSettings& settings);
 
 /// One step of the frame pipeline: one class and one shader of the same name (Falcor's
-/// RenderPass). It declares the images it reads and writes by name so the runner can check the
-/// wiring, time it and dump any of its outputs.
+/// RenderPass). It declares the images and buffers it reads and writes in a frame of
+/// `settings` by name so the runner can check the wiring, time it and dump any of its outputs.
 class RenderPass {
   public:
     virtual ~RenderPass() = default;
     virtual std::string_view name() const = 0;
-    virtual std::vector<std::string_view> inputs() const = 0;
-    virtual std::vector<std::string_view> outputs() const = 0;
+    virtual std::vector<std::string_view> inputs(const RenderSettings& settings) const = 0;
+    virtual std::vector<std::string_view> outputs(const RenderSettings& settings) const = 0;
     virtual void execute(FrameContext& frame) = 0;
 };
 

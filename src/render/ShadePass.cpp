@@ -18,7 +18,7 @@ ShadePass::ShadePass(const ShaderSources& sources, ShadeOutputs outputs)
       stages_(sources, "render/Shade.comp",
               {outputs == ShadeOutputs::Split ? "SPLIT" : "RADIANCE"}) {}
 
-std::vector<std::string_view> ShadePass::outputs() const {
+std::vector<std::string_view> ShadePass::outputs(const RenderSettings&) const {
     if (outputs_ == ShadeOutputs::Split) {
         return {"diffuse", "specular", "albedo", "radiance"};
     }

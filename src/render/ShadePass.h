@@ -17,10 +17,10 @@ class ShadePass final : public RenderPass {
     ShadePass(const ShaderSources& sources, ShadeOutputs outputs);
 
     std::string_view name() const override { return "Shade"; }
-    std::vector<std::string_view> inputs() const override {
+    std::vector<std::string_view> inputs(const RenderSettings&) const override {
         return {"surfaceDepth", "normals", "filledColor"};
     }
-    std::vector<std::string_view> outputs() const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
 
     /// The shader's parameters for the frame's settings and camera (directions into view

@@ -28,7 +28,7 @@ std::vector<std::string> stageNames(SingleScatteringBase base) {
 SingleScatteringPass::SingleScatteringPass(const ShaderSources& sources, SingleScatteringBase base)
     : base_(base), stages_(sources, "render/SingleScattering.comp", stageNames(base)) {}
 
-std::vector<std::string_view> SingleScatteringPass::inputs() const {
+std::vector<std::string_view> SingleScatteringPass::inputs(const RenderSettings&) const {
     return {"surfaceDepth", "normals", "albedo",
             base_ == SingleScatteringBase::Radiance ? "radiance" : "scatteredRadiance"};
 }

@@ -23,8 +23,8 @@ class SingleScatteringPass final : public RenderPass {
     SingleScatteringPass(const ShaderSources& sources, SingleScatteringBase base);
 
     std::string_view name() const override { return "SingleScattering"; }
-    std::vector<std::string_view> inputs() const override;
-    std::vector<std::string_view> outputs() const override {
+    std::vector<std::string_view> inputs(const RenderSettings&) const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
         return {"scatteredRadiance", "singleScattering", "sigmaSPrime", "sigmaA"};
     }
     void execute(FrameContext& frame) override;

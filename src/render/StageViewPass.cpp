@@ -26,7 +26,7 @@ StageViewPass::StageViewPass(const ShaderSources& sources, Stage stage)
     }
 }
 
-std::vector<std::string_view> StageViewPass::inputs() const {
+std::vector<std::string_view> StageViewPass::inputs(const RenderSettings&) const {
     switch (stage_) {
         case Stage::Depth:
             return {"depth"};

@@ -13,8 +13,10 @@ class StageViewPass final : public RenderPass {
     StageViewPass(const ShaderSources& sources, Stage stage);
 
     std::string_view name() const override { return "StageView"; }
-    std::vector<std::string_view> inputs() const override;
-    std::vector<std::string_view> outputs() const override { return {"stage"}; }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override;
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return {"stage"};
+    }
     void execute(FrameContext& frame) override;
 
   private:

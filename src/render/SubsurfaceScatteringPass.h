@@ -20,10 +20,10 @@ class SubsurfaceScatteringPass final : public RenderPass {
     explicit SubsurfaceScatteringPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "SubsurfaceScattering"; }
-    std::vector<std::string_view> inputs() const override {
+    std::vector<std::string_view> inputs(const RenderSettings&) const override {
         return {"surfaceDepth", "diffuse", "specular", "albedo"};
     }
-    std::vector<std::string_view> outputs() const override {
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
         return {"sssSource", "sssHalf", "sssBlurred", "sssSum", "scatteredRadiance"};
     }
     void execute(FrameContext& frame) override;

@@ -170,7 +170,7 @@ TemporalPass::TemporalPass(const ShaderSources& sources, TemporalHistory& histor
           sources, "render/Temporal.comp",
           {"RESTART", "STILL", "MOVING", "RESTART_PICTURE", "STILL_PICTURE", "MOVING_PICTURE"}) {}
 
-std::vector<std::string_view> TemporalPass::outputs() const {
+std::vector<std::string_view> TemporalPass::outputs(const RenderSettings&) const {
     if (writesPicture_) {
         return {"history", "historyState", "image"};
     }

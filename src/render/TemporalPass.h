@@ -77,8 +77,10 @@ class TemporalPass final : public RenderPass {
     TemporalPass(const ShaderSources& sources, TemporalHistory& history);
 
     std::string_view name() const override { return "Temporal"; }
-    std::vector<std::string_view> inputs() const override { return {colorInput_, "surfaceDepth"}; }
-    std::vector<std::string_view> outputs() const override;
+    std::vector<std::string_view> inputs(const RenderSettings&) const override {
+        return {colorInput_, "surfaceDepth"};
+    }
+    std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
 
     /// The radiance the frame's pipeline leaves ("radiance", "scatteredRadiance"), and whether

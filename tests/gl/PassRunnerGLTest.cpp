@@ -32,8 +32,12 @@ class FakePass final : public RenderPass {
           raisesGlError_(raisesGlError) {}
 
     std::string_view name() const override { return name_; }
-    std::vector<std::string_view> inputs() const override { return listOf(input_); }
-    std::vector<std::string_view> outputs() const override { return listOf(output_); }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override {
+        return listOf(input_);
+    }
+    std::vector<std::string_view> outputs(const RenderSettings&) const override {
+        return listOf(output_);
+    }
     void execute(FrameContext& frame) override {
         if (writes_ && !output_.empty()) {
             frame.resources.ensureTexture(output_, TextureFormat::R32F, frame.width(),

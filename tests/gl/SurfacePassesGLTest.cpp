@@ -18,11 +18,13 @@
 #include "core/Srgb.h"
 #include "gpu/ShaderSources.h"
 #include "render/FillRemovalPass.h"
+#include "render/FinishSurfacePass.h"
 #include "render/FrameUniforms.h"
 #include "render/HiddenPointRemovalPass.h"
 #include "render/MinDepthPyramidPass.h"
 #include "render/NormalsPass.h"
 #include "render/PullPushPass.h"
+#include "render/RasterizePointsPass.h"
 #include "render/ShadePass.h"
 #include "render/StageViewPass.h"
 #include "support/GlTestSupport.h"
@@ -654,6 +656,34 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     EXPECT_GE(tooSparse, 1);           // row 14
     EXPECT_GE(sparsestActed, 2);       // rows 15 and 16
     EXPECT_GE(exactlyFiveEighths, 3);  // rows 18-20
+}
+
+// The outline's sub-pixel cells pass from the raster to the mask in the "occupancy" buffer:
+// declared where a frame's settings use it, so that PassRunner refuses a frame that would read
+// an earlier frame's cells.
+TEST(SurfacePassesGLTest, TheOutlinesCellsAreDeclaredWhereTheyAreUsed) {
+    PassHarness harness = makeHarness();
+    const RasterizePointsPass raster(harness.sources(), test::glTestContext().capabilities());
+    FillRemovalPass perPass(harness.sources());
+    FillRemovalPass fused(harness.sources());
+    fused.setLevelZero(LevelZero::Fused);
+    const FinishSurfacePass finish(harness.sources(), FinishSurfacePass::Output::Picture);
+    const auto declares = [](const std::vector<std::string_view>& names) {
+        return std::ranges::find(names, "occupancy") != names.end();
+    };
+    for (const RenderMode mode : {RenderMode::Surface, RenderMode::Sss, RenderMode::Points}) {
+        for (const bool outline : {true, false}) {
+            RenderSettings settings;
+            settings.raster.mode = mode;
+            settings.surface.subpixelOutline = outline;
+            const bool used = outline && mode != RenderMode::Points;
+            EXPECT_EQ(declares(raster.outputs(settings)), used);
+            EXPECT_EQ(declares(perPass.inputs(settings)), used);
+            EXPECT_EQ(declares(finish.inputs(settings)), used);
+            // Above level 0 the fill's reach needs no cells; FinishSurface draws the outline.
+            EXPECT_FALSE(declares(fused.inputs(settings)));
+        }
+    }
 }
 
 TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
