@@ -75,6 +75,28 @@ TEST(TurntableCommandGLTest, FramesStartConvergedAndTurnByDegreesOverFrames) {
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "buffers" / "0002" / "depth.pfm"));
 }
 
+// A settings file names what it changes: one without a mode still turns the surface, one that
+// names the points mode turns points (the surface modes alone export normals).
+TEST(TurntableCommandGLTest, TurnsTheSurfaceUnlessAModeIsNamed) {
+    const test::TempDir dir;
+    const std::pair<const char*, const char*> cases[] = {
+        {"weight.json", R"({"temporal": {"new_frame_weight": 0.3}})"},
+        {"points.json", R"({"raster": {"mode": "points"}})"}};
+    for (const auto& [name, text] : cases) {
+        std::ofstream(dir / name) << text;
+        const auto turntable =
+            runSubscan({"turntable", "synthetic:sphere?points=4000", "--width", "40", "--height",
+                        "32", "--frames", "1", "--settings", (dir / name).string(), "-o",
+                        (dir / name).string() + ".frames", "--export-buffers",
+                        (dir / name).string() + ".buffers"});
+        ASSERT_EQ(turntable.exitCode, 0) << turntable.err;
+        EXPECT_EQ(std::filesystem::exists(dir / (std::string(name) + ".buffers") / "0000" /
+                                          "normals.pfm"),
+                  std::string(name) == "weight.json")
+            << name;
+    }
+}
+
 TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
     if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
         GTEST_SKIP() << "ffmpeg is not installed (scripts/setup-deps.sh installs it)";

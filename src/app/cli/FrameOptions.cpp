@@ -29,7 +29,7 @@ glm::vec3 parseBackground(const std::string& text) {
 
 }  // namespace
 
-void FrameOptions::add(CLI::App& command) {
+void FrameOptions::add(CLI::App& command, RenderMode defaultMode) {
     command.add_option("scan", source, "Scan file, or synthetic:NAME")->required();
     widthOption =
         command.add_option("--width", width, "Image width in pixels")->check(CLI::Range(1, 65536));
@@ -37,8 +37,9 @@ void FrameOptions::add(CLI::App& command) {
                        ->check(CLI::Range(1, 65536));
     command
         .add_option("--mode", mode,
-                    "points (default) | points-gl | splats | surface | sss (surface with "
-                    "subsurface scattering)")
+                    fmt::format("points | points-gl | splats | surface | sss (surface with "
+                                "subsurface scattering); default: the settings file's, else {}",
+                                toString(defaultMode)))
         ->check(CLI::IsMember({"points", "points-gl", "splats", "surface", "sss"}));
     command
         .add_option("--stage", stage,
@@ -84,10 +85,10 @@ void FrameOptions::add(CLI::App& command) {
                      "Use Mesa's software rasterizer even when a GPU exists");
 }
 
-RenderSettings FrameOptions::settings() const {
-    RenderSettings settings;
+RenderSettings FrameOptions::settings(const RenderSettings& defaults) const {
+    RenderSettings settings = defaults;
     if (!settingsFile.empty()) {
-        settings = readSettingsFile(settingsFile);
+        settings = readSettingsFile(settingsFile, defaults);
     }
     RasterSettings& rasterSettings = settings.raster;
     if (!mode.empty()) {

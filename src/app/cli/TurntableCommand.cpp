@@ -134,10 +134,10 @@ int runTurntable(const TurntableOptions& options) {
                 output.string()));
         }
     }
-    RenderSettings settings = frame.settings();
-    if (frame.mode.empty() && frame.settingsFile.empty()) {
-        settings.raster.mode = RenderMode::Surface;  // a turntable of the surface, unless asked
-    }
+    // A turntable of the surface unless --mode or the settings file names another mode.
+    RenderSettings surface;
+    surface.raster.mode = RenderMode::Surface;
+    RenderSettings settings = frame.settings(surface);
     settings.temporal.enabled = true;
     const bool filtered = filtersTemporally(settings);
 
@@ -221,7 +221,7 @@ Command addTurntableCommand(CLI::App& parent) {
     auto options = std::make_shared<TurntableOptions>();
     CLI::App* turntable = parent.add_subcommand(
         "turntable", "A turntable animation through the temporal filter (MP4 or numbered PNGs)");
-    options->frame.add(*turntable);
+    options->frame.add(*turntable, RenderMode::Surface);
     turntable
         ->add_option("-o,--output", options->output,
                      "OUT.mp4 (encoded by ffmpeg) or a folder for 0000.png, 0001.png, ...")
