@@ -29,7 +29,8 @@ glm::vec3 parseBackground(const std::string& text) {
 
 }  // namespace
 
-void FrameOptions::add(CLI::App& command, RenderMode defaultMode) {
+void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
+    defaultMode = modeByDefault;
     command.add_option("scan", source, "Scan file, or synthetic:NAME")->required();
     widthOption =
         command.add_option("--width", width, "Image width in pixels")->check(CLI::Range(1, 65536));
@@ -85,7 +86,9 @@ void FrameOptions::add(CLI::App& command, RenderMode defaultMode) {
                      "Use Mesa's software rasterizer even when a GPU exists");
 }
 
-RenderSettings FrameOptions::settings(const RenderSettings& defaults) const {
+RenderSettings FrameOptions::settings() const {
+    RenderSettings defaults;
+    defaults.raster.mode = defaultMode;
     RenderSettings settings = defaults;
     if (!settingsFile.empty()) {
         settings = readSettingsFile(settingsFile, defaults);

@@ -42,13 +42,14 @@ struct FrameOptions {
     std::string color = "auto";  // Coloring
     bool verbose = false;
     bool software = false;
+    RenderMode defaultMode = RenderMode::Points;  // set by add()
 
-    /// The options on `command`; `defaultMode` is the mode where neither --mode nor the settings
-    /// file names one (the caller passes it to settings() too).
-    void add(CLI::App& command, RenderMode defaultMode = RenderMode::Points);
-    /// The settings file's settings over `defaults` (where the file leaves a key out) with the
-    /// given options written over them; throws subscan::Error naming a bad value.
-    RenderSettings settings(const RenderSettings& defaults = {}) const;
+    /// The options on `command`; `modeByDefault` is the mode where neither --mode nor the
+    /// settings file names one.
+    void add(CLI::App& command, RenderMode modeByDefault = RenderMode::Points);
+    /// The settings file's settings (over the defaults, where the file leaves a key out) with
+    /// the given options written over them; throws subscan::Error naming a bad value.
+    RenderSettings settings() const;
     /// The camera of --camera; or with --view sensor the sensor's (SensorViewOptions); or the
     /// orbit of --yaw, --pitch, --distance, --up and --fovy around the scan's bounds, framed by
     /// `framing` when --distance is not given.

@@ -134,10 +134,7 @@ int runTurntable(const TurntableOptions& options) {
                 output.string()));
         }
     }
-    // A turntable of the surface unless --mode or the settings file names another mode.
-    RenderSettings surface;
-    surface.raster.mode = RenderMode::Surface;
-    RenderSettings settings = frame.settings(surface);
+    RenderSettings settings = frame.settings();
     settings.temporal.enabled = true;
     const bool filtered = filtersTemporally(settings);
 
@@ -221,6 +218,7 @@ Command addTurntableCommand(CLI::App& parent) {
     auto options = std::make_shared<TurntableOptions>();
     CLI::App* turntable = parent.add_subcommand(
         "turntable", "A turntable animation through the temporal filter (MP4 or numbered PNGs)");
+    // A turntable of the surface unless --mode or the settings file names another mode.
     options->frame.add(*turntable, RenderMode::Surface);
     turntable
         ->add_option("-o,--output", options->output,
