@@ -15,6 +15,9 @@
 //                walk dominated the frame.
 //   STAGE_MASK   writes "mask" (1 = surface) and "surfaceDepth" (the filled depth there, +inf
 //                elsewhere), unless FinishSurface.comp tests level 0 itself.
+//   STAGE_SURFACE_DEPTH  "surfaceDepth" alone, from the push's level 0 (which FinishSurface.comp
+//                computes for itself): for a FinishSurface whose normals look for the outline
+//                around each pixel, which one dispatch cannot know of its neighbours.
 #include "render/FillRemoval.glsl"
 #include "shared/region.glsl"
 
@@ -27,6 +30,8 @@ layout(std430, binding = SUBSCAN_SSBO_FILL_REACH) writeonly buffer FillReach {
 #if STAGE_MASK
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inFilledDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outMask;
+#endif
+#if STAGE_MASK || STAGE_SURFACE_DEPTH
 layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceDepth;
 #endif
 
@@ -41,9 +46,15 @@ void main() {
     if (!insideLevel(0u, pixel) || !insideRegion(pixel)) {
         return;
     }
+#if STAGE_MASK
     float depth = imageLoad(inFilledDepth, pixel).r;
+#else
+    float depth = pushedValue(0u, pixel).x;
+#endif
     bool surfacePixel = onSurface(pixel, depth, spacingRatioAt(pixel));
+#if STAGE_MASK
     imageStore(outMask, pixel, vec4(surfacePixel ? 1.0 : 0.0));
+#endif
     imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? depth : kInfinity));
 #endif
 }

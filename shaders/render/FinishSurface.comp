@@ -13,11 +13,16 @@
 //                             temporal filter's blend too (render/Temporal.glsl), saving its
 //                             pass (on llvmpipe a pass over the image costs ~5 ms before it
 //                             does anything)
+//   FINISH_SEES_OUTLINE       1: the mask comes from "surfaceDepth" (FillRemoval.comp's
+//                             STAGE_SURFACE_DEPTH), where the normals also find the outline
+//                             (Normals.glsl); 0: the mask is tested here and "surfaceDepth"
+//                             written
 #define FINISH_PICTURE 0
 #define FINISH_RADIANCE 1
 #define FINISH_RESTART 2
 #define FINISH_STILL 3
 #define FINISH_TEMPORAL (FINISH_OUTPUT >= FINISH_RESTART)
+#define NORMALS_SEE_OUTLINE FINISH_SEES_OUTLINE
 #include "render/FillRemoval.glsl"
 #include "render/Normals.glsl"
 #include "render/Shade.glsl"
@@ -32,7 +37,9 @@ layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outRadia
 #else
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
 #endif
+#if !FINISH_SEES_OUTLINE
 layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceDepth;
+#endif
 
 void main() {
     ivec2 pixel = dispatchTexel();
@@ -43,7 +50,12 @@ void main() {
     float depth = kInfinity;
     vec4 filled = pushedValue(0u, pixel);
     float spacingRatio = spacingRatioAt(pixel);
-    if (onSurface(pixel, filled.x, spacingRatio)) {
+#if FINISH_SEES_OUTLINE
+    bool surfacePixel = !isinf(imageLoad(inSurfaceDepth, pixel).r);
+#else
+    bool surfacePixel = onSurface(pixel, filled.x, spacingRatio);
+#endif
+    if (surfacePixel) {
         vec3 diffuse;
         vec3 specular;
         shadePixel(pixel, filled.x, blendedNormal(pixel, filled.x, spacingRatio), clamp(filled.yzw, 0.0, 1.0),
@@ -51,7 +63,9 @@ void main() {
         color = diffuse + specular;
         depth = filled.x;
     }
+#if !FINISH_SEES_OUTLINE
     imageStore(outSurfaceDepth, pixel, vec4(depth));
+#endif
 #if FINISH_OUTPUT == FINISH_RADIANCE
     imageStore(outRadiance, pixel, vec4(color, 1.0));
 #elif FINISH_OUTPUT == FINISH_PICTURE

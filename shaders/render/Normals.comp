@@ -5,10 +5,12 @@
 // only one of the two neighbours is fully covered by points (pull weight 1), its side is taken
 // instead: the other is fill, which continues the surface past its silhouette flatter than it
 // is and made the rims of round objects face the camera (too bright under a head light). Each
-// pixel then blends the normals of the two levels around its fractional smoothing level.
+// pixel then blends the normals of the two levels around its fractional smoothing level, and
+// near the outline follows the surface's turn towards it (Normals.glsl).
 //   STAGE_LEVEL  normals of level `level` into the normal pyramid
 //   STAGE_BLEND  the per-pixel blend into the "normals" image (view space), unless
 //                FinishSurface.comp blends level 0 itself
+#define NORMALS_SEE_OUTLINE STAGE_BLEND
 #include "render/Normals.glsl"
 #include "shared/region.glsl"
 
@@ -19,7 +21,6 @@ layout(std430, binding = SUBSCAN_SSBO_NORMALS) writeonly buffer Normals {
     vec4 normalPyramid[];
 };
 #if STAGE_BLEND
-layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outNormals;
 #endif
 

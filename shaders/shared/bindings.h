@@ -131,7 +131,7 @@ struct SurfaceParams {
     vec4 fill;        // x: radius of the expected gap, y: directions that must find points,
                       // z: pull depth slope (texel widths), w: 1 to place a dense
                       // cloud's outline by its points' sub-pixel cells (SUBSCAN_SSBO_OCCUPANCY)
-    vec4 normals;     // x: smoothing radius
+    vec4 normals;     // x: smoothing radius, y: 1 to extrapolate them towards the outline
     vec4 spacing;     // x: 1 when the points carry their local spacing, else 0
 };
 

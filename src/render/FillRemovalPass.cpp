@@ -8,23 +8,32 @@
 namespace subscan {
 
 FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
-    : stages_(sources, "render/FillRemoval.comp", {"REACH", "MASK"}) {}
+    : stages_(sources, "render/FillRemoval.comp", {"REACH", "MASK", "SURFACE_DEPTH"}) {}
 
 std::vector<std::string_view> FillRemovalPass::inputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names{"pullWeights"};
     if (levelZero_ == LevelZero::Fused) {
-        return {"pullWeights"};
+        if (!followsNormalsToOutline(settings)) {
+            return names;
+        }
+        names.insert(names.end(), {"pullValues", "pushValues"});
+    } else {
+        names.push_back("filledDepth");
     }
     if (placesOutlineBySubpixels(settings)) {
-        return {"filledDepth", "pullWeights", "occupancy"};
+        names.push_back("occupancy");
     }
-    return {"filledDepth", "pullWeights"};
+    return names;
 }
 
-std::vector<std::string_view> FillRemovalPass::outputs(const RenderSettings&) const {
-    if (levelZero_ == LevelZero::Fused) {
-        return {"fillReach"};
+std::vector<std::string_view> FillRemovalPass::outputs(const RenderSettings& settings) const {
+    if (levelZero_ == LevelZero::PerPass) {
+        return {"fillReach", "mask", "surfaceDepth"};
     }
-    return {"fillReach", "mask", "surfaceDepth"};
+    if (followsNormalsToOutline(settings)) {
+        return {"fillReach", "surfaceDepth"};
+    }
+    return {"fillReach"};
 }
 
 void FillRemovalPass::execute(FrameContext& frame) {
@@ -39,24 +48,35 @@ void FillRemovalPass::execute(FrameContext& frame) {
         stages_.runOverRegion(Reach, frame.region(level), level);
         glMemoryBarrier(kPyramidWritesBarrier);
     }
-    if (levelZero_ == LevelZero::Fused) {
+    const bool fused = levelZero_ == LevelZero::Fused;
+    if (fused && !followsNormalsToOutline(frame.settings)) {
         return;
     }
-    Texture& mask =
-        resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
     Texture& surfaceDepth =
         resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
     if (frame.restricted()) {
-        frame.clear(mask);
         frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
     }
     if (placesOutlineBySubpixels(frame.settings)) {
         resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
     }
-    resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    stages_.runOverRegion(Mask, frame.region(0));
+    if (fused) {
+        // Level 0 of the push, as FinishSurface computes it.
+        resources.buffer("pullValues")
+            .bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
+        resources.buffer("pushValues")
+            .bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
+    } else {
+        Texture& mask =
+            resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
+        if (frame.restricted()) {
+            frame.clear(mask);
+        }
+        resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+        mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+    }
+    stages_.runOverRegion(fused ? SurfaceDepth : Mask, frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
 }

@@ -9,7 +9,8 @@ namespace subscan {
 /// sub-pixel outline of SurfaceSettings::subpixelOutline): "mask" is 1 where
 /// visible points surround the pixel up to the level of the expected point gap (looked up in
 /// the per-direction "fillReach" pyramid), and "surfaceDepth" holds the filled depth there
-/// (+inf elsewhere). With LevelZero::Fused only "fillReach" above level 0.
+/// (+inf elsewhere). With LevelZero::Fused only "fillReach" above level 0, and "surfaceDepth"
+/// when the normals follow the surface to the outline (FinishSurface then reads it).
 class FillRemovalPass final : public RenderPass {
   public:
     explicit FillRemovalPass(const ShaderSources& sources);
@@ -21,7 +22,7 @@ class FillRemovalPass final : public RenderPass {
     void setLevelZero(LevelZero levelZero) { levelZero_ = levelZero; }
 
   private:
-    enum Stage { Reach, Mask };
+    enum Stage { Reach, Mask, SurfaceDepth };
     ComputeStages stages_;
     LevelZero levelZero_ = LevelZero::PerPass;
 };

@@ -30,36 +30,49 @@ FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources, Output output
 }
 
 std::vector<std::string_view> FinishSurfacePass::inputs(const RenderSettings& settings) const {
-    std::vector<std::string_view> names{"pullValues", "pullWeights", "pushValues", "fillReach",
-                                        "normalPyramid"};
+    std::vector<std::string_view> names{"pullValues", "pullWeights", "pushValues", "normalPyramid"};
+    if (followsNormalsToOutline(settings)) {
+        names.push_back("surfaceDepth");  // the mask, FillRemovalPass's
+        return names;
+    }
+    names.push_back("fillReach");
     if (placesOutlineBySubpixels(settings)) {
         names.push_back("occupancy");
     }
     return names;
 }
 
-std::vector<std::string_view> FinishSurfacePass::outputs(const RenderSettings&) const {
+std::vector<std::string_view> FinishSurfacePass::outputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names;
     switch (output_) {
         case Output::Picture:
-            return {"image", "surfaceDepth"};
+            names = {"image"};
+            break;
         case Output::Radiance:
-            return {"radiance", "surfaceDepth"};
+            names = {"radiance"};
+            break;
         case Output::Temporal:
+            names = {"image", "history", "historyState"};
             break;
     }
-    return {"image", "surfaceDepth", "history", "historyState"};
+    if (!followsNormalsToOutline(settings)) {
+        names.push_back("surfaceDepth");
+    }
+    return names;
 }
 
-const Program& FinishSurfacePass::program(bool directionalLights, int finishOutput) {
-    auto found = programs_.find({directionalLights, finishOutput});
+const Program& FinishSurfacePass::program(const Variant& variant) {
+    auto found = programs_.find(variant);
     if (found == programs_.end()) {
-        const std::string defines =
-            fmt::format("#define SHADE_DIRECTIONAL_LIGHTS {}\n#define FINISH_OUTPUT {}\n",
-                        directionalLights ? 1 : 0, finishOutput);
-        found = programs_
-                    .emplace(std::pair{directionalLights, finishOutput},
-                             Program::compute(sources_, "render/FinishSurface.comp", defines))
-                    .first;
+        const auto [directionalLights, finishOutput, seesOutline] = variant;
+        const std::string defines = fmt::format(
+            "#define SHADE_DIRECTIONAL_LIGHTS {}\n#define FINISH_OUTPUT {}\n"
+            "#define FINISH_SEES_OUTLINE {}\n",
+            directionalLights ? 1 : 0, finishOutput, seesOutline ? 1 : 0);
+        found =
+            programs_
+                .emplace(variant, Program::compute(sources_, "render/FinishSurface.comp", defines))
+                .first;
     }
     return found->second;
 }
@@ -72,20 +85,26 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     resources.buffer("pullValues").bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
     resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
-    resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
     resources.buffer("normalPyramid").bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
-    if (placesOutlineBySubpixels(frame.settings)) {
-        resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
+    const bool seesOutline = followsNormalsToOutline(frame.settings);
+    if (seesOutline) {
+        resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    } else {
+        resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
+        if (placesOutlineBySubpixels(frame.settings)) {
+            resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
+        }
+        Texture& surfaceDepth = resources.ensureTexture("surfaceDepth", TextureFormat::R32F,
+                                                        frame.width(), frame.height());
+        if (frame.restricted()) {
+            frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
+        }
+        surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     }
     const gpu::ShadeParams shade = ShadePass::parameters(frame);
     params_.set(shade);
     params_.bind(SUBSCAN_UBO_PASS);
 
-    Texture& surfaceDepth =
-        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
-    if (frame.restricted()) {
-        frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
-    }
     int finishOutput = kFinishPicture;
     TemporalHistory::Mode mode = TemporalHistory::Mode::Restart;
     if (output_ == Output::Temporal) {
@@ -110,8 +129,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
         color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
         finishOutput = picture ? kFinishPicture : kFinishRadiance;
     }
-    surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
-    const Program& shader = program(shade.lightCount.x > 0, finishOutput);
+    const Program& shader = program({shade.lightCount.x > 0, finishOutput, seesOutline});
     shader.use();
     const TexelRegion region = frame.region(0);
     ComputeStages::setRegionUniforms(shader, region);

@@ -1,7 +1,7 @@
 #pragma once
 
 #include <map>
-#include <utility>
+#include <tuple>
 
 #include "gpu/GlObjects.h"
 #include "render/RenderPass.h"
@@ -16,6 +16,8 @@ class TemporalHistory;
 /// over the background, from the pyramids PullPushPass, FillRemovalPass and NormalsPass leave
 /// above level 0. Writes "image" and "surfaceDepth" (+inf off the surface) and nothing between:
 /// on llvmpipe the per-pass chain's six full-screen images cost more than their arithmetic.
+/// When the normals follow the surface to the outline (followsNormalsToOutline), which needs
+/// the mask around each pixel, the mask comes from FillRemovalPass's "surfaceDepth" instead.
 /// Equals the chain up to its half-float rounding of colour, normals and radiance. With the
 /// temporal filter it also blends the frame into the history when the filter restarts or the
 /// camera rests (Output::Temporal: TemporalPass's work without its dispatch), or leaves the
@@ -32,7 +34,7 @@ class FinishSurfacePass final : public RenderPass {
 
     std::string_view name() const override { return "FinishSurface"; }
     std::vector<std::string_view> inputs(const RenderSettings& settings) const override;
-    std::vector<std::string_view> outputs(const RenderSettings&) const override;
+    std::vector<std::string_view> outputs(const RenderSettings& settings) const override;
     void execute(FrameContext& frame) override;
 
     /// Whether a frame can finish here: at full resolution (reduced frames scale up in
@@ -42,15 +44,18 @@ class FinishSurfacePass final : public RenderPass {
     }
 
   private:
-    /// The shader for the lights and what it writes (FINISH_OUTPUT), built on first use: on
-    /// llvmpipe an unused loop over directional lights still costs a frame lit by the head
-    /// light alone a sixth of this pass.
-    const Program& program(bool directionalLights, int finishOutput);
+    /// Directional lights or not, FINISH_OUTPUT, and whether the mask comes from
+    /// "surfaceDepth" (FINISH_SEES_OUTLINE).
+    using Variant = std::tuple<bool, int, bool>;
+
+    /// The shader of a variant, built on first use: on llvmpipe an unused loop over
+    /// directional lights still costs a frame lit by the head light alone a sixth of this pass.
+    const Program& program(const Variant& variant);
 
     const ShaderSources& sources_;
     Output output_;
     TemporalHistory* history_;
-    std::map<std::pair<bool, int>, Program> programs_;
+    std::map<Variant, Program> programs_;
     UniformBlock<gpu::ShadeParams> params_{"FinishSurface.shade"};
 };
 

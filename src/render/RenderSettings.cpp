@@ -87,6 +87,10 @@ bool placesOutlineBySubpixels(const RenderSettings& settings) {
     return settings.surface.subpixelOutline && reconstructsSurface(settings.raster.mode);
 }
 
+bool followsNormalsToOutline(const RenderSettings& settings) {
+    return settings.surface.outlineNormals && reconstructsSurface(settings.raster.mode);
+}
+
 bool filtersTemporally(const RenderSettings& settings) {
     return settings.temporal.enabled && reconstructsSurface(settings.raster.mode) &&
            settings.raster.stage == Stage::Final;

@@ -121,6 +121,9 @@ bool filtersTemporally(const RenderSettings& settings);
 /// Whether the frame records its points' sub-pixel cells and places the outline by them
 /// (SurfaceSettings::subpixelOutline in a mode that reconstructs the surface).
 bool placesOutlineBySubpixels(const RenderSettings& settings);
+/// Whether the frame's normals follow the surface towards the outline, which they find in
+/// "surfaceDepth" (SurfaceSettings::outlineNormals in a mode that reconstructs the surface).
+bool followsNormalsToOutline(const RenderSettings& settings);
 /// Frames a camera at rest renders through the temporal filter before its picture counts as
 /// finished (the viewer then idles; `render` with the filter on averages this many): 32 jitter
 /// offsets put an edge pixel's coverage within 1/32 of its supersampled value.

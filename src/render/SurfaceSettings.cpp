@@ -21,6 +21,7 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
         {"restrict_to_points", settings.restrictToPoints},
         {"local_spacing", settings.localSpacing},
         {"subpixel_outline", settings.subpixelOutline},
+        {"outline_normals", settings.outlineNormals},
     };
 }
 
@@ -28,7 +29,7 @@ void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
     rejectUnknownKeys(json, "surface",
                       {"visibility_radius", "visibility_threshold", "edge_rule", "pull_depth_slope",
                        "fill_radius", "fill_directions", "normal_radius", "restrict_to_points",
-                       "local_spacing", "subpixel_outline"});
+                       "local_spacing", "subpixel_outline", "outline_normals"});
     readSetting(json, "visibility_radius", settings.visibilityRadius, 0.1f, 1000.0f);
     readSetting(json, "visibility_threshold", settings.visibilityThreshold, 0.0f, 2.0f);
     readSetting(json, "edge_rule", settings.edgeRule);
@@ -39,6 +40,7 @@ void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
     readSetting(json, "restrict_to_points", settings.restrictToPoints);
     readSetting(json, "local_spacing", settings.localSpacing);
     readSetting(json, "subpixel_outline", settings.subpixelOutline);
+    readSetting(json, "outline_normals", settings.outlineNormals);
 }
 
 namespace {

@@ -31,6 +31,11 @@ struct SurfaceSettings {
     // sub-pixel cells say it does (more than about half covered: kept), instead of every pixel
     // a point falls in being surface (half a pixel too far out on average).
     bool subpixelOutline = true;
+    // Normals within 3 pixels of the outline against the background extrapolated to it along
+    // the depth profile the two smoothing levels show (Normals.glsl): a smoothed normal there
+    // is the surface's a few pixels further in, where a round object's surface faces the
+    // camera more, so rims came out too bright.
+    bool outlineNormals = true;
 
     bool operator==(const SurfaceSettings&) const = default;
 };

@@ -78,7 +78,13 @@ TEST(FinishSurfaceGLTest, FramedObjectLooksAsPassByPass) {
     RenderSettings settings;
     settings.raster.mode = RenderMode::Surface;
     settings.shading.lights.push_back({{0.3f, 1.0f, 0.5f}, {0.6f, 0.5f, 0.4f}});
-    expectSamePicture(cloud, orbitCamera(cloud.bounds, {30.0, 20.0}, 161, 97, 45.0), settings);
+    // With the normals' outline rule FinishSurface reads the mask FillRemoval drew; without it,
+    // it draws the mask itself.
+    for (const bool outlineNormals : {true, false}) {
+        SCOPED_TRACE(outlineNormals ? "normals follow the outline" : "normals as blended");
+        settings.surface.outlineNormals = outlineNormals;
+        expectSamePicture(cloud, orbitCamera(cloud.bounds, {30.0, 20.0}, 161, 97, 45.0), settings);
+    }
 }
 
 TEST(FinishSurfaceGLTest, CloseUpLooksAsPassByPass) {

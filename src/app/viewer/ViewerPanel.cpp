@@ -407,6 +407,10 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
     helpTooltip(
         "A dense scan's outline runs where its points' sub-pixel cells put it, instead of "
         "through every pixel a point falls in (half a pixel too far out).");
+    ImGui::Checkbox("normals towards the outline", &surface.outlineNormals);
+    helpTooltip(
+        "Normals near the outline follow the surface's turn away from the camera there, so "
+        "round objects' rims darken as they should; off: the smoothed normal, too bright.");
     ImGui::Checkbox("skip the screen around the points", &surface.restrictToPoints);
     helpTooltip(
         "Passes after rasterization work only inside the points' bounds (the same "
