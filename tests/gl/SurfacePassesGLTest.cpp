@@ -769,14 +769,21 @@ TEST(SurfacePassesGLTest, NormalsMatchToFloatPrecision) {
 }
 
 /// The CPU twin of Normals.glsl's outlineRing: how many pixels along the nearest of the 4 axes
-/// the background lies (1 to 3), 0 when farther or beyond the image's border only.
+/// the background lies (1 to 3) where it goes on for 3 pixels, 0 when none does or only the
+/// image's border lies there.
 int outlineRing(const std::vector<float>& surfaceDepth, int x, int y) {
     constexpr int kAxes[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+    const auto background = [&](int nx, int ny) {
+        return nx >= 0 && ny >= 0 && nx < kWidth && ny < kHeight &&
+               std::isinf(surfaceDepth[ny * kWidth + nx]);
+    };
     for (int ring = 1; ring <= 3; ++ring) {
         for (const auto& axis : kAxes) {
-            const int nx = x + ring * axis[0], ny = y + ring * axis[1];
-            if (nx >= 0 && ny >= 0 && nx < kWidth && ny < kHeight &&
-                std::isinf(surfaceDepth[ny * kWidth + nx])) {
+            bool run = true;
+            for (int d = ring; d < ring + 3; ++d) {
+                run = run && background(x + d * axis[0], y + d * axis[1]);
+            }
+            if (run) {
                 return ring;
             }
         }
@@ -855,9 +862,11 @@ TEST_P(SurfacePassesSpacingGLTest, NormalBlendFollowsTheSmoothingLevel) {
     }
     EXPECT_GT(checked, 300);
     std::printf("normals turned towards the outline: %d of %d\n", turned, checked);
-    // The frame's round silhouettes turn a share of the pixels within 3 of them; without the
-    // turn (or with it on the wrong pixels) the comparison above fails there.
-    EXPECT_GT(turned, 10);
+    // The frame's round silhouettes turn some of the pixels within 3 of them (58 with the
+    // global spacing, 8 with the local one, whose surface reaches the frame's border on more
+    // sides, on llvmpipe); without the turn, or with it on the wrong pixels, the comparison
+    // above fails there. Half the fewer leaves room for another driver's rounding.
+    EXPECT_GE(turned, 4);
 }
 
 TEST(SurfacePassesGLTest, ShadeMatchesTheLightingFormula) {
