@@ -52,11 +52,8 @@ void FillRemovalPass::execute(FrameContext& frame) {
     if (fused && !followsNormalsToOutline(frame.settings)) {
         return;
     }
-    Texture& surfaceDepth =
-        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, frame.width(), frame.height());
-    if (frame.restricted()) {
-        frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
-    }
+    Texture& surfaceDepth = frame.imageOverRegion(
+        "surfaceDepth", TextureFormat::R32F, glm::vec4(std::numeric_limits<float>::infinity()));
     if (placesOutlineBySubpixels(frame.settings)) {
         resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
     }
@@ -68,11 +65,7 @@ void FillRemovalPass::execute(FrameContext& frame) {
         resources.buffer("pushValues")
             .bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     } else {
-        Texture& mask =
-            resources.ensureTexture("mask", TextureFormat::R8, frame.width(), frame.height());
-        if (frame.restricted()) {
-            frame.clear(mask);
-        }
+        Texture& mask = frame.imageOverRegion("mask", TextureFormat::R8);
         resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
         mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     }

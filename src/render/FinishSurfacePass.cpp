@@ -94,12 +94,10 @@ void FinishSurfacePass::execute(FrameContext& frame) {
         if (placesOutlineBySubpixels(frame.settings)) {
             resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
         }
-        Texture& surfaceDepth = resources.ensureTexture("surfaceDepth", TextureFormat::R32F,
-                                                        frame.width(), frame.height());
-        if (frame.restricted()) {
-            frame.clear(surfaceDepth, glm::vec4(std::numeric_limits<float>::infinity()));
-        }
-        surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+        frame
+            .imageOverRegion("surfaceDepth", TextureFormat::R32F,
+                             glm::vec4(std::numeric_limits<float>::infinity()))
+            .bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     }
     const gpu::ShadeParams shade = ShadePass::parameters(frame);
     params_.set(shade);

@@ -40,11 +40,7 @@ void NormalsPass::execute(FrameContext& frame) {
     if (levelZero_ == LevelZero::Fused) {
         return;
     }
-    Texture& normals =
-        resources.ensureTexture("normals", TextureFormat::RGBA16F, frame.width(), frame.height());
-    if (frame.restricted()) {
-        frame.clear(normals);
-    }
+    Texture& normals = frame.imageOverRegion("normals", TextureFormat::RGBA16F);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     normals.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     stages_.runOverRegion(Blend, frame.region(0));

@@ -30,6 +30,15 @@ TexelRegion FrameContext::region(unsigned level) const {
     return {first, last - first + 1};
 }
 
+Texture& FrameContext::imageOverRegion(std::string_view name, TextureFormat format,
+                                       const glm::vec4& outside) const {
+    Texture& image = resources.ensureTexture(name, format, width(), height());
+    if (restricted()) {
+        clear(image, outside);
+    }
+    return image;
+}
+
 TexelRegion FrameContext::cloudRegion() const {
     if (!cloudPixels) {
         return {glm::ivec2(0), glm::ivec2(width(), height())};

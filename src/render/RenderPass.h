@@ -65,6 +65,11 @@ struct FrameContext {
     void fill(Buffer& buffer, std::uint32_t value) const {
         clears.buffer(buffer, value, settings.raster.clears);
     }
+    /// The frame-sized image `name` a pass writes over its region only: where the frame is
+    /// restricted to the points' bounds it is first cleared to `outside`, so that nothing an
+    /// earlier frame left there is read as this frame's.
+    Texture& imageOverRegion(std::string_view name, TextureFormat format,
+                             const glm::vec4& outside = glm::vec4(0.0f)) const;
 
     int width() const { return camera.width; }
     int height() const { return camera.height; }

@@ -78,11 +78,8 @@ void ShadePass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
     const int width = frame.width();
     const int height = frame.height();
-    Texture& radiance = resources.ensureTexture("radiance", TextureFormat::RGBA16F, width, height);
-    if (frame.restricted()) {
-        // The other outputs are read only on the surface; the radiance is exported whole.
-        frame.clear(radiance);
-    }
+    // The other outputs are read only on the surface; the radiance is exported whole.
+    Texture& radiance = frame.imageOverRegion("radiance", TextureFormat::RGBA16F);
     params_.set(parameters(frame));
     params_.bind(SUBSCAN_UBO_PASS);
     resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);

@@ -4,6 +4,7 @@
 // leakage) while the test stays within a few seconds.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
