@@ -7,9 +7,10 @@
 // is the function its pass runs, so the two differ only where that chain rounds its images to
 // half floats. Defined by FinishSurfacePass:
 //   SHADE_DIRECTIONAL_LIGHTS  0: the head light alone; 1: and the directional lights
-//   FINISH_OUTPUT             FINISH_PICTURE: the picture; FINISH_RADIANCE: linear radiance
-//                             for a temporal filter pass after it (a moving camera, whose
-//                             blend needs the neighbourhood); FINISH_RESTART, FINISH_STILL: the
+//   FINISH_OUTPUT             FINISH_PICTURE: the picture; FINISH_RADIANCE_AND_DEPTH: linear
+//                             radiance with the depth in alpha, for a temporal filter pass
+//                             after it (a moving camera, whose blend needs the
+//                             neighbourhood); FINISH_RESTART, FINISH_STILL: the
 //                             temporal filter's blend too (render/Temporal.glsl), saving its
 //                             pass (on llvmpipe a pass over the image costs ~5 ms before it
 //                             does anything)
@@ -18,7 +19,7 @@
 //                             (Normals.glsl); 0: the mask is tested here and "surfaceDepth"
 //                             written
 #define FINISH_PICTURE 0
-#define FINISH_RADIANCE 1
+#define FINISH_RADIANCE_AND_DEPTH 1
 #define FINISH_RESTART 2
 #define FINISH_STILL 3
 #define FINISH_TEMPORAL (FINISH_OUTPUT >= FINISH_RESTART)
@@ -32,8 +33,8 @@
 #endif
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
-#if FINISH_OUTPUT == FINISH_RADIANCE
-layout(binding = SUBSCAN_IMAGE_OUT0, rgba16f) writeonly uniform image2D outRadiance;
+#if FINISH_OUTPUT == FINISH_RADIANCE_AND_DEPTH
+layout(binding = SUBSCAN_IMAGE_OUT0, rgba32f) writeonly uniform image2D outRadianceAndDepth;
 #else
 layout(binding = SUBSCAN_IMAGE_OUT0, rgba8) writeonly uniform image2D outImage;
 #endif
@@ -66,8 +67,8 @@ void main() {
 #if !FINISH_SEES_OUTLINE
     imageStore(outSurfaceDepth, pixel, vec4(depth));
 #endif
-#if FINISH_OUTPUT == FINISH_RADIANCE
-    imageStore(outRadiance, pixel, vec4(color, 1.0));
+#if FINISH_OUTPUT == FINISH_RADIANCE_AND_DEPTH
+    imageStore(outRadianceAndDepth, pixel, vec4(color, depth));
 #elif FINISH_OUTPUT == FINISH_PICTURE
     imageStore(outImage, pixel, vec4(linearToSrgb(color), 1.0));
 #else

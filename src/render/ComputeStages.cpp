@@ -9,13 +9,13 @@
 namespace subscan {
 
 ComputeStages::ComputeStages(const ShaderSources& sources, std::string_view path,
-                             const std::vector<std::string>& names) {
+                             const std::vector<std::string>& names, std::string_view defines) {
     for (const std::string& active : names) {
-        std::string defines;
+        std::string variant(defines);
         for (const std::string& name : names) {
-            defines += fmt::format("#define STAGE_{} {}\n", name, name == active ? 1 : 0);
+            variant += fmt::format("#define STAGE_{} {}\n", name, name == active ? 1 : 0);
         }
-        programs_.push_back(Program::compute(sources, path, defines));
+        programs_.push_back(Program::compute(sources, path, variant));
         hasLevelUniform_.push_back(glGetProgramResourceLocation(programs_.back().id(), GL_UNIFORM,
                                                                 "level") == SUBSCAN_UNIFORM_LEVEL);
         const bool origin =

@@ -18,11 +18,12 @@ struct TexelRegion {
 };
 
 /// The variants of one compute shader, one per STAGE_* macro: `names` {"COPY", "REDUCE"} build
-/// the shader once with STAGE_COPY 1 (others 0), once with STAGE_REDUCE 1, and so on.
+/// the shader once with STAGE_COPY 1 (others 0), once with STAGE_REDUCE 1, and so on, each
+/// after `defines` (lines of #define that all variants share).
 class ComputeStages {
   public:
     ComputeStages(const ShaderSources& sources, std::string_view path,
-                  const std::vector<std::string>& names);
+                  const std::vector<std::string>& names, std::string_view defines = {});
     const Program& operator[](std::size_t stage) const { return programs_[stage]; }
 
     /// Runs `stage` over a width x height grid of image-sized work groups, with the per-level

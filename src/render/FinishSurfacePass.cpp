@@ -16,7 +16,7 @@ namespace {
 
 // FINISH_OUTPUT in FinishSurface.comp.
 constexpr int kFinishPicture = 0;
-constexpr int kFinishRadiance = 1;
+constexpr int kFinishRadianceAndDepth = 1;
 constexpr int kFinishRestart = 2;  // then still: TemporalHistory::Mode in order
 
 }  // namespace
@@ -48,8 +48,8 @@ std::vector<std::string_view> FinishSurfacePass::outputs(const RenderSettings& s
         case Output::Picture:
             names = {"image"};
             break;
-        case Output::Radiance:
-            names = {"radiance"};
+        case Output::RadianceAndDepth:
+            names = {"radianceAndDepth"};
             break;
         case Output::Temporal:
             names = {"image", "history", "historyState"};
@@ -116,16 +116,21 @@ void FinishSurfacePass::execute(FrameContext& frame) {
         finishOutput = kFinishRestart + static_cast<int>(mode);
     } else {
         const bool picture = output_ == Output::Picture;
-        Texture& color = picture ? resources.ensureTexture("image", TextureFormat::RGBA8,
-                                                           frame.width(), frame.height())
-                                 : resources.ensureTexture("radiance", TextureFormat::RGBA16F,
-                                                           frame.width(), frame.height());
-        // Radiance off the surface is never read: surfaceDepth marks it.
-        if (picture && frame.restricted()) {
-            PresentPass::clearToBackground(frame, color);
+        Texture* color = nullptr;
+        if (picture) {
+            color = &resources.ensureTexture("image", TextureFormat::RGBA8, frame.width(),
+                                             frame.height());
+            if (frame.restricted()) {
+                PresentPass::clearToBackground(frame, *color);
+            }
+        } else {
+            // TemporalPass reads the pixels next to the region too: there they are background.
+            color = &frame.imageOverRegion(
+                "radianceAndDepth", TextureFormat::RGBA32F, 1,
+                glm::vec4(0.0f, 0.0f, 0.0f, std::numeric_limits<float>::infinity()));
         }
-        color.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
-        finishOutput = picture ? kFinishPicture : kFinishRadiance;
+        color->bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
+        finishOutput = picture ? kFinishPicture : kFinishRadianceAndDepth;
     }
     const Program& shader = program({shade.lightCount.x > 0, finishOutput, seesOutline});
     shader.use();

@@ -20,13 +20,14 @@ class TemporalHistory;
 /// the mask around each pixel, the mask comes from FillRemovalPass's "surfaceDepth" instead.
 /// Equals the chain up to its half-float rounding of colour, normals and radiance. With the
 /// temporal filter it also blends the frame into the history when the filter restarts or the
-/// camera rests (Output::Temporal: TemporalPass's work without its dispatch), or leaves the
-/// linear "radiance" for a TemporalPass after it (Output::Radiance: a moving camera's blend
-/// needs the neighbourhood, which here would take a work-group barrier that made the pass
-/// 14 ms slower on llvmpipe).
+/// camera rests (Output::Temporal: TemporalPass's work without its dispatch), or leaves
+/// "radianceAndDepth" for a TemporalPass after it (Output::RadianceAndDepth, RGBA32F: linear
+/// radiance, the depth in alpha, so that the pass loads each neighbour once; a moving camera's
+/// blend needs the neighbourhood, which here would take a work-group barrier that made the
+/// pass 14 ms slower on llvmpipe).
 class FinishSurfacePass final : public RenderPass {
   public:
-    enum class Output { Picture, Radiance, Temporal };
+    enum class Output { Picture, RadianceAndDepth, Temporal };
 
     /// `history` is the filter's memory, for Output::Temporal.
     FinishSurfacePass(const ShaderSources& sources, Output output,

@@ -97,13 +97,13 @@ void Renderer::appendShading(bool split, std::vector<RenderPass*>& passes) {
 }
 
 void Renderer::appendPresent(const RenderSettings& settings, int divisor, const std::string& color,
-                             std::vector<RenderPass*>& passes) {
+                             std::vector<RenderPass*>& passes, TemporalDepth depth) {
     if (!filtersTemporally(settings)) {
         passes.push_back(&present(color, "surfaceDepth"));
         return;
     }
     TemporalPass& temporal = lazyPass(temporal_, sources_, temporalHistory_);
-    temporal.setInput(color, divisor == 1);
+    temporal.setInput(color, depth, divisor == 1);
     passes.push_back(&temporal);
     if (divisor != 1) {
         passes.push_back(&present("history", ""));
@@ -133,9 +133,10 @@ std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, int
             // A moving camera's blend needs the neighbourhood: its own pass after this.
             if (temporalHistory_.modeFor(pipelineCamera_, settings, divisor) ==
                 TemporalHistory::Mode::Moving) {
-                passes.push_back(&lazyPass(finishSurfaceRadiance_, sources_,
-                                           FinishSurfacePass::Output::Radiance));
-                appendPresent(settings, divisor, "radiance", passes);
+                passes.push_back(&lazyPass(finishSurfaceRadianceAndDepth_, sources_,
+                                           FinishSurfacePass::Output::RadianceAndDepth));
+                appendPresent(settings, divisor, "radianceAndDepth", passes,
+                              TemporalDepth::ColorAlpha);
             } else {
                 passes.push_back(&lazyPass(finishSurfaceTemporal_, sources_,
                                            FinishSurfacePass::Output::Temporal, &temporalHistory_));

@@ -101,9 +101,11 @@ class Renderer {
     /// The scattering passes of the sss mode's final picture, by ScatteringSettings::method.
     void appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes);
     /// Present of the linear colour `color` (over the background where "surfaceDepth" is
-    /// +inf), through the temporal filter when the settings ask for it.
+    /// +inf), through the temporal filter when the settings ask for it, which finds the depth
+    /// where `depth` says (only the filter reads `color`'s alpha).
     void appendPresent(const RenderSettings& settings, int divisor, const std::string& color,
-                       std::vector<RenderPass*>& passes);
+                       std::vector<RenderPass*>& passes,
+                       TemporalDepth depth = TemporalDepth::SurfaceDepth);
     PresentPass& present(const std::string& color, const std::string& depth);
     FrameResources& resourcesFor(int divisor) {
         return divisor == 1 ? fullResources_ : reducedResources_;
@@ -130,8 +132,8 @@ class Renderer {
     LightMaps lightMaps_;
     std::unique_ptr<DrawPointsPass> drawPoints_;
     std::unique_ptr<FinishSurfacePass> finishSurface_;
-    std::unique_ptr<FinishSurfacePass> finishSurfaceRadiance_;  // before TemporalPass
-    std::unique_ptr<FinishSurfacePass> finishSurfaceTemporal_;  // with its blend at rest
+    std::unique_ptr<FinishSurfacePass> finishSurfaceRadianceAndDepth_;  // before TemporalPass
+    std::unique_ptr<FinishSurfacePass> finishSurfaceTemporal_;          // with its blend at rest
     TemporalHistory temporalHistory_;
     std::unique_ptr<TemporalPass> temporal_;
     std::unique_ptr<ShadePass> shade_;

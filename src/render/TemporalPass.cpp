@@ -165,10 +165,14 @@ void TemporalHistory::end(const FrameContext& frame, Mode mode) {
 }
 
 TemporalPass::TemporalPass(const ShaderSources& sources, TemporalHistory& history)
-    : history_(history),
-      stages_(
-          sources, "render/Temporal.comp",
-          {"RESTART", "STILL", "MOVING", "RESTART_PICTURE", "STILL_PICTURE", "MOVING_PICTURE"}) {}
+    : sources_(sources), history_(history) {}
+
+std::vector<std::string_view> TemporalPass::inputs(const RenderSettings&) const {
+    if (depth_ == TemporalDepth::ColorAlpha) {
+        return {colorInput_};
+    }
+    return {colorInput_, "surfaceDepth"};
+}
 
 std::vector<std::string_view> TemporalPass::outputs(const RenderSettings&) const {
     if (writesPicture_) {
@@ -177,12 +181,28 @@ std::vector<std::string_view> TemporalPass::outputs(const RenderSettings&) const
     return {"history", "historyState"};
 }
 
+const ComputeStages& TemporalPass::stages() {
+    const bool inAlpha = depth_ == TemporalDepth::ColorAlpha;
+    std::optional<ComputeStages>& stages = stages_[inAlpha ? 1 : 0];
+    if (!stages) {
+        stages.emplace(sources_, "render/Temporal.comp",
+                       std::vector<std::string>{"RESTART", "STILL", "MOVING", "RESTART_PICTURE",
+                                                "STILL_PICTURE", "MOVING_PICTURE"},
+                       inAlpha ? "#define TEMPORAL_DEPTH_IN_ALPHA 1\n"
+                               : "#define TEMPORAL_DEPTH_IN_ALPHA 0\n");
+    }
+    return *stages;
+}
+
 void TemporalPass::execute(FrameContext& frame) {
+    const ComputeStages& variants = stages();
     const TemporalHistory::Mode mode = history_.begin(frame, writesPicture_);
     frame.resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    frame.resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
-    stages_.runOverRegion(static_cast<std::size_t>(mode) + (writesPicture_ ? 3 : 0),
-                          frame.region(0));
+    if (depth_ == TemporalDepth::SurfaceDepth) {
+        frame.resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+    }
+    variants.runOverRegion(static_cast<std::size_t>(mode) + (writesPicture_ ? 3 : 0),
+                           frame.region(0));
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT);
     history_.end(frame, mode);

@@ -68,6 +68,12 @@ class TemporalHistory {
     unsigned frameIndex_ = 0;
 };
 
+/// Where TemporalPass finds the frame's depth.
+enum class TemporalDepth {
+    SurfaceDepth,  // the image "surfaceDepth"
+    ColorAlpha,    // the colour input's alpha (RGBA32F; FinishSurface's "radianceAndDepth")
+};
+
 /// The temporal filter as its own pass, after shading or scattering (the sss mode, reduced
 /// resolution, exports): blends the frame's linear colour into `history`. At full resolution
 /// it also encodes the picture "image" (Present's work, saving a full-screen pass); a reduced
@@ -77,25 +83,30 @@ class TemporalPass final : public RenderPass {
     TemporalPass(const ShaderSources& sources, TemporalHistory& history);
 
     std::string_view name() const override { return "Temporal"; }
-    std::vector<std::string_view> inputs(const RenderSettings&) const override {
-        return {colorInput_, "surfaceDepth"};
-    }
+    std::vector<std::string_view> inputs(const RenderSettings&) const override;
     std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
 
-    /// The radiance the frame's pipeline leaves ("radiance", "scatteredRadiance"), and whether
-    /// this pass encodes the picture (a full-resolution frame).
-    void setInput(std::string colorInput, bool writesPicture) {
+    /// The radiance the frame's pipeline leaves ("radiance", "scatteredRadiance",
+    /// "radianceAndDepth") and where its depth is, and whether this pass encodes the picture
+    /// (a full-resolution frame).
+    void setInput(std::string colorInput, TemporalDepth depth, bool writesPicture) {
         colorInput_ = std::move(colorInput);
+        depth_ = depth;
         writesPicture_ = writesPicture;
     }
 
   private:
+    const ComputeStages& stages();
+
+    const ShaderSources& sources_;
     TemporalHistory& history_;
     std::string colorInput_ = "radiance";
+    TemporalDepth depth_ = TemporalDepth::SurfaceDepth;
     bool writesPicture_ = true;
-    ComputeStages stages_;  // Temporal.comp's variants, by TemporalHistory::Mode, then the same
-                            // writing the picture
+    // Temporal.comp's variants by TemporalDepth, each compiled when first used: by
+    // TemporalHistory::Mode, then the same writing the picture.
+    std::optional<ComputeStages> stages_[2];
 };
 
 }  // namespace subscan

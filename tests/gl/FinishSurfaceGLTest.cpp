@@ -99,9 +99,27 @@ TEST(FinishSurfaceGLTest, CloseUpLooksAsPassByPass) {
     expectSamePicture(cloud, orbitCamera(cloud.bounds, close, 120, 90, 45.0), settings);
 }
 
-TEST(FinishSurfaceGLTest, TemporalFilterAtRestBlendsAsItsOwnPassDoes) {
+/// The pictures of the two renderers: equal up to the per-pass chain's half floats. Most bytes
+/// agree exactly; a wrong blend, depth or history would move most of them. Bytes more than one
+/// step apart may number `beyondOneStep`, none more than `steps` apart.
+void expectSameBlend(Renderer& fused, Renderer& perPass, int steps, std::size_t beyondOneStep) {
+    const std::vector<std::uint8_t> a = fused.readImage(), b = perPass.readImage();
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differences = 0, large = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const int difference = std::abs(int(a[i]) - int(b[i]));
+        ASSERT_LE(difference, steps) << "byte " << i;
+        differences += difference == 0 ? 0 : 1;
+        large += difference > 1 ? 1 : 0;
+    }
+    EXPECT_LT(differences, a.size() / 20);
+    EXPECT_LE(large, beyondOneStep);
+}
+
+TEST(FinishSurfaceGLTest, TemporalFilterBlendsAsItsOwnPassDoes) {
     // A still camera's 8 jittered frames: FinishSurface blends them itself (pictures only),
-    // pass by pass TemporalPass does; moving, both leave the blend to TemporalPass.
+    // pass by pass TemporalPass does. Moving, FinishSurface leaves the blend to TemporalPass,
+    // which then finds the depth in the radiance's alpha instead of in "surfaceDepth".
     const PointCloud cloud = makeSyntheticScene("sculpture?points=20000");
     const Camera camera = orbitCamera(cloud.bounds, {30.0, 20.0}, 161, 97, 45.0);
     RenderSettings settings;
@@ -116,21 +134,22 @@ TEST(FinishSurfaceGLTest, TemporalFilterAtRestBlendsAsItsOwnPassDoes) {
         EXPECT_TRUE(
             ranPass(perPass.render(camera, settings, FrameOutputs::Everything), "Temporal"));
     }
-    const std::vector<std::uint8_t> a = fused.readImage(), b = perPass.readImage();
-    ASSERT_EQ(a.size(), b.size());
-    std::size_t differences = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        const int difference = std::abs(int(a[i]) - int(b[i]));
-        // As above: the chain's half floats move a value near a rounding boundary by a step.
-        ASSERT_LE(difference, 1) << "byte " << i;
-        differences += difference == 0 ? 0 : 1;
-    }
-    EXPECT_LT(differences, a.size() / 20);
+    // As above: the chain's half floats move a value near a rounding boundary by a step.
+    expectSameBlend(fused, perPass, 1, 0);
     Camera moved = camera;
-    moved.view = glm::translate(camera.view, glm::dvec3(0.01, 0.0, 0.0));
-    const FrameResult moving = fused.render(moved, settings);
-    EXPECT_TRUE(ranPass(moving, "FinishSurface"));
-    EXPECT_TRUE(ranPass(moving, "Temporal"));
+    for (int frame = 1; frame <= 3; ++frame) {
+        SCOPED_TRACE(frame);
+        moved.view = glm::rotate(moved.view, glm::radians(1.0), glm::dvec3(0.0, 1.0, 0.0));
+        const FrameResult moving = fused.render(moved, settings);
+        EXPECT_TRUE(ranPass(moving, "FinishSurface"));
+        EXPECT_TRUE(ranPass(moving, "Temporal"));
+        perPass.render(moved, settings, FrameOutputs::Everything);
+        // Moving, the history is clipped to the neighbourhood's mean ± one standard deviation.
+        // Where the neighbourhood is nearly flat the deviation is of the order of the chain's
+        // rounding, so the clip can turn that rounding into a few steps: measured up to 4 in
+        // at most 5 of 62,468 bytes over these three frames.
+        expectSameBlend(fused, perPass, 6, 20);
+    }
 }
 
 TEST(FinishSurfaceGLTest, OnlyTheSurfaceModesFinalFullResolutionPictureIsFused) {

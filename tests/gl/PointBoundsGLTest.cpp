@@ -2,6 +2,7 @@
 // (SurfaceSettings::restrictToPoints). The bounds must hold every point, and a restricted frame
 // must equal the whole-frame computation bit for bit in every image that leaves the pipeline,
 // even when the images still hold an earlier frame.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -133,6 +134,33 @@ TEST(PointBoundsGLTest, AnEmptyFrameHasAnEmptyRegion) {
     MinDepthPyramidPass(harness.sources()).execute(frame);
     ASSERT_TRUE(frame.pointBounds.has_value());
     EXPECT_EQ(frame.region(0).size, glm::ivec2(0));
+}
+
+TEST(PointBoundsGLTest, AnImageReadOneTexelOffTheRegionIsClearedOnlyThere) {
+    // Points within [40, 100) x [30, 60): the region adds its margin. An image read one texel
+    // off the region has exactly that ring cleared, corners included; what lies further out
+    // keeps what it held (never read), and so does the region (the pass writes it).
+    PassHarness harness(kWidth, kHeight, boundsSettings(true), kSpacing);
+    FrameContext frame = harness.context();
+    frame.pointBounds = glm::ivec4(40, 30, 100, 60);
+    const TexelRegion region = frame.region(0);
+    ASSERT_GT(region.origin.x, 1);
+    ASSERT_LT(region.origin.x + region.size.x, kWidth - 1);
+    harness.resources()
+        .ensureTexture("ringed", TextureFormat::R32F, kWidth, kHeight)
+        .clear(glm::vec4(7.0f));
+    const std::vector<float> values =
+        frame.imageOverRegion("ringed", TextureFormat::R32F, 1, glm::vec4(-1.0f)).readFloats();
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const glm::ivec2 inside = glm::ivec2(x, y) - region.origin;
+            const glm::ivec2 beyond = inside - region.size + 1;
+            // Texels from the region's nearest texel, along the farther axis.
+            const int distance = std::max({-inside.x, -inside.y, beyond.x, beyond.y, 0});
+            EXPECT_EQ(values[y * kWidth + x], distance == 1 ? -1.0f : 7.0f)
+                << "at " << x << "," << y;
+        }
+    }
 }
 
 TEST(PointBoundsGLTest, RestrictedFrameEqualsTheWholeFrame) {

@@ -24,27 +24,40 @@ namespace {
 
 constexpr int kWidth = 48;
 constexpr int kHeight = 40;
+constexpr double kSpacing = 0.05;  // the point spacing the harness's frames assume
 
 /// A tilted plane in front of the harness's first camera.
 struct Plane {
     glm::dvec3 point{0.0, 0.0, -5.0};
     glm::dvec3 normal = glm::normalize(glm::dvec3(0.15, 0.1, 1.0));
 
-    /// Where the ray from the eye of `camera` through window position `window` meets the plane,
-    /// in world (= the harness's cloud) coordinates; the ray built from the camera's lens and
-    /// jitter as the definition of a pinhole, independent of the shaders' helpers.
-    glm::dvec3 hit(const Camera& camera, glm::dvec2 window) const {
-        const double f = camera.focalLengthPixels();
-        const glm::dvec2 shifted = window - camera.jitterPixels;
-        const glm::dvec3 direction((shifted.x - 0.5 * camera.width) / f,
-                                   (0.5 * camera.height - shifted.y) / f, -1.0);
-        const glm::dmat4 toWorld = glm::inverse(camera.view);
-        const glm::dvec3 eye(toWorld * glm::dvec4(0, 0, 0, 1));
-        const glm::dvec3 ray(toWorld * glm::dvec4(direction, 0.0));
-        const double t = glm::dot(point - eye, normal) / glm::dot(ray, normal);
-        return eye + t * ray;
-    }
+    /// Where the ray from the eye of `camera` through window position `window` (viewRay)
+    /// meets the plane, in world (= the harness's cloud) coordinates.
+    glm::dvec3 hit(const Camera& camera, glm::dvec2 window) const;
 };
+
+/// The direction, in view space, of the ray from the eye of `camera` through window position
+/// `window`, of length 1 along the view axis: built from the camera's lens and jitter as the
+/// definition of a pinhole, independent of the shaders' helpers.
+glm::dvec3 viewRay(const Camera& camera, glm::dvec2 window) {
+    const double f = camera.focalLengthPixels();
+    const glm::dvec2 shifted = window - camera.jitterPixels;
+    return {(shifted.x - 0.5 * camera.width) / f, (0.5 * camera.height - shifted.y) / f, -1.0};
+}
+
+glm::dvec3 Plane::hit(const Camera& camera, glm::dvec2 window) const {
+    const glm::dvec3 direction = viewRay(camera, window);
+    const glm::dmat4 toWorld = glm::inverse(camera.view);
+    const glm::dvec3 eye(toWorld * glm::dvec4(0, 0, 0, 1));
+    const glm::dvec3 ray(toWorld * glm::dvec4(direction, 0.0));
+    const double t = glm::dot(point - eye, normal) / glm::dot(ray, normal);
+    return eye + t * ray;
+}
+
+/// The world point `camera` sees at window position `window` and linear depth `depth`.
+glm::dvec3 worldAt(const Camera& camera, glm::dvec2 window, double depth) {
+    return glm::dvec3(glm::inverse(camera.view) * glm::dvec4(depth * viewRay(camera, window), 1.0));
+}
 
 double linearDepth(const Camera& camera, const glm::dvec3& world) {
     return -(camera.view * glm::dvec4(world, 1.0)).z;
@@ -86,11 +99,17 @@ Inputs planeInputs(const Camera& camera, const Plane& plane, Color colorOf, Hole
     return inputs;
 }
 
+/// TemporalPass alone, fed as the per-pass chain feeds it ("radiance" and "surfaceDepth") or
+/// as FinishSurface does ("radianceAndDepth").
 class TemporalHarness {
   public:
-    explicit TemporalHarness(const RenderSettings& settings, double spacing = 0.05)
-        : harness_(kWidth, kHeight, settings, spacing), pass_(harness_.sources(), history_) {
-        pass_.setInput("radiance", false);
+    explicit TemporalHarness(const RenderSettings& settings, double spacing = kSpacing,
+                             TemporalDepth depth = TemporalDepth::SurfaceDepth)
+        : harness_(kWidth, kHeight, settings, spacing),
+          pass_(harness_.sources(), history_),
+          depth_(depth) {
+        pass_.setInput(depth == TemporalDepth::ColorAlpha ? "radianceAndDepth" : "radiance", depth,
+                       false);
     }
 
     const Camera& camera() const { return harness_.camera(); }
@@ -100,10 +119,19 @@ class TemporalHarness {
                                                           const Inputs& inputs) {
         harness_.setCamera(camera);
         FrameResources& resources = harness_.resources();
-        resources.ensureTexture("radiance", TextureFormat::RGBA16F, kWidth, kHeight)
-            .uploadFloats(inputs.radiance);
-        resources.ensureTexture("surfaceDepth", TextureFormat::R32F, kWidth, kHeight)
-            .uploadFloats(inputs.depth);
+        if (depth_ == TemporalDepth::ColorAlpha) {
+            std::vector<float> packed = inputs.radiance;
+            for (std::size_t i = 0; i < inputs.depth.size(); ++i) {
+                packed[4 * i + 3] = inputs.depth[i];
+            }
+            resources.ensureTexture("radianceAndDepth", TextureFormat::RGBA32F, kWidth, kHeight)
+                .uploadFloats(packed);
+        } else {
+            resources.ensureTexture("radiance", TextureFormat::RGBA16F, kWidth, kHeight)
+                .uploadFloats(inputs.radiance);
+            resources.ensureTexture("surfaceDepth", TextureFormat::R32F, kWidth, kHeight)
+                .uploadFloats(inputs.depth);
+        }
         FrameContext frame = harness_.context();
         pass_.execute(frame);
         return {resources.texture("history").readFloats(),
@@ -114,7 +142,16 @@ class TemporalHarness {
     test::PassHarness harness_;
     TemporalHistory history_;
     TemporalPass pass_;
+    TemporalDepth depth_;
 };
+
+// The two ways the filter gets the frame's depth: each test of the pass alone runs both.
+const TemporalDepth kDepthSources[] = {TemporalDepth::SurfaceDepth, TemporalDepth::ColorAlpha};
+
+const char* describe(TemporalDepth depth) {
+    return depth == TemporalDepth::SurfaceDepth ? "depth from surfaceDepth"
+                                                : "depth in the colour's alpha";
+}
 
 /// Four colours by the parities of x and y: a neighbourhood whose luma and both chromas spread
 /// over most of 0..1, so that clipping to it (with a wide sigma) keeps any history of 0..1.
@@ -147,116 +184,132 @@ TEST(TemporalGLTest, ReprojectsTheHistoryLikeTheCpuReference) {
     // Clipping far outside the new frame's spread: this test is about where the history comes
     // from, not about how it is clipped.
     settings.temporal.clipSigma = 100.0f;
-    TemporalHarness harness(settings);
-    const Plane plane;
-    Camera first = harness.camera();
-    first.jitterPixels = {-0.2, 0.35};
-    const Camera second = movedCamera(first);
-    auto none = [](int, int) { return false; };
+    for (const TemporalDepth depth : kDepthSources) {
+        SCOPED_TRACE(describe(depth));
+        TemporalHarness harness(settings, kSpacing, depth);
+        const Plane plane;
+        Camera first = harness.camera();
+        first.jitterPixels = {-0.2, 0.35};
+        const Camera second = movedCamera(first);
+        auto none = [](int, int) { return false; };
 
-    const auto [history1, state1] = harness.run(
-        first, planeInputs(
-                   first, plane, [](glm::dvec3 w, int, int) { return pattern(w); }, none));
-    const Inputs secondInputs = planeInputs(second, plane, checker, none);
-    const auto [history2, state2] = harness.run(second, secondInputs);
+        const auto [history1, state1] = harness.run(
+            first, planeInputs(
+                       first, plane, [](glm::dvec3 w, int, int) { return pattern(w); }, none));
+        // Bumps: a fifth of the pixels lie 40 % nearer, so which neighbour is nearest decides
+        // where the history comes from. No tap is dropped: a tap is kept within 4 spacings
+        // plus the neighbourhood's depth range of the depth it kept, and the range spans the
+        // bump.
+        Inputs secondInputs = planeInputs(second, plane, checker, none);
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                if ((7 * x + 13 * y) % 5 == 0) {
+                    secondInputs.depth[y * kWidth + x] *= 0.6f;
+                }
+            }
+        }
+        const auto [history2, state2] = harness.run(second, secondInputs);
 
-    int compared = 0, reprojected = 0;
-    for (int y = 0; y < kHeight; ++y) {
-        for (int x = 0; x < kWidth; ++x) {
-            // The neighbour with the nearest depth stands for the pixel's motion (first of
-            // equals in row order, borders clamped), as in the shader.
-            glm::ivec2 nearest(x, y);
-            float nearestDepth = INFINITY;
-            for (int dy = -1; dy <= 1; ++dy) {
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const glm::ivec2 t = glm::clamp(glm::ivec2(x + dx, y + dy), glm::ivec2(0),
-                                                    glm::ivec2(kWidth - 1, kHeight - 1));
+        int compared = 0, reprojected = 0;
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth; ++x) {
+                // The neighbour with the nearest depth stands for the pixel's motion (first of
+                // equals in row order, borders clamped), as in the shader.
+                glm::ivec2 nearest(x, y);
+                float nearestDepth = INFINITY;
+                for (int i = 0; i < 9; ++i) {
+                    const glm::ivec2 t =
+                        glm::clamp(glm::ivec2(x + i % 3 - 1, y + i / 3 - 1), glm::ivec2(0),
+                                   glm::ivec2(kWidth - 1, kHeight - 1));
                     const float d = secondInputs.depth[t.y * kWidth + t.x];
                     if (d < nearestDepth) {
                         nearestDepth = d;
                         nearest = t;
                     }
                 }
-            }
-            const glm::dvec3 world = plane.hit(second, glm::dvec2(nearest) + 0.5);
-            const glm::dvec2 velocity =
-                windowOf(first, world) - (glm::dvec2(nearest) + 0.5 - second.jitterPixels);
-            const glm::dvec2 source = glm::dvec2(x, y) + velocity;
-            const glm::ivec2 base(glm::floor(source));
-            const glm::dvec2 t = source - glm::dvec2(base);
-            glm::dvec4 sum(0.0);
-            double weights = 0.0;
-            for (int tap = 0; tap < 4; ++tap) {
-                const glm::ivec2 texel = base + glm::ivec2(tap & 1, tap >> 1);
-                if (texel.x < 0 || texel.y < 0 || texel.x >= kWidth || texel.y >= kHeight) {
-                    continue;
+                const glm::dvec3 world = worldAt(second, glm::dvec2(nearest) + 0.5, nearestDepth);
+                const glm::dvec2 velocity =
+                    windowOf(first, world) - (glm::dvec2(nearest) + 0.5 - second.jitterPixels);
+                const glm::dvec2 source = glm::dvec2(x, y) + velocity;
+                const glm::ivec2 base(glm::floor(source));
+                const glm::dvec2 t = source - glm::dvec2(base);
+                glm::dvec4 sum(0.0);
+                double weights = 0.0;
+                for (int tap = 0; tap < 4; ++tap) {
+                    const glm::ivec2 texel = base + glm::ivec2(tap & 1, tap >> 1);
+                    if (texel.x < 0 || texel.y < 0 || texel.x >= kWidth || texel.y >= kHeight) {
+                        continue;
+                    }
+                    const std::size_t i = 4 * static_cast<std::size_t>(texel.y * kWidth + texel.x);
+                    const double w = ((tap & 1) ? t.x : 1.0 - t.x) * ((tap >> 1) ? t.y : 1.0 - t.y);
+                    sum += w * glm::dvec4(history1[i], history1[i + 1], history1[i + 2],
+                                          history1[i + 3]);
+                    weights += w;
                 }
-                const double w = ((tap & 1) ? t.x : 1.0 - t.x) * ((tap >> 1) ? t.y : 1.0 - t.y);
-                const std::size_t i = 4 * static_cast<std::size_t>(texel.y * kWidth + texel.x);
-                sum +=
-                    w * glm::dvec4(history1[i], history1[i + 1], history1[i + 2], history1[i + 3]);
-                weights += w;
+                const std::size_t i = 4 * static_cast<std::size_t>(y * kWidth + x);
+                const glm::dvec4 current(secondInputs.radiance[i], secondInputs.radiance[i + 1],
+                                         secondInputs.radiance[i + 2], 1.0);
+                // Each history holds one frame: the new one weighs 1/2.
+                const glm::dvec4 expected =
+                    weights > 0.1 ? 0.5 * (sum / weights) + 0.5 * current : current;
+                reprojected += weights > 0.1 ? 1 : 0;
+                for (int c = 0; c < 4; ++c) {
+                    // Half-float storage of the result: 2^-11 relative, and the pattern is <= 1.
+                    EXPECT_NEAR(history2[i + c], expected[c], 2e-3)
+                        << "pixel " << x << "," << y << " channel " << c;
+                }
+                ++compared;
             }
-            const std::size_t i = 4 * static_cast<std::size_t>(y * kWidth + x);
-            const glm::dvec4 current(secondInputs.radiance[i], secondInputs.radiance[i + 1],
-                                     secondInputs.radiance[i + 2], 1.0);
-            // Each history holds one frame: the new one weighs 1/2.
-            const glm::dvec4 expected =
-                weights > 0.1 ? 0.5 * (sum / weights) + 0.5 * current : current;
-            reprojected += weights > 0.1 ? 1 : 0;
-            for (int c = 0; c < 4; ++c) {
-                // Half-float storage of the result: 2^-11 relative, and the pattern is <= 1.
-                EXPECT_NEAR(history2[i + c], expected[c], 2e-3)
-                    << "pixel " << x << "," << y << " channel " << c;
-            }
-            ++compared;
         }
+        EXPECT_EQ(compared, kWidth * kHeight);
+        EXPECT_GT(reprojected, compared * 3 / 4) << "the move should keep most of the view";
+        EXPECT_LT(reprojected, compared) << "the move should uncover a border";
     }
-    EXPECT_EQ(compared, kWidth * kHeight);
-    EXPECT_GT(reprojected, compared * 3 / 4) << "the move should keep most of the view";
-    EXPECT_LT(reprojected, compared) << "the move should uncover a border";
 }
 
 TEST(TemporalGLTest, DropsHistoryThatSawAnotherSurface) {
     RenderSettings settings;
     settings.temporal.enabled = true;
     settings.temporal.clipSigma = 100.0f;  // as above: only disocclusion may drop the history
-    TemporalHarness harness(settings);
-    const Plane plane;
-    const Camera first = harness.camera();
-    const Camera second = movedCamera(first);
-    // The first frame has an object in front (1 m nearer) over the left half; the second sees
-    // the plane everywhere, so the left half's history belongs to another surface.
-    Inputs occluded = planeInputs(
-        first, plane, [](glm::dvec3, int, int) { return glm::vec3(1.0f, 0.0f, 0.0f); },
-        [](int, int) { return false; });
-    for (int y = 0; y < kHeight; ++y) {
-        for (int x = 0; x < kWidth / 2; ++x) {
-            occluded.depth[y * kWidth + x] -= 1.0f;
-        }
-    }
-    harness.run(first, occluded);
-    const Inputs plain = planeInputs(second, plane, checker, [](int, int) { return false; });
-    const auto [history, state] = harness.run(second, plain);
-    int blended = 0;
-    for (int y = 4; y < kHeight - 4; ++y) {
-        for (int x = 4; x < kWidth - 4; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y * kWidth + x);
-            const float red = plain.radiance[4 * i];
-            if (x < kWidth / 2 - 8) {
-                // Well inside the left half (the move shifts it by a few pixels): the frame
-                // alone, none of the occluder's red.
-                EXPECT_EQ(history[4 * i], red) << "at " << x << "," << y;
-                EXPECT_EQ(state[2 * i + 1], 1.0f) << "frames at " << x << "," << y;
-            } else if (x > kWidth / 2 + 8) {
-                // The same surface: the occluder-free history (red 1) blended in at 1/2.
-                EXPECT_NEAR(history[4 * i], 0.5f * (1.0f + red), 1e-3)  // half floats
-                    << "at " << x << "," << y;
-                ++blended;
+    for (const TemporalDepth depth : kDepthSources) {
+        SCOPED_TRACE(describe(depth));
+        TemporalHarness harness(settings, kSpacing, depth);
+        const Plane plane;
+        const Camera first = harness.camera();
+        const Camera second = movedCamera(first);
+        // The first frame has an object in front (1 m nearer) over the left half; the second sees
+        // the plane everywhere, so the left half's history belongs to another surface.
+        Inputs occluded = planeInputs(
+            first, plane, [](glm::dvec3, int, int) { return glm::vec3(1.0f, 0.0f, 0.0f); },
+            [](int, int) { return false; });
+        for (int y = 0; y < kHeight; ++y) {
+            for (int x = 0; x < kWidth / 2; ++x) {
+                occluded.depth[y * kWidth + x] -= 1.0f;
             }
         }
+        harness.run(first, occluded);
+        const Inputs plain = planeInputs(second, plane, checker, [](int, int) { return false; });
+        const auto [history, state] = harness.run(second, plain);
+        int blended = 0;
+        for (int y = 4; y < kHeight - 4; ++y) {
+            for (int x = 4; x < kWidth - 4; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y * kWidth + x);
+                const float red = plain.radiance[4 * i];
+                if (x < kWidth / 2 - 8) {
+                    // Well inside the left half (the move shifts it by a few pixels): the frame
+                    // alone, none of the occluder's red.
+                    EXPECT_EQ(history[4 * i], red) << "at " << x << "," << y;
+                    EXPECT_EQ(state[2 * i + 1], 1.0f) << "frames at " << x << "," << y;
+                } else if (x > kWidth / 2 + 8) {
+                    // The same surface: the occluder-free history (red 1) blended in at 1/2.
+                    EXPECT_NEAR(history[4 * i], 0.5f * (1.0f + red), 1e-3)  // half floats
+                        << "at " << x << "," << y;
+                    ++blended;
+                }
+            }
+        }
+        EXPECT_GT(blended, 0);
     }
-    EXPECT_GT(blended, 0);
 }
 
 TEST(TemporalGLTest, ClipsTheHistoryToTheNewFramesNeighbourhood) {
@@ -265,20 +318,23 @@ TEST(TemporalGLTest, ClipsTheHistoryToTheNewFramesNeighbourhood) {
     // ghost of a surface that has left.
     RenderSettings settings;
     settings.temporal.enabled = true;
-    TemporalHarness harness(settings);
-    const Plane plane;
-    const Camera first = harness.camera();
-    auto none = [](int, int) { return false; };
-    harness.run(first,
-                planeInputs(
-                    first, plane, [](glm::dvec3, int, int) { return glm::vec3(1, 0, 0); }, none));
-    const auto [history, state] = harness.run(
-        movedCamera(first), planeInputs(
-                                movedCamera(first), plane,
-                                [](glm::dvec3, int, int) { return glm::vec3(0, 0, 1); }, none));
-    for (std::size_t i = 0; i < history.size(); i += 4) {
-        EXPECT_NEAR(history[i], 0.0f, 1e-3) << "texel " << i / 4;  // half-float rounding
-        EXPECT_NEAR(history[i + 2], 1.0f, 1e-3) << "texel " << i / 4;
+    for (const TemporalDepth depth : kDepthSources) {
+        SCOPED_TRACE(describe(depth));
+        TemporalHarness harness(settings, kSpacing, depth);
+        const Plane plane;
+        const Camera first = harness.camera();
+        auto none = [](int, int) { return false; };
+        harness.run(first, planeInputs(
+                               first, plane,
+                               [](glm::dvec3, int, int) { return glm::vec3(1, 0, 0); }, none));
+        const auto [history, state] = harness.run(
+            movedCamera(first), planeInputs(
+                                    movedCamera(first), plane,
+                                    [](glm::dvec3, int, int) { return glm::vec3(0, 0, 1); }, none));
+        for (std::size_t i = 0; i < history.size(); i += 4) {
+            EXPECT_NEAR(history[i], 0.0f, 1e-3) << "texel " << i / 4;  // half-float rounding
+            EXPECT_NEAR(history[i + 2], 1.0f, 1e-3) << "texel " << i / 4;
+        }
     }
 }
 
@@ -286,35 +342,39 @@ TEST(TemporalGLTest, StillCameraAveragesEvenlyAndBackgroundCountsAsUncovered) {
     RenderSettings settings;
     settings.temporal.enabled = true;
     settings.temporal.maxFrames = 4;
-    TemporalHarness harness(settings);
-    const Plane plane;
-    const Camera camera = harness.camera();
-    // Frames 1..6 show 0.1 k; the left column is background in odd frames. With a still
-    // camera the mean is even over the last frames up to 4, then slides by 1/4.
-    std::vector<float> history;
-    double expected = 0.0, coverage = 0.0, left = 0.0;
-    const double background = srgbToLinear(settings.raster.backgroundSrgb.r);
-    for (int k = 1; k <= 6; ++k) {
-        Camera jittered = camera;
-        jittered.jitterPixels = haltonJitter(static_cast<unsigned>(k));
-        const float value = 0.1f * static_cast<float>(k);
-        const bool hole = k % 2 == 1;
-        history = harness
-                      .run(jittered, planeInputs(
-                                         jittered, plane,
-                                         [&](glm::dvec3, int, int) { return glm::vec3(value); },
-                                         [&](int x, int) { return hole && x == 0; }))
-                      .first;
-        const double weight = 1.0 / std::min(k, 4);
-        expected += weight * (value - expected);
-        left += weight * ((hole ? background : value) - left);
-        coverage += weight * ((hole ? 0.0 : 1.0) - coverage);
-        const std::size_t middle = 4 * static_cast<std::size_t>(kHeight / 2 * kWidth + kWidth / 2);
-        const std::size_t edge = 4 * static_cast<std::size_t>(kHeight / 2 * kWidth);
-        // Half floats: 2^-11 relative on values below 1.
-        EXPECT_NEAR(history[middle], expected, 1e-3) << "frame " << k;
-        EXPECT_NEAR(history[edge], left, 1e-3) << "frame " << k;
-        EXPECT_NEAR(history[edge + 3], coverage, 1e-3) << "frame " << k;
+    for (const TemporalDepth depth : kDepthSources) {
+        SCOPED_TRACE(describe(depth));
+        TemporalHarness harness(settings, kSpacing, depth);
+        const Plane plane;
+        const Camera camera = harness.camera();
+        // Frames 1..6 show 0.1 k; the left column is background in odd frames. With a still
+        // camera the mean is even over the last frames up to 4, then slides by 1/4.
+        std::vector<float> history;
+        double expected = 0.0, coverage = 0.0, left = 0.0;
+        const double background = srgbToLinear(settings.raster.backgroundSrgb.r);
+        for (int k = 1; k <= 6; ++k) {
+            Camera jittered = camera;
+            jittered.jitterPixels = haltonJitter(static_cast<unsigned>(k));
+            const float value = 0.1f * static_cast<float>(k);
+            const bool hole = k % 2 == 1;
+            history = harness
+                          .run(jittered, planeInputs(
+                                             jittered, plane,
+                                             [&](glm::dvec3, int, int) { return glm::vec3(value); },
+                                             [&](int x, int) { return hole && x == 0; }))
+                          .first;
+            const double weight = 1.0 / std::min(k, 4);
+            expected += weight * (value - expected);
+            left += weight * ((hole ? background : value) - left);
+            coverage += weight * ((hole ? 0.0 : 1.0) - coverage);
+            const std::size_t middle =
+                4 * static_cast<std::size_t>(kHeight / 2 * kWidth + kWidth / 2);
+            const std::size_t edge = 4 * static_cast<std::size_t>(kHeight / 2 * kWidth);
+            // Half floats: 2^-11 relative on values below 1.
+            EXPECT_NEAR(history[middle], expected, 1e-3) << "frame " << k;
+            EXPECT_NEAR(history[edge], left, 1e-3) << "frame " << k;
+            EXPECT_NEAR(history[edge + 3], coverage, 1e-3) << "frame " << k;
+        }
     }
 }
 
