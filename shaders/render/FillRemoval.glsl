@@ -105,7 +105,13 @@ bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
     if (!(depth > 0.0 && !isinf(depth) && !isnan(depth))) {
         return false;
     }
-    if (pullWeightAt(texelIndex(0u, pixel)) > 0.0) {
+    // A pixel whose points the hidden-point test all removed still shows a surface: its
+    // points' own where the test erred (beside a near surface's edge it hides a band of the
+    // far one, wider than the fill closes), else the one in front of them. So its cells place
+    // the outline as a visible point's do (the cells are known only with the sub-pixel rule).
+    bool holdsPoints = pullWeightAt(texelIndex(0u, pixel)) > 0.0 ||
+                       (surface.fill.w != 0.0 && occupiedCells(pixel) > 0u);
+    if (holdsPoints) {
         return surface.fill.w == 0.0 || !centreBeyondOutline(pixel, depth, spacingRatio);
     }
     return fillsGap(pixel, depth, spacingRatio);

@@ -553,7 +553,8 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     // except in the last two columns of the rows whose outline points are visible (14-20),
     // where the rule's limits are set: one cell at the outline beside 2 (row 14: too sparse
     // for the rule) or 3 (rows 15 and 16: the sparsest it acts on), and from row 18 on 5 beside
-    // 8 (exactly 5/8: background).
+    // 8 (exactly 5/8: background). Beyond the visible outline, rows 2-9 of columns 28-30 hold
+    // only hidden points (cells, no visible point): the rule places the outline there too.
     RenderSettings settings = makeHarness().settings();
     settings.raster.mode = RenderMode::Surface;
     PassHarness harness(kWidth, kHeight, settings, kSpacing, 50.0, GetParam());
@@ -574,7 +575,9 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     for (int i = 0; i < kWidth * kHeight; ++i) {
         // Near the outline two in three pixels partly covered, elsewhere one in three.
         const bool partly = random() % 3 < (i % kWidth >= 24 ? 2u : 1u);
-        if (!std::isfinite(depth[i])) {
+        const bool hiddenOnly =
+            i % kWidth >= 28 && i % kWidth < 31 && i / kWidth >= 2 && i / kWidth < 10;
+        if (!std::isfinite(depth[i]) && !hiddenOnly) {
             continue;
         }
         cells[i] = partly ? static_cast<std::uint32_t>(random() % 0xFFFF) + 1u : 0xFFFFu;
@@ -597,12 +600,13 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const auto cellsAt = [&](int x, int y) { return std::popcount(cells[y * kWidth + x]); };
     const auto inside = [](int x, int y) { return x >= 0 && y >= 0 && x < kWidth && y < kHeight; };
-    int ties = 0, beyond = 0, besideFilledGap = 0, kept = 0;
+    int ties = 0, beyond = 0, besideFilledGap = 0, kept = 0, hiddenKept = 0;
     int tooSparse = 0, sparsestActed = 0, exactlyFiveEighths = 0;  // the limits' rows
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
-            if (!(weights[i] > 0.0f)) {
+            const bool hiddenOnly = !(weights[i] > 0.0f) && cellsAt(x, y) > 0;
+            if (!(weights[i] > 0.0f) && !hiddenOnly) {
                 continue;  // the gap rule, tested above
             }
             int densest = cellsAt(x, y);
@@ -643,6 +647,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
                 exactlyFiveEighths += outside && 8 * cellsAt(x, y) == 5 * densest ? 1 : 0;
             }
             EXPECT_EQ(mask[i] > 0.5f, !outside) << x << "," << y;
+            hiddenKept += hiddenOnly && !outside ? 1 : 0;
         }
     }
     // A tie (a fill level this close to an integer) is rare: a few in this frame would mean
@@ -657,6 +662,9 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     EXPECT_GE(tooSparse, 1);           // row 14
     EXPECT_GE(sparsestActed, 2);       // rows 15 and 16
     EXPECT_GE(exactlyFiveEighths, 3);  // rows 18-20
+    // Most of the hidden points' pixels are surface: without them, the gap rule would find
+    // too few directions enclosed this far out.
+    EXPECT_GT(hiddenKept, 10);
 }
 
 // The outline's sub-pixel cells pass from the raster to the mask in the "occupancy" buffer:
