@@ -1,8 +1,7 @@
 #version 450
 // Fill removal: pull-push also fills the background around the object. A pixel belongs to the
 // surface when it holds a visible point (unless it lies beyond a dense cloud's outline:
-// FillRemoval.glsl's centreBeyondOutline; with that rule, hidden points count too), or when
-// visible points surround it: in (by default)
+// FillRemoval.glsl's centreBeyondOutline), or when visible points surround it: in (by default)
 // all 8 directions, some level up to the expected-gap level L(x) (at least 1) finds pull weight
 // in the neighbouring texel. This replaces the paper's threshold on the pull weight at L(x),
 // which spreads the mask past the silhouette by about a texel of L(x) (the coarse weight is

@@ -7,24 +7,10 @@ layout(binding = SUBSCAN_TEXELS_FILL_REACH) uniform usamplerBuffer fillReachTexe
 
 const uint kNoReach = 15u;
 
-// Which of each pixel's 4x4 sub-cells hold a point, hidden ones too (bound with the sub-pixel
-// outline, surface.fill.w).
-layout(std430, binding = SUBSCAN_SSBO_OCCUPANCY) readonly buffer Occupancy {
-    uint occupancy[];
-};
-
-/// How many of the 4x4 sub-cells of `pixel` hold a point (hidden ones too).
-uint occupiedCells(ivec2 pixel) {
-    return uint(bitCount(occupancy[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)]));
-}
-
 /// Beyond the image counts as weighted: a surface that reaches the image's border goes on past
 /// it, and would otherwise lose its outermost pixels (a frame of background around close-ups).
-/// So does a pixel of hidden points only, which onSurface keeps: the pixels of a band the
-/// hidden-point test eroded that hold no point are enclosed by it.
 bool weighted(uint onLevel, ivec2 texel) {
-    return !insideLevel(onLevel, texel) || pullWeightAt(texelIndex(onLevel, texel)) > 0.0 ||
-           (onLevel == 0u && surface.fill.w != 0.0 && occupiedCells(texel) > 0u);
+    return !insideLevel(onLevel, texel) || pullWeightAt(texelIndex(onLevel, texel)) > 0.0;
 }
 
 /// Per direction, `onLevel` where the neighbour of `texel` on that level has weight, else the
@@ -41,6 +27,10 @@ uint reachOf(uint onLevel, ivec2 texel) {
     }
     return reach;
 }
+
+layout(std430, binding = SUBSCAN_SSBO_OCCUPANCY) readonly buffer Occupancy {
+    uint occupancy[];
+};
 
 /// Whether the pixel `pixel` without a visible point of its own, at depth `depth`, lies in a
 /// gap the fill closes: enough directions find points within the expected gap.
@@ -59,8 +49,13 @@ bool fillsGap(ivec2 pixel, float depth, float spacingRatio) {
     return float(enclosed) >= surface.fill.y;
 }
 
-/// Whether `pixel`, holding a point, lies on the outline of the cloud with its centre outside
-/// it. A straight outline leaves more than half of a pixel inside exactly when
+/// How many of the 4x4 sub-cells of `pixel` hold a point (hidden ones too).
+uint occupiedCells(ivec2 pixel) {
+    return uint(bitCount(occupancy[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)]));
+}
+
+/// Whether `pixel`, holding a visible point, lies on the outline of the cloud with its centre
+/// outside it. A straight outline leaves more than half of a pixel inside exactly when
 /// it passes the centre; the points' cells show that area plus the cells the outline cuts,
 /// half a column of them on average (1/8 of a pixel): so the centre lies outside when at most
 /// 1/2 + 1/8 of the densest neighbour's cells hold points. Only beside a pixel without any

@@ -473,8 +473,7 @@ double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, 
 /// nullopt for a tie (float vs double: an unclamped level this close to an integer may round
 /// up either way).
 std::optional<bool> cpuFillsGap(const PassHarness& harness, const std::vector<float>& weights,
-                                int x, int y, double depth, double ratio,
-                                const std::vector<std::uint32_t>* cells = nullptr) {
+                                int x, int y, double depth, double ratio) {
     const auto all = levels();
     const SurfaceSettings& surface = harness.settings().surface;
     const double raw = std::log2(surface.fillRadius * kSpacing * ratio * harness.focal() / depth);
@@ -491,11 +490,9 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const std::vector<fl
         for (int l = 0; l <= maxLevel && !found; ++l) {
             const Level& lv = all[l];
             const int qx = (x >> l) + direction[0], qy = (y >> l) + direction[1];
-            // Beyond the image counts as found: the surface goes on past it. With the sub-pixel
-            // outline's `cells`, so does a pixel holding hidden points only.
+            // Beyond the image counts as found: the surface goes on past it.
             found = qx < 0 || qy < 0 || qx >= lv.width || qy >= lv.height ||
-                    weights[lv.offset + qy * lv.width + qx] > 0.0f ||
-                    (l == 0 && cells && (*cells)[qy * lv.width + qx] != 0u);
+                    weights[lv.offset + qy * lv.width + qx] > 0.0f;
         }
         enclosed += found;
     }
@@ -632,7 +629,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
                     // The neighbour's gap judged at this pixel's depth and spacing ratio.
                     const std::optional<bool> gap =
                         cpuFillsGap(harness, weights, x + dx, y + dy, filled[i],
-                                    cpuSpacingRatio(pulled, GetParam(), x, y), &cells);
+                                    cpuSpacingRatio(pulled, GetParam(), x, y));
                     tie = tie || !gap;
                     outside = outside || (gap && !*gap);
                 }
