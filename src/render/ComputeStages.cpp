@@ -1,5 +1,7 @@
 #include "render/ComputeStages.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "core/Error.h"
@@ -7,6 +9,25 @@
 #include "shared/bindings.h"
 
 namespace subscan {
+
+std::vector<TexelRegion> texelsOutside(const TexelRegion& old, const TexelRegion& current) {
+    const glm::ivec2 oldEnd = old.origin + old.size, end = current.origin + current.size;
+    std::vector<TexelRegion> parts;
+    auto add = [&](glm::ivec2 from, glm::ivec2 to) {
+        if (to.x > from.x && to.y > from.y) {
+            parts.push_back({from, to - from});
+        }
+    };
+    const int top = std::min(oldEnd.y, current.origin.y);
+    const int bottom = std::max(old.origin.y, end.y);
+    add(old.origin, {oldEnd.x, top});
+    add({old.origin.x, bottom}, oldEnd);
+    const int bandTop = std::max(old.origin.y, current.origin.y);
+    const int bandBottom = std::min(oldEnd.y, end.y);
+    add({old.origin.x, bandTop}, {std::min(oldEnd.x, current.origin.x), bandBottom});
+    add({std::max(old.origin.x, end.x), bandTop}, {oldEnd.x, bandBottom});
+    return parts;
+}
 
 ComputeStages::ComputeStages(const ShaderSources& sources, std::string_view path,
                              const std::vector<std::string>& names, std::string_view defines) {

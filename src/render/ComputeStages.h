@@ -17,6 +17,9 @@ struct TexelRegion {
     glm::ivec2 size{0};
 };
 
+/// The texels of `old` outside `current`: up to four rectangles (above, below, left, right).
+std::vector<TexelRegion> texelsOutside(const TexelRegion& old, const TexelRegion& current);
+
 /// The variants of one compute shader, one per STAGE_* macro: `names` {"COPY", "REDUCE"} build
 /// the shader once with STAGE_COPY 1 (others 0), once with STAGE_REDUCE 1, and so on, each
 /// after `defines` (lines of #define that all variants share).

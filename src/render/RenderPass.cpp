@@ -45,19 +45,10 @@ Texture& FrameContext::imageOverRegion(std::string_view name, TextureFormat form
     if (restricted()) {
         const TexelRegion inner = region(0);
         const glm::ivec2 from = glm::max(inner.origin - ring, glm::ivec2(0));
-        const glm::ivec2 innerEnd = inner.origin + inner.size;
-        const glm::ivec2 to = glm::min(innerEnd + ring, glm::ivec2(width(), height()));
-        // Above and below the region across the ring's width, then left and right of it.
-        const TexelRegion parts[] = {
-            {from, {to.x - from.x, inner.origin.y - from.y}},
-            {{from.x, innerEnd.y}, {to.x - from.x, to.y - innerEnd.y}},
-            {{from.x, inner.origin.y}, {inner.origin.x - from.x, inner.size.y}},
-            {{innerEnd.x, inner.origin.y}, {to.x - innerEnd.x, inner.size.y}},
-        };
-        for (const TexelRegion& part : parts) {
-            if (part.size.x > 0 && part.size.y > 0) {
-                clear(image, part, outside);
-            }
+        const glm::ivec2 to =
+            glm::min(inner.origin + inner.size + ring, glm::ivec2(width(), height()));
+        for (const TexelRegion& part : texelsOutside({from, to - from}, inner)) {
+            clear(image, part, outside);
         }
     }
     return image;

@@ -37,26 +37,6 @@ bool sameView(const Camera& a, const Camera& b) {
            a.principalOffsetPixels == b.principalOffsetPixels;
 }
 
-/// The texels of `old` outside `current`: up to four rectangles (above, below, left, right).
-std::vector<TexelRegion> outside(const TexelRegion& old, const TexelRegion& current) {
-    const glm::ivec2 oldEnd = old.origin + old.size, end = current.origin + current.size;
-    std::vector<TexelRegion> parts;
-    auto add = [&](glm::ivec2 from, glm::ivec2 to) {
-        if (to.x > from.x && to.y > from.y) {
-            parts.push_back({from, to - from});
-        }
-    };
-    const int top = std::min(oldEnd.y, current.origin.y);
-    const int bottom = std::max(old.origin.y, end.y);
-    add(old.origin, {oldEnd.x, top});
-    add({old.origin.x, bottom}, oldEnd);
-    const int bandTop = std::max(old.origin.y, current.origin.y);
-    const int bandBottom = std::min(oldEnd.y, end.y);
-    add({old.origin.x, bandTop}, {std::min(oldEnd.x, current.origin.x), bandBottom});
-    add({std::max(old.origin.x, end.x), bandTop}, {oldEnd.x, bandBottom});
-    return parts;
-}
-
 Camera withoutJitter(const Camera& camera) {
     Camera plain = camera;
     plain.jitterPixels = glm::dvec2(0.0);
@@ -137,7 +117,7 @@ TemporalHistory::Mode TemporalHistory::begin(FrameContext& frame, bool picture) 
                                           srgbToLinear(background.b), 0.0f);
         const glm::vec4 backgroundState(std::numeric_limits<float>::infinity(), 1.0f, 0.0f, 0.0f);
         const std::vector<TexelRegion> stale =
-            writtenBefore_ ? outside(*writtenBefore_, region)
+            writtenBefore_ ? texelsOutside(*writtenBefore_, region)
                            : std::vector<TexelRegion>{{glm::ivec2(0), glm::ivec2(width, height)}};
         for (const TexelRegion& part : stale) {
             frame.clear(history, part, backgroundHistory);
