@@ -3,16 +3,17 @@
 // surface when it holds a visible point (unless it lies beyond a dense cloud's outline:
 // FillRemoval.glsl's centreBeyondOutline), or when visible points surround it: in (by default)
 // all 8 directions, some level up to the expected-gap level L(x) (at least 1) finds pull weight
-// in the neighbouring texel. This replaces the paper's threshold on the pull weight at L(x),
-// which spreads the mask past the silhouette by about a texel of L(x) (the coarse weight is
-// interpolated across the edge): measured on the Stanford bunny, leakage fell from 4.6 % to 2 %
-// at equal coverage (bench/README.md).
+// in the neighbouring texel, or from level 1 on any point, hidden ones too (FillRemoval.glsl's
+// weighted). This replaces the paper's threshold on the pull weight at L(x), which spreads the
+// mask past the silhouette by about a texel of L(x) (the coarse weight is interpolated across
+// the edge): measured on the Stanford bunny, leakage fell from 4.6 % to 2 % at equal coverage
+// (bench/README.md).
 //   STAGE_REACH  level `level` (coarsest first) of the "fillReach" pyramid: per direction k,
 //                in 4 bits, the finest level l' >= level whose texel (t >> (l' - level)) + d_k
-//                has pull weight (15: none). A texel takes its own neighbour's level or else its
-//                parent's answer, so the mask stage reads 9 values per pixel instead of
-//                walking up to 8 x (L(x) + 1) texels: on close-ups, where L(x) is large, that
-//                walk dominated the frame.
+//                is weighted (FillRemoval.glsl; 15: none). A texel takes its own
+//                neighbour's level or else its parent's answer, so the mask stage reads 9
+//                values per pixel instead of walking up to 8 x (L(x) + 1) texels: on
+//                close-ups, where L(x) is large, that walk dominated the frame.
 //   STAGE_MASK   writes "mask" (1 = surface) and "surfaceDepth" (the filled depth there, +inf
 //                elsewhere), unless FinishSurface.comp tests level 0 itself.
 //   STAGE_SURFACE_DEPTH  "surfaceDepth" alone, from the push's level 0 (which FinishSurface.comp

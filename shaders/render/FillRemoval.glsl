@@ -4,13 +4,25 @@
 #include "shared/surface.glsl"
 
 layout(binding = SUBSCAN_TEXELS_FILL_REACH) uniform usamplerBuffer fillReachTexels;
+layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 
 const uint kNoReach = 15u;
 
 /// Beyond the image counts as weighted: a surface that reaches the image's border goes on past
 /// it, and would otherwise lose its outermost pixels (a frame of background around close-ups).
+/// From level 1 on, a texel holding any point counts too, hidden ones included (the min-depth
+/// pyramid is finite there): beside a near surface's edge, hidden point removal hides a band
+/// of the far surface, and where that band was wider than a pixel the gaps in it found too
+/// few directions enclosed and showed the background (the bunny's vertices at 512x512: holes
+/// where one ear crosses the other and beside the feet). A hidden point lies behind a
+/// surface or on one the test took for hidden, so in either case a surface covers its texel.
+/// Level 0 keeps to the visible points: there the mask reads 8 neighbours a pixel, and more
+/// loads cost FillRemoval +50 % and more on llvmpipe, where the levels above are a quarter
+/// of the pixels and less.
 bool weighted(uint onLevel, ivec2 texel) {
-    return !insideLevel(onLevel, texel) || pullWeightAt(texelIndex(onLevel, texel)) > 0.0;
+    return !insideLevel(onLevel, texel) || pullWeightAt(texelIndex(onLevel, texel)) > 0.0 ||
+           (onLevel > 0u &&
+            !isinf(texelFetch(minDepthTexels, int(texelIndex(onLevel, texel))).r));
 }
 
 /// Per direction, `onLevel` where the neighbour of `texel` on that level has weight, else the

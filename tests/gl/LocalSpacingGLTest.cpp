@@ -2,9 +2,10 @@
 // a sparse layer (a tree's canopy) over dense ground, seen from above. With the global h, the
 // hidden-point pass removes the ground around the canopy's points while the fill cannot bridge
 // the canopy's wider gaps: background shows through as dark squares, each around an isolated
-// canopy point. With the local spacing the canopy's gaps fill. Since the sub-pixel outline's
-// cells also keep the pixels of hidden points as surface (FillRemoval.glsl), the global h
-// leaves no holes here either when that rule is on (the default).
+// canopy point. With the local spacing the canopy's gaps fill. Since the fill counts texels of
+// hidden points as enclosing from pyramid level 1 on, and the sub-pixel outline's cells keep
+// the pixels of hidden points as surface (both FillRemoval.glsl), the global h leaves far
+// fewer holes, and none when that outline is on (the default).
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -104,10 +105,11 @@ TEST(LocalSpacingGLTest, ASparseCanopyOverDenseGroundLeavesNoHoles) {
         "background pixels under the canopy: %d of %d with h, %d with the local spacing, "
         "%d with h and the sub-pixel outline\n",
         withGlobal.background, withGlobal.pixels, withLocal.background, byCells.background);
-    // The global h leaves holes (the scene reproduces the artefact: measured 1854 of 2309
-    // pixels); the local spacing fills all but single pixels where ground and canopy meet
-    // (measured 3), and so do the hidden ground points' cells (measured 0).
-    EXPECT_GT(withGlobal.background, withGlobal.pixels / 2);
+    // The global h leaves holes (measured 132 of 2309 pixels, where the hidden ground's
+    // texels do not reach; 1854 before they enclosed gaps); the local spacing fills all but
+    // single pixels where ground and canopy meet (measured 0 to 3), and so do the hidden ground
+    // points' cells (measured 0).
+    EXPECT_GT(withGlobal.background, withGlobal.pixels / 40);
     EXPECT_LT(withLocal.background, withLocal.pixels / 100);
     EXPECT_LT(byCells.background, byCells.pixels / 100);
 }
