@@ -1,9 +1,9 @@
 #version 450
 // Fill removal: pull-push also fills the background around the object. A pixel belongs to the
 // surface when it holds a visible point (unless it lies beyond a dense cloud's outline:
-// FillRemoval.glsl's centreBeyondOutline), or when visible points surround it: in (by default)
-// all 8 directions, some level up to the expected-gap level L(x) (at least 1) finds pull weight
-// in the neighbouring texel, or from level 1 on any point, hidden ones too (FillRemoval.glsl's
+// FillRemoval.glsl's centreBeyondOutline), or when points surround it: in (by default) all 8
+// directions, some level up to the expected-gap level L(x) (at least 1) finds pull weight in
+// the neighbouring texel, or from level 1 on any point, hidden ones too (FillRemoval.glsl's
 // weighted). This replaces the paper's threshold on the pull weight at L(x), which spreads the
 // mask past the silhouette by about a texel of L(x) (the coarse weight is interpolated across
 // the edge): measured on the Stanford bunny, leakage fell from 4.6 % to 2 % at equal coverage

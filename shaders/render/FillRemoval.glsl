@@ -15,17 +15,19 @@ const uint kNoReach = 15u;
 /// of the far surface, and where that band was wider than a pixel the gaps in it found too
 /// few directions enclosed and showed the background (the bunny's vertices at 512x512: holes
 /// where one ear crosses the other and beside the feet). A hidden point lies behind a
-/// surface or on one the test took for hidden, so in either case a surface covers its texel.
-/// Level 0 keeps to the visible points: there the mask reads 8 neighbours a pixel, and more
-/// loads cost FillRemoval +50 % and more on llvmpipe, where the levels above are a quarter
-/// of the pixels and less.
+/// surface or on one the test took for hidden, so in either case a surface covers its own
+/// texel; the directions still do not compare depths, so a far structure thinner than the
+/// band (a wire beside a building's edge) could close the background between it and the edge.
+/// Level 0 keeps to the visible points: there the mask reads 8 neighbours a pixel, where 8
+/// more loads (of the sub-pixel cells) cost FillRemoval +50 % and more on llvmpipe; the levels
+/// above are a quarter of the pixels and less.
 bool weighted(uint onLevel, ivec2 texel) {
     return !insideLevel(onLevel, texel) || pullWeightAt(texelIndex(onLevel, texel)) > 0.0 ||
            (onLevel > 0u &&
             !isinf(texelFetch(minDepthTexels, int(texelIndex(onLevel, texel))).r));
 }
 
-/// Per direction, `onLevel` where the neighbour of `texel` on that level has weight, else the
+/// Per direction, `onLevel` where the neighbour of `texel` on that level is weighted, else the
 /// parent's answer (levels above `onLevel`).
 uint reachOf(uint onLevel, ivec2 texel) {
     uint parent = onLevel + 1u < levelCount()

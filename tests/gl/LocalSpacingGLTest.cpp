@@ -108,8 +108,9 @@ TEST(LocalSpacingGLTest, ASparseCanopyOverDenseGroundLeavesNoHoles) {
     // The global h leaves holes (measured 132 of 2309 pixels, where the hidden ground's
     // texels do not reach; 1854 before they enclosed gaps); the local spacing fills all but
     // single pixels where ground and canopy meet (measured 0 to 3), and so do the hidden ground
-    // points' cells (measured 0).
-    EXPECT_GT(withGlobal.background, withGlobal.pixels / 40);
+    // points' cells (measured 0). The local spacing must leave at least 1 % fewer holes than
+    // the global h, so that this scene still shows what it does.
+    EXPECT_GT(withGlobal.background, withLocal.background + withGlobal.pixels / 100);
     EXPECT_LT(withLocal.background, withLocal.pixels / 100);
     EXPECT_LT(byCells.background, byCells.pixels / 100);
 }

@@ -841,7 +841,7 @@ TEST_P(SurfacePassesSpacingGLTest, NormalBlendFollowsTheSmoothingLevel) {
     uploadInputs(harness, depth, color, GetParam());
     // The right quarter empty: an outline along x = 27 for the normals to turn towards. Within
     // the frame the points behind the surface enclose its gaps (FillRemoval.glsl's weighted),
-    // so with the local spacing few outlines are left there.
+    // so few outlines are left there (with the local spacing none turned a normal).
     for (int y = 0; y < kHeight; ++y) {
         std::fill_n(depth.begin() + y * kWidth + 28, kWidth - 28,
                     std::numeric_limits<float>::infinity());
