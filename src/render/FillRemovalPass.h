@@ -6,12 +6,12 @@
 namespace subscan {
 
 /// Separates surface from filled background (DESIGN.md §5.4, "fill removal"; beyond it, the
-/// sub-pixel outline of SurfaceSettings::subpixelOutline): "mask" is 1 where
-/// points surround the pixel up to the level of the expected point gap (visible ones beside it,
-/// hidden ones too from level 1 on; looked up in the per-direction "fillReach" pyramid), and
-/// "surfaceDepth" holds the filled depth there
-/// (+inf elsewhere). With LevelZero::Fused only "fillReach" above level 0, and "surfaceDepth"
-/// when the normals follow the surface to the outline (FinishSurface then reads it).
+/// sub-pixel outline of SurfaceSettings::subpixelOutline): "mask" is 1 where points surround
+/// the pixel up to the level of the expected point gap (visible ones beside it, hidden ones too
+/// from level 1 on; looked up in the per-direction "fillReach" pyramid), and "surfaceDepth"
+/// holds the filled depth there (+inf elsewhere). With LevelZero::Fused only "fillReach" above
+/// level 0, and "surfaceDepth" when the normals follow the surface to the outline
+/// (FinishSurface then reads it).
 class FillRemovalPass final : public RenderPass {
   public:
     explicit FillRemovalPass(const ShaderSources& sources);
