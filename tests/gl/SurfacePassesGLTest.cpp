@@ -509,8 +509,8 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
     return enclosed >= surface.fillDirections;
 }
 
-FillInputs fillInputsOf(const FrameResources& resources) {
-    const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
+/// `pulled`: the "pullWeights" buffer (w, w * ratio) as read back.
+FillInputs fillInputsOf(const std::vector<glm::vec2>& pulled, const FrameResources& resources) {
     FillInputs inputs{std::vector<float>(pulled.size()), resources.buffer("pyramid").read<float>()};
     std::transform(pulled.begin(), pulled.end(), inputs.weights.begin(),
                    [](const glm::vec2& texel) { return texel.x; });
@@ -525,7 +525,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
     FillRemovalPass(harness.sources()).execute(frame);
     const FrameResources& resources = harness.resources();
     const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
-    const FillInputs inputs = fillInputsOf(resources);
+    const FillInputs inputs = fillInputsOf(pulled, resources);
     const std::vector<float> filled = resources.texture("filledDepth").readFloats();
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const std::vector<float> surfaceDepth = resources.texture("surfaceDepth").readFloats();
@@ -612,7 +612,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     FillRemovalPass(harness.sources()).execute(frame);
     const FrameResources& resources = harness.resources();
     const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
-    const FillInputs inputs = fillInputsOf(resources);
+    const FillInputs inputs = fillInputsOf(pulled, resources);
     const std::vector<float>& weights = inputs.weights;
     const std::vector<float> filled = resources.texture("filledDepth").readFloats();
     const std::vector<float> mask = resources.texture("mask").readFloats();
