@@ -232,10 +232,11 @@ Entry localSlabEntry(float s, vec3 toLight, vec3 normal, float cosView) {
 #if LIGHT_MAP_ENTRIES
 /// Where directional light `light` entered on its way to `samplePoint`, from its light map:
 /// the first surface the light meets above the sample (lightMapSurface), at the straight
-/// distance between them along the light, with that surface's normal. kInside (no light) where the sample lies
-/// in front of that surface by more than the tolerance `slack` — outside the medium as the light
-/// sees it, e.g. past the far face of a thin part —, kOffScreen where the map holds no surface.
-Entry lightMapEntry(uint light, vec3 samplePoint, float slack) {
+/// distance between them along the light less `registration` (lightMapRegistration), with that
+/// surface's normal. kInside (no light) where the sample lies in front of that surface by more
+/// than the tolerance `slack` — outside the medium as the light sees it, e.g. past the far face
+/// of a thin part —, kOffScreen where the map holds no surface.
+Entry lightMapEntry(uint light, vec3 samplePoint, float slack, float registration) {
     Entry entry;
     vec4 map = lights.lightMap[light];
     vec3 at = lightMapPosition(lights.lightFromView[light], map, samplePoint);
@@ -250,10 +251,44 @@ Entry lightMapEntry(uint light, vec3 samplePoint, float slack) {
     }
     // Light view -> camera view: the inverse of a rotation is its transpose.
     entry.normal = normalize(transpose(mat3(lights.lightFromView[light])) * normal);
-    float distanceAlong = at.z - surfaceDepth;
+    float distanceAlong = at.z - surfaceDepth - registration;
     entry.state = distanceAlong >= -slack ? kOutside : kInside;
     entry.distance = max(distanceAlong, 0.0);
     return entry;
+}
+
+/// How far the camera's reconstruction of this pixel's surface (`surfacePoint`, `normal`) lies
+/// behind light `light`'s reconstruction of it, along the light, where both show one surface.
+/// Each view takes a pixel's (texel's) depth from its nearest point, anywhere inside it: a
+/// surface tilted to the view comes out up to that pixel's depth slope in front of the truth,
+/// differently in the two views, and under a close camera that is a good part of a mean free
+/// path (a marble plate seen at 60 degrees and lit head-on came out 28 % too bright). The
+/// entries are measured from the camera's surface, as the samples are. None where the pixel
+/// lies farther from the light's surface than both slopes and the shadows' tolerance (it is in
+/// shadow, or the light enters elsewhere, e.g. through a thin part's far face): the
+/// registration fades out between one and two such widths.
+float lightMapRegistration(uint light, vec3 surfacePoint, vec3 normal, float pixelSize) {
+    vec3 toLight = lights.lightDirection[light].xyz;
+    float cosIn = dot(normal, toLight);
+    if (!(cosIn > 0.0)) {
+        return 0.0;
+    }
+    vec4 map = lights.lightMap[light];
+    vec3 at = lightMapPosition(lights.lightFromView[light], map, surfacePoint);
+    vec3 mapNormal;
+    float surfaceDepth =
+        lightMapSurface(light, map, at.xy, lightMapJump(map, lights.shadow.x), mapNormal);
+    if (isinf(surfaceDepth)) {
+        return 0.0;
+    }
+    // The depth slope over a pixel (texel) in each view, as a distance from the plane, then
+    // along the light; the steepest 78 degrees.
+    vec3 normalInLight = mat3(lights.lightFromView[light]) * normal;
+    float slopes = pixelSize * (abs(normal.x) + abs(normal.y)) +
+                   (abs(normalInLight.x) + abs(normalInLight.y)) / map.x;
+    float width = lights.shadow.x + slopes / max(cosIn, 0.2);
+    float offset = at.z - surfaceDepth;
+    return offset * (1.0 - smoothstep(width, 2.0 * width, abs(offset)));
 }
 #endif
 
@@ -340,6 +375,13 @@ void main() {
         int samples = int(params.sampling.x);
         ivec3 channelSamples = (ivec3(samples + 2) - ivec3(0, 1, 2)) / 3;
         float thicknessScale = 2.0 / max(cosView, 0.2);
+#if LIGHT_MAP_ENTRIES
+        float registration[SUBSCAN_MAX_LIGHTS];
+        float pixelSize = projectiveDepth(depth) / frame.depthRange.z;
+        for (uint i = 0u; i < lights.lightCount.x; ++i) {
+            registration[i] = lightMapRegistration(i, surfacePoint, normal, pixelSize);
+        }
+#endif
         for (int k = 0; k < samples; ++k) {
             int channel = k % 3;
             float xi = (float(k / 3) + 0.5) / float(channelSamples[channel]);
@@ -376,7 +418,7 @@ void main() {
                 // may lie that far in front of the light's (the shadows' tolerance). Deeper
                 // samples need none, so that a thin part's far face cuts off exactly.
                 float slack = max(lights.shadow.x - s * cosViewInside, 0.0);
-                entry = lightMapEntry(i, samplePoint, slack);
+                entry = lightMapEntry(i, samplePoint, slack, registration[i]);
                 if (entry.state == kOffScreen) {
                     entry = localSlabEntry(s, toLight, normal, cosView);
                 }
