@@ -4,11 +4,14 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 #include <glm/trigonometric.hpp>
+
+#include "core/Error.h"
 
 namespace subscan {
 
@@ -191,6 +194,13 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
     camera.farPlane = toMiddle + radius + margin;
     camera.nearPlane = std::max(toMiddle - radius - margin, 1e-4 * camera.farPlane);
     return camera;
+}
+
+UpAxis upAxisFor(std::string_view up, std::string_view format) {
+    if (up != "auto" && up != "y" && up != "z") {
+        throw Error(fmt::format("up '{}' is not auto, y or z", up));
+    }
+    return up == "z" || (up == "auto" && format == "las") ? UpAxis::Z : UpAxis::Y;
 }
 
 }  // namespace subscan

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <optional>
+#include <string_view>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
@@ -57,6 +58,11 @@ struct Camera {
 glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds);
 
 enum class UpAxis { Y, Z };
+
+/// The up axis `up` ("auto", "y" or "z") names for a scan read as `format` (LoadedScan's and
+/// subscan.Cloud's: "las", "ply", ...): auto is Z for LAS-family files (airborne and
+/// terrestrial LiDAR), Y otherwise. Throws subscan::Error for any other name.
+UpAxis upAxisFor(std::string_view up, std::string_view format);
 
 /// How an orbit without a given distance frames the bounds: their bounding sphere fits the
 /// narrower field of view with 5 % to spare, the same distance from every direction (what the

@@ -10,6 +10,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include "core/Camera.h"
 #include "core/LocalSpacing.h"
 #include "core/PointCloud.h"
 #include "core/SensorView.h"
@@ -68,6 +69,10 @@ using SettingsHandle = std::shared_ptr<SettingsData>;
 /// What a `settings=` argument may be: a Settings, a dict in the settings file's layout, or
 /// None for the defaults. Throws ValueError (dicts with bad values) or TypeError.
 RenderSettings settingsArgument(const pybind11::handle& argument);
+
+/// The up axis an `up=` argument ("auto", "y" or "z") names for `cloud`, as the CLI's --up
+/// (upAxisFor: auto is Z for LAS-family files); ValueError for any other name.
+UpAxis upAxisArgument(const std::string& up, const CloudData& cloud);
 
 /// The path of a str or os.PathLike argument.
 std::string pathArgument(const pybind11::handle& argument);

@@ -21,6 +21,14 @@ namespace py = pybind11;
 
 namespace subscan::python {
 
+UpAxis upAxisArgument(const std::string& up, const CloudData& cloud) {
+    try {
+        return upAxisFor(up, cloud.format());
+    } catch (const Error& error) {
+        throw py::value_error(error.what());
+    }
+}
+
 namespace {
 
 /// The camera if camera.json would accept it (sizes, lens, planes, finite matrices), else
@@ -91,15 +99,11 @@ Camera orbit(const CloudData& cloud, double yaw, double pitch, std::optional<dou
     if (distance && !(*distance > 0.0 && std::isfinite(*distance))) {
         throw py::value_error(fmt::format("distance {} must be positive", *distance));
     }
-    if (up != "auto" && up != "y" && up != "z") {
-        throw py::value_error(fmt::format("up '{}' is not auto, y or z", up));
-    }
     OrbitView view;
     view.yawDegrees = yaw;
     view.pitchDegrees = pitch;
     view.distance = distance;
-    // As the CLI's --up auto: Z up for LAS (airborne and terrestrial LiDAR), Y up otherwise.
-    view.up = up == "z" || (up == "auto" && cloud.format() == "las") ? UpAxis::Z : UpAxis::Y;
+    view.up = upAxisArgument(up, cloud);
     if (!center.is_none()) {
         view.center = vectorArgument(center, "center");
     }
@@ -115,11 +119,7 @@ Camera sensorView(const CloudData& cloud, const py::object& sensorObject, std::o
     checkRange(fovy, 1.0, 170.0, "fovy");
     checkRange(width.value_or(1), 1, 65536, "width");
     checkRange(height.value_or(1), 1, 65536, "height");
-    if (up != "auto" && up != "y" && up != "z") {
-        throw py::value_error(fmt::format("up '{}' is not auto, y or z", up));
-    }
-    const UpAxis upAxis =
-        up == "z" || (up == "auto" && cloud.format() == "las") ? UpAxis::Z : UpAxis::Y;
+    const UpAxis upAxis = upAxisArgument(up, cloud);
     // As --sensor: a given position overrides what the file says, its grid's camera included.
     const OrganisedGrid noGrid;
     std::optional<SensorPose> pose = cloud.sensor;

@@ -12,6 +12,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include "core/Coloring.h"
 #include "core/Error.h"
 #include "gpu/GlContext.h"
 #include "python/Bindings.h"
@@ -56,7 +57,16 @@ py::array arrayOf(ImageF image) {
 
 class RendererState {
   public:
-    RendererState(const CloudHandle& cloud, bool software) : cloud_(cloud) {
+    RendererState(const CloudHandle& cloud, bool software, const std::string& color,
+                  const std::string& up)
+        : cloud_(cloud) {
+        Coloring coloring;
+        try {
+            coloring = parseColoring(color);
+        } catch (const Error& error) {
+            throw py::value_error(error.what());
+        }
+        const UpAxis upAxis = upAxisArgument(up, *cloud);
         const py::gil_scoped_release release;
         HeadlessContextOptions options;
         options.preferHardware = !software;
@@ -68,6 +78,13 @@ class RendererState {
         // allows (the Cloud is immutable and kept alive here): no 160 MB copy for 10 M points.
         renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing(), 0,
                                                PointMemory::Borrow);
+        // The colours `subscan render --color` draws (FrameOptions::applyColoring); the scan's
+        // own are drawn from where they are, not copied.
+        const bool ownColors =
+            cloud->cloud().hasColors() && (coloring == Coloring::Auto || coloring == Coloring::Rgb);
+        if (!ownColors) {
+            renderer_->setColors(pointColors(cloud->cloud(), coloring, upAxis));
+        }
     }
     ~RendererState() {
         try {
@@ -227,7 +244,7 @@ class RendererState {
             cloud = cloud_;
         }
         OrbitView orbit;
-        orbit.up = cloud->format() == "las" ? UpAxis::Z : UpAxis::Y;
+        orbit.up = upAxisFor("auto", cloud->format());
         orbit.framing = Framing::Box;  // as render frames a scan
         orbit.framed = cloud->framed();
         return orbitCamera(cloud->cloud().bounds, orbit, 1280, 720, 45.0);
@@ -254,11 +271,16 @@ uploaded once; the GIL is released while the renderer works, and one call runs a
     image = r.render(camera, mode="surface")         # H×W×3 uint8, sRGB, row 0 at the top
     image = r.render(camera, buffers=True); r.buffers()["depth"]
 
-Renderer(cloud, software=False): software=True uses Mesa's software rasterizer even where a
-GPU exists (`subscan render --software`). close() (or a with-block) frees the GPU memory now.
+Renderer(cloud, software=False, color="auto", up="auto"): software=True uses Mesa's software
+rasterizer even where a GPU exists (`subscan render --software`); color is what the points'
+colour shows, as `subscan render --color`: 'auto' (the scan's colour where it has one, else
+height for Z-up data, else a uniform grey), 'rgb', 'intensity', 'height', 'uniform' or
+'classification'; up is the axis height runs along, as --up ('auto': z for LAS, LAZ and COPC
+files, y otherwise). close() (or a with-block) frees the GPU memory now.
 )doc")
-        .def(py::init<const CloudHandle&, bool>(), py::arg("cloud"), py::kw_only(),
-             py::arg("software") = false)
+        .def(py::init<const CloudHandle&, bool, const std::string&, const std::string&>(),
+             py::arg("cloud"), py::kw_only(), py::arg("software") = false,
+             py::arg("color") = "auto", py::arg("up") = "auto")
         .def("render", &RendererState::render, py::arg("camera") = py::none(),
              py::arg("mode") = py::none(), py::arg("settings") = py::none(), py::kw_only(),
              py::arg("samples") = py::none(), py::arg("buffers") = false, R"doc(

@@ -259,3 +259,97 @@ def test_buffers_need_a_render_that_kept_them(torus, camera):
     assert "depth" in renderer.buffers()
     with pytest.raises(TypeError):
         subscan.Renderer("not a cloud")
+
+
+def write_ply(path, points, colors=None, intensity=None):
+    """A binary PLY of `points` (N×3), with 8-bit `colors` (N×3) and float `intensity` (N)
+    where given."""
+    fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
+    header = ["ply", "format binary_little_endian 1.0", f"element vertex {len(points)}",
+              "property float x", "property float y", "property float z"]
+    if colors is not None:
+        fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
+        header += ["property uchar red", "property uchar green", "property uchar blue"]
+    if intensity is not None:
+        fields += [("intensity", "<f4")]
+        header += ["property float intensity"]
+    records = np.zeros(len(points), dtype=fields)
+    for axis, name in enumerate("xyz"):
+        records[name] = points[:, axis]
+    if colors is not None:
+        for channel, name in enumerate(("red", "green", "blue")):
+            records[name] = colors[:, channel]
+    if intensity is not None:
+        records["intensity"] = intensity
+    with open(path, "wb") as file:
+        file.write(("\n".join(header + ["end_header"]) + "\n").encode("ascii"))
+        file.write(records.tobytes())
+
+
+@pytest.fixture(scope="module")
+def scans_of_each_kind(torus, tmp_path_factory):
+    """The torus's points as a PLY without colour, one with colour and one with intensity only
+    (a speckle of it, as a scanner's confidence is: drawn as grey, it would show)."""
+    directory = tmp_path_factory.mktemp("kinds")
+    points = np.asarray(torus.points, dtype=np.float32)
+    random = np.random.default_rng(7)
+    colors = random.integers(0, 256, size=(len(points), 3), dtype=np.uint8)
+    intensity = random.uniform(0.0, 1.0, size=len(points)).astype(np.float32)
+    files = {"plain": directory / "plain.ply", "colour": directory / "colour.ply",
+             "intensity": directory / "intensity.ply"}
+    write_ply(files["plain"], points)
+    write_ply(files["colour"], points, colors=colors)
+    write_ply(files["intensity"], points, intensity=intensity)
+    return files
+
+
+def default_pictures_agree(cli, tmp_path, path, camera, *color):
+    """`subscan render PATH` and subscan.Renderer(subscan.load(PATH)) with nothing but the
+    camera and mode given (and the colouring, where `color` holds one): byte for byte."""
+    camera.save(tmp_path / "camera.json")
+    cli("render", path, "-o", tmp_path / "cli.png", "--camera", tmp_path / "camera.json",
+        "--mode", "surface", *(("--color", color[0]) if color else ()))
+    expected = read_png(tmp_path / "cli.png")[:, :, :3]
+    keywords = {"color": color[0]} if color else {}
+    with subscan.Renderer(subscan.load(path), **keywords) as renderer:
+        image = renderer.render(camera, mode="surface")
+    np.testing.assert_array_equal(image, expected)
+    return image
+
+
+@pytest.mark.parametrize("kind", ["plain", "colour", "intensity"])
+def test_default_colouring_is_the_cli_one(cli, tmp_path, camera, scans_of_each_kind, kind):
+    image = default_pictures_agree(cli, tmp_path, scans_of_each_kind[kind], camera)
+    # Not only equal: by default intensity is not drawn (the auto colouring shows the grey of a
+    # scan without colour), so the plain and intensity-only scans give one picture.
+    if kind == "intensity":
+        plain = default_pictures_agree(cli, tmp_path, scans_of_each_kind["plain"], camera)
+        np.testing.assert_array_equal(image, plain)
+
+
+def test_an_asked_colouring_is_the_cli_one(cli, tmp_path, camera, scans_of_each_kind):
+    speckled = default_pictures_agree(cli, tmp_path, scans_of_each_kind["intensity"], camera,
+                                      "intensity")
+    plain = default_pictures_agree(cli, tmp_path, scans_of_each_kind["plain"], camera)
+    assert (speckled != plain).any(axis=2).mean() > 0.05  # the intensity shows where asked
+
+
+def test_the_stanford_bunny_default_is_the_cli_one(cli, tmp_path, data_dir):
+    # The scan whose confidence channel the PLY reader takes as intensity (issue 41).
+    path = data_dir / "bun_zipper_res2.ply"
+    camera = subscan.Camera.orbit(subscan.load(path), yaw=40, width=160, height=120)
+    default_pictures_agree(cli, tmp_path, path, camera)
+
+
+@pytest.mark.parametrize("keywords, message", [
+    ({"color": "plaid"}, "there is no colouring 'plaid'"),
+    ({"up": "x"}, "up 'x' is not auto, y or z"),
+])
+def test_bad_colourings_raise(torus, keywords, message):
+    with pytest.raises(ValueError, match=message):
+        subscan.Renderer(torus, **keywords)
+
+
+def test_a_colouring_the_cloud_cannot_give_raises(torus, scans_of_each_kind):
+    with pytest.raises(subscan.Error, match="the scan has no intensities to show"):
+        subscan.Renderer(subscan.load(scans_of_each_kind["plain"]), color="intensity")

@@ -288,8 +288,7 @@ int runBench(const BenchOptions& options) {
         settings.raster.resolution = parseResolution(options.resolution);
     }
     const LoadedScan scan = loadScanForCommand(options.source);
-    const UpAxis up =
-        options.up == "z" || (options.up == "auto" && scan.format == "las") ? UpAxis::Z : UpAxis::Y;
+    const UpAxis up = upAxisFor(options.up, scan.format);
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();

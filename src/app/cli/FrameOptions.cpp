@@ -125,7 +125,7 @@ void FrameOptions::applyColoring(LoadedScan& scan) const {
 }
 
 UpAxis FrameOptions::upAxis(const LoadedScan& scan) const {
-    return up == "z" || (up == "auto" && scan.format == "las") ? UpAxis::Z : UpAxis::Y;
+    return upAxisFor(up, scan.format);
 }
 
 Camera FrameOptions::camera(const LoadedScan& scan, Framing framing) const {
