@@ -476,12 +476,21 @@ OrbitView lookingAt(const glm::dvec3& eye, const glm::dvec3& target) {
 }  // namespace
 
 void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
-                    const ScannerSettings& scanner) {
+                    const ScannerSettings& scanner, ViewsFrom viewsFrom) {
     if (scanner.mode == ScannerSettings::Mode::Object) {
         return;
     }
     constexpr double kFirstAzimuthDegrees = 45.0;
     ScannerSettings fixed = scanner;
+    const auto orbitAt = [distance = settings.distance](double pitchDegrees) {
+        return [distance, pitchDegrees](double degrees) {
+            OrbitView orbit;
+            orbit.yawDegrees = kFirstAzimuthDegrees + degrees;
+            orbit.pitchDegrees = pitchDegrees;
+            orbit.distance = distance;
+            return orbit;
+        };
+    };
     if (scanner.mode == ScannerSettings::Mode::Station) {
         const glm::dvec3 station = stationPosition(scene, scanner.station);
         fixed.station.position = station;  // found once, not per pixel
@@ -496,14 +505,10 @@ void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
             return lookingAt(eye, target);
         };
     } else {
-        settings.scannerView = [distance = settings.distance](double degrees) {
-            constexpr double kPitchDegrees = 45.0;
-            OrbitView orbit;
-            orbit.yawDegrees = kFirstAzimuthDegrees + degrees;
-            orbit.pitchDegrees = kPitchDegrees;
-            orbit.distance = distance;
-            return orbit;
-        };
+        settings.scannerView = orbitAt(45.0);
+    }
+    if (viewsFrom == ViewsFrom::Orbit) {
+        settings.scannerView = orbitAt(30.0);
     }
     settings.viewpoints.clear();
     for (int view = 0; view < settings.views; ++view) {

@@ -45,17 +45,23 @@ struct EvaluationSettings {
     SampledTest sampled;
 };
 
+/// Where the views of a LiDAR scan's evaluation stand: near its scanner (ViewsFrom::Scanner),
+/// or on an orbit around the whole scene (ViewsFrom::Orbit), where a station's sparse far
+/// surfaces stand in front of its dense near ground.
+enum class ViewsFrom { Scanner, Orbit };
+
 /// Fits `settings` to a scan made with `scanner` of `scene` (DESIGN.md §7, real scans). Object
 /// scans keep the orbit. A station sees only what is visible from where it stands, so its
 /// `views` views stand 1 m above and 1 m behind the station, look out in azimuths 45 degrees
 /// plus equal turns, 10 degrees down; an airborne strip's look down at 45 degrees from the
-/// orbit's usual distance, in the same azimuths. Both count only surfaces the scan could sample
-/// (scannerCanSample): the backs of buildings, the ground behind a wall, walls parallel to the
-/// flight's scan planes are no reconstruction's to fill. `scene` must outlive `settings`.
-/// Also sets `scannerView`, so that eval --temporal turns at the station (or about the strip)
-/// instead of orbiting the whole scene from outside.
+/// orbit's usual distance, in the same azimuths. With ViewsFrom::Orbit both instead look down
+/// at 30 degrees from the orbit's distance, in those azimuths. All count only surfaces the
+/// scan could sample (scannerCanSample): the backs of buildings, the ground behind a wall,
+/// walls parallel to the flight's scan planes are no reconstruction's to fill. `scene` must
+/// outlive `settings`. Also sets `scannerView`, so that eval --temporal turns at the station
+/// (or about the scene) instead of orbiting it at the object scans' angles.
 void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
-                    const ScannerSettings& scanner);
+                    const ScannerSettings& scanner, ViewsFrom viewsFrom = ViewsFrom::Scanner);
 
 /// DESIGN.md §7 metrics of each method, averaged over the views.
 struct EvaluationReport {

@@ -4,6 +4,8 @@
 #include <cstddef>
 
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <glm/trigonometric.hpp>
 
 #include "core/Camera.h"
 #include "eval/Evaluation.h"
@@ -72,6 +74,40 @@ TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
     EXPECT_LE(withLocal.surface.occlusionErrorRate, 0.015);
     EXPECT_GT(withLocal.surface.coverage, withGlobal.surface.coverage + 0.1);
     EXPECT_GT(withLocal.surface.psnrDb, withGlobal.surface.psnrDb + 3.0);  // measured +7.7 dB
+}
+
+TEST(LidarEvaluationGLTest, OrbitViewsLookDownAtTheWholeStationScene) {
+    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    EvaluationSettings settings;
+    settings.views = 4;
+    adaptToScanner(settings, *source.scene, source.scanner, ViewsFrom::Orbit);
+    ASSERT_EQ(settings.viewpoints.size(), 4u);
+    const Bounds bounds = source.scene->bounds();
+    const glm::dvec3 centre = bounds.center();
+    for (const OrbitView& view : settings.viewpoints) {
+        const Camera camera = orbitCamera(bounds, view, 96, 96, 45.0);
+        // Outside the scene, 30 degrees above its middle, looking at it: the station's
+        // sparse far walls stand between these eyes and its dense near ground.
+        const glm::dvec3 eye = camera.eye();
+        EXPECT_FALSE(eye.x > bounds.min.x && eye.x < bounds.max.x && eye.z > bounds.min.z &&
+                     eye.z < bounds.max.z);
+        const glm::dvec3 towardsEye = glm::normalize(eye - centre);
+        EXPECT_NEAR(std::asin(towardsEye.y), glm::radians(30.0), 1e-6);
+    }
+    // The scan's own sampling still decides what counts: the truth leaves unsampled surfaces
+    // (backs of buildings, ground behind walls) out, which the orbit sees plenty of.
+    const Camera camera = orbitCamera(bounds, settings.viewpoints[0], 96, 96, 45.0);
+    const GroundTruthImages truth = renderGroundTruth(*source.scene, camera, settings.sampled);
+    std::size_t surface = 0, unsampled = 0;
+    for (std::size_t i = 0; i < truth.depth.size(); ++i) {
+        if (std::isfinite(truth.depth[i])) {
+            ++surface;
+            unsampled += truth.sampled[i] == 0;
+        }
+    }
+    ASSERT_GT(surface, 0u);
+    EXPECT_GT(unsampled, 0u);
+    EXPECT_LT(unsampled, surface);
 }
 
 TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {

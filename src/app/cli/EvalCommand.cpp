@@ -24,6 +24,7 @@ struct EvalOptions {
     bool temporal = false;
     TemporalEvaluationSettings temporalEvaluation;
     std::string points = "vertices";
+    std::string viewsFrom = "scanner";
     std::string settingsFile;
     bool json = false;
     bool software = false;
@@ -77,7 +78,8 @@ int runEval(const EvalOptions& options) {
     }
 
     EvaluationSettings evaluation = options.evaluation;
-    adaptToScanner(evaluation, *truth, scanner);
+    adaptToScanner(evaluation, *truth, scanner,
+                   options.viewsFrom == "orbit" ? ViewsFrom::Orbit : ViewsFrom::Scanner);
 
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
@@ -150,6 +152,11 @@ Command addEvalCommand(CLI::App& parent) {
     eval->add_option("mesh", options->source, "Mesh PLY with faces, or synthetic:NAME")->required();
     eval->add_option("--views", options->evaluation.views, "Views on the orbit")
         ->check(CLI::Range(1, 360));
+    eval->add_option("--views-from", options->viewsFrom,
+                     "Where the views of a LiDAR source stand: scanner (near the station, or "
+                     "over the strip at 45 degrees) or orbit (around the whole scene, 30 degrees "
+                     "down)")
+        ->check(CLI::IsMember({"scanner", "orbit"}));
     eval->add_option("--width", options->evaluation.width, "Image width")
         ->check(CLI::Range(16, 8192));
     eval->add_option("--height", options->evaluation.height, "Image height")
