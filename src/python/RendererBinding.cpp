@@ -68,6 +68,15 @@ class RendererState {
         }
         const UpAxis upAxis = upAxisArgument(up, *cloud);
         const py::gil_scoped_release release;
+        // The colours `subscan render --color` draws (FrameOptions::applyColoring), made before
+        // any GL object, so that a colouring the cloud cannot give leaves nothing to free; the
+        // scan's own are drawn from where they are, not copied.
+        std::vector<Rgba8> colors;
+        const bool ownColors =
+            cloud->cloud().hasColors() && (coloring == Coloring::Auto || coloring == Coloring::Rgb);
+        if (!ownColors) {
+            colors = pointColors(cloud->cloud(), coloring, upAxis);
+        }
         HeadlessContextOptions options;
         options.preferHardware = !software;
         options.debugOutput = glDebugOutputRequested();
@@ -78,12 +87,8 @@ class RendererState {
         // allows (the Cloud is immutable and kept alive here): no 160 MB copy for 10 M points.
         renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing(), 0,
                                                PointMemory::Borrow);
-        // The colours `subscan render --color` draws (FrameOptions::applyColoring); the scan's
-        // own are drawn from where they are, not copied.
-        const bool ownColors =
-            cloud->cloud().hasColors() && (coloring == Coloring::Auto || coloring == Coloring::Rgb);
         if (!ownColors) {
-            renderer_->setColors(pointColors(cloud->cloud(), coloring, upAxis));
+            renderer_->setColors(colors);
         }
     }
     ~RendererState() {
