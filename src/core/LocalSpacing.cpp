@@ -4,11 +4,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <thread>
 
 #include <glm/geometric.hpp>
 
 #include "core/KdTree.h"
+#include "core/Parallel.h"
 #include "core/Spacing.h"
 
 namespace subscan {
@@ -94,23 +94,6 @@ Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& 
     result = {};
     scanNeighbours(positions, point, indices.data(), squared.data(), wide, result);
     return result;
-}
-
-/// Runs `work(i)` for every i < count, split across the machine's cores.
-template <class Work>
-void inParallel(std::size_t count, const Work& work) {
-    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
-    const auto range = [&](std::size_t thread) {
-        const std::size_t last = (thread + 1) * count / threads;
-        for (std::size_t i = thread * count / threads; i < last; ++i) {
-            work(i);
-        }
-    };
-    std::vector<std::jthread> workers;
-    for (std::size_t thread = 1; thread < threads; ++thread) {
-        workers.emplace_back(range, thread);
-    }
-    range(0);
 }
 
 }  // namespace

@@ -4,16 +4,19 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <tuple>
 #include <vector>
 
 #include <fmt/format.h>
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <glm/trigonometric.hpp>
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/Parallel.h"
 #include "eval/GroundTruth.h"
 #include "gpu/ShaderSources.h"
 #include "io/Image.h"
@@ -161,7 +164,7 @@ void exportView(const std::filesystem::path& directory, int view, const Camera& 
         const bool inSurface = std::isfinite(surface.depth[i]);
         const bool unsampled = inTruth && !truth.sampled.empty() && truth.sampled[i] == 0;
         const bool occluded =
-            inTruth && inSurface && surface.depth[i] - truth.depth[i] > 3.0 * spacing;
+            inTruth && inSurface && showsThrough(truth, i, surface.depth[i], spacing);
         const glm::u8vec3 color = unsampled              ? glm::u8vec3(60)
                                   : occluded             ? glm::u8vec3(250, 220, 30)
                                   : inTruth && inSurface ? glm::u8vec3(160)
@@ -186,11 +189,52 @@ void exportView(const std::filesystem::path& directory, int view, const Camera& 
 
 }  // namespace
 
+SpacingAtTruth::SpacingAtTruth(const PointCloud& points, const PointSpacing& spacing)
+    : points_(points),
+      spacing_(spacing),
+      adaptor_{points.positions},
+      tree_(3, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {}
+
+std::vector<float> SpacingAtTruth::at(const Camera& camera, const GroundTruthImages& truth) const {
+    std::vector<float> spacing(truth.depth.size(), static_cast<float>(spacing_.global));
+    if (spacing_.local.empty() || points_.positions.empty()) {
+        return spacing;
+    }
+    const glm::dmat4 worldFromView = glm::inverse(camera.view);
+    const double focal = camera.focalLengthPixels();
+    const int width = camera.width;
+    inParallel(truth.depth.size(), [&](std::size_t i) {
+        if (!std::isfinite(truth.depth[i])) {
+            return;
+        }
+        const double x = static_cast<double>(i % static_cast<std::size_t>(width)) + 0.5;
+        const double y = static_cast<double>(i / static_cast<std::size_t>(width)) + 0.5;
+        const double depth = truth.depth[i];
+        const glm::dvec3 inView((x - 0.5 * width) / focal * depth,
+                                (0.5 * camera.height - y) / focal * depth, -depth);
+        const glm::vec3 query(glm::dvec3(worldFromView * glm::dvec4(inView, 1.0)) - points_.origin);
+        std::uint32_t nearest = 0;
+        float squared = 0.0f;
+        if (tree_.knnSearch(&query.x, 1, &nearest, &squared) == 0) {
+            return;
+        }
+        const glm::vec4& local = spacing_.local[nearest];
+        spacing[i] =
+            static_cast<float>(spacing_.global * std::max(local.w, glm::length(glm::vec3(local))));
+    });
+    return spacing;
+}
+
 EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointCloud& points,
                           const EvaluationSettings& settings, const RenderSettings& render) {
-    Renderer renderer(context, points);
+    const PointSpacing pointSpacing = estimatePointSpacing(points);
+    Renderer renderer(context, points, pointSpacing);
     ImageShader shader(context, renderer.gpuCloud());
     const double h = renderer.spacing();
+    std::optional<SpacingAtTruth> spacingAtTruth;
+    if (settings.occlusionsByLocalSpacing) {
+        spacingAtTruth.emplace(points, pointSpacing);
+    }
 
     EvaluationReport report;
     std::vector<QualityMetrics> pointViews, surfaceViews;
@@ -209,7 +253,10 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         }
         const Camera camera = orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
                                           settings.fovyDegrees);
-        const GroundTruthImages groundTruth = renderGroundTruth(truth, camera, settings.sampled);
+        GroundTruthImages groundTruth = renderGroundTruth(truth, camera, settings.sampled);
+        if (spacingAtTruth) {
+            groundTruth.spacing = spacingAtTruth->at(camera, groundTruth);
+        }
         const std::vector<std::uint8_t> truthImage = shader.shade(
             camera, render, groundTruth.depth, groundTruth.normals, groundTruth.albedo);
         // The baselines: rasterized points, flat shaded.
@@ -517,6 +564,7 @@ void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
     settings.sampled = [&scene, fixed](const glm::dvec3& p, const glm::dvec3& normal) {
         return scannerCanSample(scene, fixed, p, normal);
     };
+    settings.occlusionsByLocalSpacing = true;
 }
 
 }  // namespace subscan

@@ -9,6 +9,8 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "core/Camera.h"
+#include "core/KdTree.h"
+#include "core/LocalSpacing.h"
 #include "core/PointCloud.h"
 #include "eval/GroundTruth.h"
 #include "eval/Metrics.h"
@@ -43,6 +45,11 @@ struct EvaluationSettings {
     /// When set, which true surface points the scan could sample: coverage and leakage count
     /// only those (DESIGN.md §7: coverage is of the ground truth the scan sampled).
     SampledTest sampled;
+    /// Judge occlusion errors by the scan's local spacing where the true surface is (the
+    /// nearest point's, the larger of its spacing and its gap across scan lines, at least h)
+    /// instead of h alone: a LiDAR scan's far rings lie tens of h apart, and the fill between
+    /// them is off the plane by a share of that gap without anything showing through.
+    bool occlusionsByLocalSpacing = false;
 };
 
 /// Where the views of a LiDAR scan's evaluation stand: near its scanner (ViewsFrom::Scanner),
@@ -57,11 +64,29 @@ enum class ViewsFrom { Scanner, Orbit };
 /// orbit's usual distance, in the same azimuths. With ViewsFrom::Orbit both instead look down
 /// at 30 degrees from the orbit's distance, in those azimuths. All count only surfaces the
 /// scan could sample (scannerCanSample): the backs of buildings, the ground behind a wall,
-/// walls parallel to the flight's scan planes are no reconstruction's to fill. `scene` must
-/// outlive `settings`. Also sets `scannerView`, so that eval --temporal turns at the station
+/// walls parallel to the flight's scan planes are no reconstruction's to fill; occlusion errors
+/// are judged by the local spacing (occlusionsByLocalSpacing). `scene` must outlive
+/// `settings`. Also sets `scannerView`, so that eval --temporal turns at the station
 /// (or about the scene) instead of orbiting it at the object scans' angles.
 void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
                     const ScannerSettings& scanner, ViewsFrom viewsFrom = ViewsFrom::Scanner);
+
+/// The scan's local spacing (scene units) where each pixel's true surface is, for
+/// GroundTruthImages::spacing: that of the nearest scan point, the larger of its spacing w and
+/// its gap across scan lines (estimateLocalSpacing) times h; h everywhere where the local
+/// spacing is not estimated. `points` and `spacing` must outlive it.
+class SpacingAtTruth {
+  public:
+    SpacingAtTruth(const PointCloud& points, const PointSpacing& spacing);
+    /// Per pixel of `truth` seen by `camera` (h where it shows nothing).
+    std::vector<float> at(const Camera& camera, const GroundTruthImages& truth) const;
+
+  private:
+    const PointCloud& points_;
+    const PointSpacing& spacing_;
+    PositionsAdaptor adaptor_;
+    KdTree tree_;
+};
 
 /// DESIGN.md §7 metrics of each method, averaged over the views.
 struct EvaluationReport {

@@ -22,6 +22,10 @@ struct GroundTruthImages {
     /// 1 where the pixel's surface point is one the scan could sample, else 0 (see
     /// scannerCanSample); empty when every point could be. Metrics skip unsampled pixels.
     std::vector<std::uint8_t> sampled;
+    /// The scan's spacing at each pixel's true surface point (scene units), where the
+    /// evaluation judges occlusions by it (EvaluationSettings::occlusionsByLocalSpacing); empty
+    /// when h is the scale everywhere.
+    std::vector<float> spacing;
 };
 
 /// Whether the scan sampled a surface point (scene coordinates, with its unit outward normal).

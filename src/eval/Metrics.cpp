@@ -26,6 +26,12 @@ double percentile(std::vector<double>& values, double fraction) {
 
 }  // namespace
 
+bool showsThrough(const GroundTruthImages& truth, std::size_t i, float reconstructedDepth,
+                  double h) {
+    const double scale = truth.spacing.empty() ? h : std::max(h, double{truth.spacing[i]});
+    return static_cast<double>(reconstructedDepth) - truth.depth[i] > 3.0 * scale;
+}
+
 QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
                                     const GroundTruthImages& truth, double spacing) {
     std::size_t truthPixels = 0, reconstructed = 0, both = 0, occluded = 0;
@@ -50,7 +56,7 @@ QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,
         const double difference = static_cast<double>(reconstruction.depth[i]) - truth.depth[i];
         depthErrors.push_back(std::abs(difference) / spacing);
         signedDepthErrors.push_back(difference / spacing);
-        occluded += difference > 3.0 * spacing;
+        occluded += showsThrough(truth, i, reconstruction.depth[i], spacing);
         if (hasNormals) {
             const double cosine =
                 std::clamp(static_cast<double>(glm::dot(glm::normalize(reconstruction.normals[i]),

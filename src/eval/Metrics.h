@@ -23,11 +23,18 @@ struct QualityMetrics {
     double leakage = 0.0;             // |rec \ gt| / |rec|
     double depthErrorMedianH = 0.0;   // median |z_rec - z_gt| / h over rec ∩ gt
     double depthBiasH = 0.0;          // median (z_rec - z_gt) / h over rec ∩ gt: < 0 in front
-    double occlusionErrorRate = 0.0;  // share of rec ∩ gt with z_rec - z_gt > 3 h
+    double occlusionErrorRate = 0.0;  // share of rec ∩ gt with z_rec - z_gt > 3 h (or 3 times
+                                      // GroundTruthImages::spacing, where given)
     std::optional<double> normalErrorMeanDeg;
     std::optional<double> normalErrorP95Deg;
     double psnrDb = 0.0;  // shaded image against the shaded ground truth, 8-bit sRGB
 };
+
+/// Whether a reconstructed depth at pixel `i` of `truth` lies so far behind the true surface
+/// that a surface behind it shows through: more than 3 h behind, or 3 times the scan's spacing
+/// there where `truth` gives it (GroundTruthImages::spacing), and never less than 3 h.
+bool showsThrough(const GroundTruthImages& truth, std::size_t i, float reconstructedDepth,
+                  double h);
 
 /// Everything but PSNR, from the images; `spacing` is h. Pixels whose true surface the scan
 /// could not sample (GroundTruthImages::sampled) count nowhere: coverage is over the sampled

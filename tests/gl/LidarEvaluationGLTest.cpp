@@ -1,13 +1,17 @@
 // The evaluation of LiDAR sources (a station, an airborne strip) at a small size: its views
 // near the scanner, coverage counted over the surfaces the scan sampled.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <glm/trigonometric.hpp>
 
 #include "core/Camera.h"
+#include "core/LocalSpacing.h"
 #include "eval/Evaluation.h"
 #include "eval/GroundTruth.h"
 #include "scan/SyntheticScenes.h"
@@ -108,6 +112,52 @@ TEST(LidarEvaluationGLTest, OrbitViewsLookDownAtTheWholeStationScene) {
     ASSERT_GT(surface, 0u);
     EXPECT_GT(unsampled, 0u);
     EXPECT_LT(unsampled, surface);
+}
+
+TEST(LidarEvaluationGLTest, OcclusionsAreJudgedByTheStationsSpacingWhereTheTruthIs) {
+    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    EvaluationSettings settings;
+    settings.views = 1;
+    adaptToScanner(settings, *source.scene, source.scanner, ViewsFrom::Orbit);
+    EXPECT_TRUE(settings.occlusionsByLocalSpacing);
+    const PointSpacing spacing = estimatePointSpacing(source.points);
+    ASSERT_FALSE(spacing.local.empty());
+    const Camera camera =
+        orbitCamera(source.scene->bounds(), settings.viewpoints[0], 128, 128, 45.0);
+    const GroundTruthImages truth = renderGroundTruth(*source.scene, camera, settings.sampled);
+    const std::vector<float> atTruth = SpacingAtTruth(source.points, spacing).at(camera, truth);
+    ASSERT_EQ(atTruth.size(), truth.depth.size());
+    // A station's points lie farther apart with range: on the sampled surfaces near the
+    // station (within 5 m) the spacing is a few h, beyond 20 m many times that (the rings).
+    const glm::dmat4 worldFromView = glm::inverse(camera.view);
+    const double f = camera.focalLengthPixels();
+    std::vector<double> nearRatios, farRatios;
+    for (std::size_t i = 0; i < truth.depth.size(); ++i) {
+        if (!std::isfinite(truth.depth[i]) || truth.sampled[i] == 0) {
+            continue;
+        }
+        const double x = static_cast<double>(i % 128) + 0.5, y = static_cast<double>(i / 128) + 0.5;
+        const double depth = truth.depth[i];
+        const glm::dvec3 world(worldFromView * glm::dvec4((x - 64.0) / f * depth,
+                                                          (64.0 - y) / f * depth, -depth, 1.0));
+        const glm::dvec3 offset = world - *source.scanner.station.position;
+        const double range = std::hypot(offset.x, offset.z);
+        const double ratio = atTruth[i] / spacing.global;
+        if (range < 5.0) {
+            nearRatios.push_back(ratio);
+        } else if (range > 20.0) {
+            farRatios.push_back(ratio);
+        }
+    }
+    ASSERT_GT(nearRatios.size(), 10u);
+    ASSERT_GT(farRatios.size(), 100u);
+    const auto median = [](std::vector<double> values) {
+        std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+        return values[values.size() / 2];
+    };
+    // Measured: 3.3 h near, 130 h far (the far rings' gaps; 30,000 points).
+    EXPECT_LT(median(nearRatios), 6.0);
+    EXPECT_GT(median(farRatios), 10.0 * median(nearRatios));
 }
 
 TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {

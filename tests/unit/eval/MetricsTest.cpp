@@ -40,6 +40,24 @@ TEST(MetricsTest, CountsCoverageLeakageDepthAndOcclusion) {
     EXPECT_FALSE(m.normalErrorMeanDeg.has_value());     // no normals given
 }
 
+TEST(MetricsTest, OcclusionsScaleWithTheScansSpacingWhereGiven) {
+    // 4 pixels, each reconstructed 10 h behind the truth; the scan's spacing there is 0 (none
+    // known: h stands), 2 h, 3.5 h and 5 h. Behind by more than 3 times the larger of h and
+    // that spacing: the first two (10 h > 3 h, 6 h), not the last two (10.5 h, 15 h).
+    const float h = 0.01f;
+    GroundTruthImages truth{4, 1, std::vector<float>(4, 1.0f), std::vector<glm::vec3>(4, {0, 0, 1}),
+                            std::vector<glm::vec3>(4)};
+    truth.spacing = {0.0f, 2 * h, 3.5f * h, 5 * h};
+    const ReconstructionImages reconstruction{std::vector<float>(4, 1.0f + 10 * h), {}};
+    EXPECT_DOUBLE_EQ(compareToGroundTruth(reconstruction, truth, h).occlusionErrorRate, 0.5);
+    for (std::size_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(showsThrough(truth, i, reconstruction.depth[i], h), i < 2) << i;
+    }
+    // Without the spacing, h alone: all four.
+    truth.spacing.clear();
+    EXPECT_DOUBLE_EQ(compareToGroundTruth(reconstruction, truth, h).occlusionErrorRate, 1.0);
+}
+
 TEST(MetricsTest, UnsampledTruthCountsNeitherForCoverageNorForLeakage) {
     // 8 pixels of truth, 0..7; the scan could sample only 0..3. The reconstruction covers 0..2
     // and 4..5 (true surface it could not know about) and 9 (nothing there).

@@ -1,0 +1,28 @@
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <thread>
+#include <vector>
+
+namespace subscan {
+
+/// Runs `work(i)` for every i < count, split across the machine's cores (at most 16) in
+/// contiguous ranges.
+template <class Work>
+void inParallel(std::size_t count, const Work& work) {
+    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+    const auto range = [&](std::size_t thread) {
+        const std::size_t last = (thread + 1) * count / threads;
+        for (std::size_t i = thread * count / threads; i < last; ++i) {
+            work(i);
+        }
+    };
+    std::vector<std::jthread> workers;
+    for (std::size_t thread = 1; thread < threads; ++thread) {
+        workers.emplace_back(range, thread);
+    }
+    range(0);
+}
+
+}  // namespace subscan
