@@ -196,6 +196,12 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
     return camera;
 }
 
+glm::dvec3 pixelCentreDirection(const Camera& camera, int x, int y) {
+    const double focal = camera.focalLengthPixels();
+    return {(x + 0.5 - 0.5 * camera.width) / focal, (0.5 * camera.height - (y + 0.5)) / focal,
+            -1.0};
+}
+
 UpAxis upAxisFor(std::string_view up, std::string_view format) {
     if (up != "auto" && up != "y" && up != "z") {
         throw Error(fmt::format("up '{}' is not auto, y or z", up));

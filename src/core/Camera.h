@@ -57,6 +57,10 @@ struct Camera {
 /// then unbounded); empty (x1 <= x0) when `bounds` is empty or falls outside the image.
 glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds);
 
+/// The view-space direction through the centre of pixel (x, y) (row 0 at the top) of a
+/// perspective camera, scaled to z = −1: the view-space point at linear depth d is d times it.
+glm::dvec3 pixelCentreDirection(const Camera& camera, int x, int y);
+
 enum class UpAxis { Y, Z };
 
 /// The up axis `up` ("auto", "y" or "z") names for a scan read as `format` (LoadedScan's and

@@ -114,13 +114,10 @@ std::vector<float> atOutputPixels(const Renderer& renderer, const char* name, in
 /// Normals that face the eye, for flat shading of methods without normals.
 std::vector<glm::vec3> towardsEye(const Camera& camera) {
     std::vector<glm::vec3> normals(static_cast<std::size_t>(camera.width * camera.height));
-    const double focal = camera.focalLengthPixels();
     for (int y = 0; y < camera.height; ++y) {
         for (int x = 0; x < camera.width; ++x) {
-            const glm::dvec3 direction((x + 0.5 - 0.5 * camera.width) / focal,
-                                       (0.5 * camera.height - (y + 0.5)) / focal, -1.0);
             normals[static_cast<std::size_t>(y * camera.width + x)] =
-                glm::vec3(-glm::normalize(direction));
+                glm::vec3(-glm::normalize(pixelCentreDirection(camera, x, y)));
         }
     }
     return normals;
@@ -201,17 +198,14 @@ std::vector<float> SpacingAtTruth::at(const Camera& camera, const GroundTruthIma
         return spacing;
     }
     const glm::dmat4 worldFromView = glm::inverse(camera.view);
-    const double focal = camera.focalLengthPixels();
-    const int width = camera.width;
+    const auto width = static_cast<std::size_t>(camera.width);
     inParallel(truth.depth.size(), [&](std::size_t i) {
         if (!std::isfinite(truth.depth[i])) {
             return;
         }
-        const double x = static_cast<double>(i % static_cast<std::size_t>(width)) + 0.5;
-        const double y = static_cast<double>(i / static_cast<std::size_t>(width)) + 0.5;
-        const double depth = truth.depth[i];
-        const glm::dvec3 inView((x - 0.5 * width) / focal * depth,
-                                (0.5 * camera.height - y) / focal * depth, -depth);
+        const glm::dvec3 inView =
+            static_cast<double>(truth.depth[i]) *
+            pixelCentreDirection(camera, static_cast<int>(i % width), static_cast<int>(i / width));
         const glm::vec3 query(glm::dvec3(worldFromView * glm::dvec4(inView, 1.0)) - points_.origin);
         std::uint32_t nearest = 0;
         float squared = 0.0f;
@@ -539,9 +533,12 @@ void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
         };
     };
     if (scanner.mode == ScannerSettings::Mode::Station) {
-        const glm::dvec3 station = stationPosition(scene, scanner.station);
-        fixed.station.position = station;  // found once, not per pixel
-        settings.scannerView = [station](double degrees) {
+        fixed.station.position = stationPosition(scene, scanner.station);  // once, not per pixel
+    }
+    if (viewsFrom == ViewsFrom::Orbit) {
+        settings.scannerView = orbitAt(30.0);
+    } else if (scanner.mode == ScannerSettings::Mode::Station) {
+        settings.scannerView = [station = *fixed.station.position](double degrees) {
             constexpr double kAbove = 1.0, kBehind = 1.0, kLookDistance = 20.0, kDownDegrees = 10.0;
             const double azimuth = glm::radians(kFirstAzimuthDegrees + degrees);
             const glm::dvec3 outward(std::sin(azimuth), 0.0, std::cos(azimuth));
@@ -553,9 +550,6 @@ void adaptToScanner(EvaluationSettings& settings, const Scene& scene,
         };
     } else {
         settings.scannerView = orbitAt(45.0);
-    }
-    if (viewsFrom == ViewsFrom::Orbit) {
-        settings.scannerView = orbitAt(30.0);
     }
     settings.viewpoints.clear();
     for (int view = 0; view < settings.views; ++view) {

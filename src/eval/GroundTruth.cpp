@@ -23,14 +23,12 @@ GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera,
     const glm::dmat4 toFile = glm::inverse(camera.view);
     const glm::dvec3 eye = camera.eye();
     const glm::dmat3 rotation(camera.view);
-    const double focal = camera.focalLengthPixels();
     const double maxDistance = 2.0 * camera.farPlane;
 
     auto renderRows = [&](int firstRow, int rowStep) {
         for (int y = firstRow; y < height; y += rowStep) {
             for (int x = 0; x < width; ++x) {
-                const glm::dvec3 viewDirection((x + 0.5 - 0.5 * width) / focal,
-                                               (0.5 * height - (y + 0.5)) / focal, -1.0);
+                const glm::dvec3 viewDirection = pixelCentreDirection(camera, x, y);
                 Ray ray;
                 ray.origin = eye;
                 ray.direction = glm::normalize(glm::dvec3(toFile * glm::dvec4(viewDirection, 0.0)));

@@ -25,6 +25,22 @@ void expectFraction(double value, const char* what) {
     EXPECT_LE(value, 1.0) << what;
 }
 
+/// Of a view's true surface pixels, how many there are and how many of them the scan could not
+/// sample.
+struct SampledCount {
+    std::size_t surface = 0, unsampled = 0;
+};
+SampledCount countSampled(const GroundTruthImages& truth) {
+    SampledCount count;
+    for (std::size_t i = 0; i < truth.depth.size(); ++i) {
+        if (std::isfinite(truth.depth[i])) {
+            ++count.surface;
+            count.unsampled += truth.sampled[i] == 0;
+        }
+    }
+    return count;
+}
+
 /// `views` square views of `size` pixels near the source's scanner.
 EvaluationSettings viewsNearTheScanner(const SyntheticSource& source, int views, int size) {
     EvaluationSettings settings;
@@ -101,17 +117,11 @@ TEST(LidarEvaluationGLTest, OrbitViewsLookDownAtTheWholeStationScene) {
     // The scan's own sampling still decides what counts: the truth leaves unsampled surfaces
     // (backs of buildings, ground behind walls) out, which the orbit sees plenty of.
     const Camera camera = orbitCamera(bounds, settings.viewpoints[0], 96, 96, 45.0);
-    const GroundTruthImages truth = renderGroundTruth(*source.scene, camera, settings.sampled);
-    std::size_t surface = 0, unsampled = 0;
-    for (std::size_t i = 0; i < truth.depth.size(); ++i) {
-        if (std::isfinite(truth.depth[i])) {
-            ++surface;
-            unsampled += truth.sampled[i] == 0;
-        }
-    }
-    ASSERT_GT(surface, 0u);
-    EXPECT_GT(unsampled, 0u);
-    EXPECT_LT(unsampled, surface);
+    const SampledCount count =
+        countSampled(renderGroundTruth(*source.scene, camera, settings.sampled));
+    ASSERT_GT(count.surface, 0u);
+    EXPECT_GT(count.unsampled, 0u);
+    EXPECT_LT(count.unsampled, count.surface);
 }
 
 TEST(LidarEvaluationGLTest, OcclusionsAreJudgedByTheStationsSpacingWhereTheTruthIs) {
@@ -130,16 +140,15 @@ TEST(LidarEvaluationGLTest, OcclusionsAreJudgedByTheStationsSpacingWhereTheTruth
     // A station's points lie farther apart with range: on the sampled surfaces near the
     // station (within 5 m) the spacing is a few h, beyond 20 m many times that (the rings).
     const glm::dmat4 worldFromView = glm::inverse(camera.view);
-    const double f = camera.focalLengthPixels();
     std::vector<double> nearRatios, farRatios;
     for (std::size_t i = 0; i < truth.depth.size(); ++i) {
         if (!std::isfinite(truth.depth[i]) || truth.sampled[i] == 0) {
             continue;
         }
-        const double x = static_cast<double>(i % 128) + 0.5, y = static_cast<double>(i / 128) + 0.5;
-        const double depth = truth.depth[i];
-        const glm::dvec3 world(worldFromView * glm::dvec4((x - 64.0) / f * depth,
-                                                          (64.0 - y) / f * depth, -depth, 1.0));
+        const glm::dvec3 inView =
+            static_cast<double>(truth.depth[i]) *
+            pixelCentreDirection(camera, static_cast<int>(i % 128), static_cast<int>(i / 128));
+        const glm::dvec3 world(worldFromView * glm::dvec4(inView, 1.0));
         const glm::dvec3 offset = world - *source.scanner.station.position;
         const double range = std::hypot(offset.x, offset.z);
         const double ratio = atTruth[i] / spacing.global;
@@ -171,15 +180,9 @@ TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {
     const Camera camera = orbitCamera(source.scene->bounds(), settings.viewpoints[0], 96, 96, 45.0);
     const GroundTruthImages truth = renderGroundTruth(*source.scene, camera, settings.sampled);
     ASSERT_EQ(truth.sampled.size(), truth.depth.size());
-    std::size_t surface = 0, unsampled = 0;
-    for (std::size_t i = 0; i < truth.depth.size(); ++i) {
-        if (std::isfinite(truth.depth[i])) {
-            ++surface;
-            unsampled += truth.sampled[i] == 0;
-        }
-    }
-    ASSERT_GT(surface, 0u);
-    const double share = static_cast<double>(unsampled) / static_cast<double>(surface);
+    const SampledCount count = countSampled(truth);
+    ASSERT_GT(count.surface, 0u);
+    const double share = static_cast<double>(count.unsampled) / static_cast<double>(count.surface);
     // The office's and the tower's +X walls cover a few percent of the view; everything else is
     // sampled, so the share is small but not zero.
     EXPECT_GT(share, 0.002);

@@ -89,9 +89,7 @@ struct Ray {
     glm::dvec3 origin, direction;
 };
 Ray pixelRay(const Camera& camera, int x, int y) {
-    const double f = camera.focalLengthPixels();
-    const glm::dvec3 inView((x + 0.5 - 0.5 * camera.width) / f, (0.5 * camera.height - y - 0.5) / f,
-                            -1.0);
+    const glm::dvec3 inView = pixelCentreDirection(camera, x, y);
     const glm::dmat4 worldFromView = glm::inverse(camera.view);
     return {glm::dvec3(worldFromView * glm::dvec4(0, 0, 0, 1)),
             glm::normalize(glm::dvec3(worldFromView * glm::dvec4(inView, 0.0)))};
@@ -277,10 +275,10 @@ PointCloud slab(double thickness, double side, double spacing) {
 constexpr double kSlabSpacing = 0.01;  // mm: a twentieth of the thinnest slab
 constexpr int kSlabSamples = 63;       // the most the pass takes but one (a multiple of 3)
 
-BackLitSlab renderBackLitSlab(double thickness, const glm::dvec3& towardsLight, LightPath path) {
-    // 2 mm wide: the light reaches the middle through the back face, not the sides, for the
-    // thickest slab (0.76 mm) at the test's angle.
-    Renderer renderer(test::glTestContext(), slab(thickness, 2.0, kSlabSpacing), kSlabSpacing);
+/// Single scattering alone in marble (millimetres, the material's coefficients, kSlabSamples)
+/// under one white directional light, its entries found by `path`.
+RenderSettings marbleSingleScattering(const glm::dvec3& towardsLight, LightPath path,
+                                      float g = 0.0f) {
     RenderSettings settings = lightOnly(towardsLight);
     settings.raster.mode = RenderMode::Sss;
     ScatteringSettings& scattering = settings.scattering;
@@ -288,8 +286,17 @@ BackLitSlab renderBackLitSlab(double thickness, const glm::dvec3& towardsLight, 
     scattering.coefficients = CoefficientSource::Material;
     scattering.material = "marble";
     scattering.unit = SceneUnit::Millimetre;
+    scattering.phaseG = g;
     scattering.singleSamples = kSlabSamples;
     scattering.lightPath = path;
+    return settings;
+}
+
+BackLitSlab renderBackLitSlab(double thickness, const glm::dvec3& towardsLight, LightPath path) {
+    // 2 mm wide: the light reaches the middle through the back face, not the sides, for the
+    // thickest slab (0.76 mm) at the test's angle.
+    Renderer renderer(test::glTestContext(), slab(thickness, 2.0, kSlabSpacing), kSlabSpacing);
+    const RenderSettings settings = marbleSingleScattering(towardsLight, path);
     // 32² pixels over 0.4 mm: a pixel (0.0125 mm) holds at least one point of the front face,
     // so the back face never shows.
     Camera camera;
@@ -417,16 +424,7 @@ FrontLitPlate renderFrontLitPlate(double lightDegrees, double viewDegrees, float
     Renderer renderer(test::glTestContext(), marblePlate(), kPlateSpacing);
     const double light = glm::radians(lightDegrees), view = glm::radians(viewDegrees);
     const glm::dvec3 towardsLight(0.0, -std::sin(light), std::cos(light));
-    RenderSettings settings = lightOnly(towardsLight);
-    settings.raster.mode = RenderMode::Sss;
-    ScatteringSettings& scattering = settings.scattering;
-    scattering.method = ScatteringMethod::Single;
-    scattering.coefficients = CoefficientSource::Material;
-    scattering.material = "marble";
-    scattering.unit = SceneUnit::Millimetre;
-    scattering.phaseG = g;
-    scattering.singleSamples = kSlabSamples;
-    scattering.lightPath = path;
+    const RenderSettings settings = marbleSingleScattering(towardsLight, path, g);
     // 6 mm seen from 40 mm: a pixel is 0.125 mm, a third of marble's mean free path, so that
     // where in its pixel the reconstruction puts the surface matters.
     Camera camera;
