@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (clang, ASan + UBSan) and fuzzes each reader in turn.
+# Builds the libFuzzer targets (clang, ASan + UBSan, in build-sanitize: scripts/sanitize-build.sh)
+# and fuzzes each reader for N seconds, as many readers at a time as there are cores.
 #   scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off ...]   default: 300 s each, all
 # Seeds: tiny files written here or by the unit tests that build them (LAZ, COPC, E57; from the
 # Release build in build/), plus small real scans from ../shared/data when present (copied into
 # the build folder only). A finding stops the script with a non-zero exit and
-# leaves the input under build-fuzz/artifacts/.
+# leaves the input under build-sanitize/artifacts/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,10 +21,8 @@ done
 [[ ${#readers[@]} -gt 0 ]] || readers=(ply las laz copc pcd xyz e57 off)
 
 scripts/setup-deps.sh
-build=build-fuzz
-CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DSUBSCAN_FUZZ=ON \
-    -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build "$build" --target "${readers[@]/#/fuzz_}"
+build=build-sanitize
+scripts/sanitize-build.sh "${readers[@]/#/fuzz_}" >/dev/null
 
 # Seeds the unit tests build (a LAZ encoder, an E57 writer live there): run them from the
 # Release build, building just those tests when it lacks them.
@@ -99,22 +98,45 @@ write_seeds() {  # reader directory
     fi
 }
 
-mkdir -p "$build/artifacts"
-for reader in "${readers[@]}"; do
-    corpus="$build/corpus/$reader"
-    seeds="$build/seeds/$reader"
-    mkdir -p "$corpus" "$seeds"
-    write_seeds "$reader" "$seeds"
-    log="$build/fuzz-$reader.log"
-    echo "fuzz: $reader for ${seconds}s (log: $log)"
+fuzz() {  # reader: fuzzes it for $seconds; its output goes to its log
+    local reader=$1
     # -rss_limit_mb/-malloc_limit_mb turn allocation bombs from lying headers into findings.
-    if ! "$build/tests/fuzz/fuzz_$reader" -max_total_time="$seconds" -timeout=10 \
+    "$build/tests/fuzz/fuzz_$reader" -max_total_time="$seconds" -timeout=10 \
         -rss_limit_mb=2048 -malloc_limit_mb=1024 -max_len=65536 -print_final_stats=1 \
-        -artifact_prefix="$build/artifacts/$reader-" "$corpus" "$seeds" >"$log" 2>&1; then
+        -artifact_prefix="$build/artifacts/$reader-" "$build/corpus/$reader" \
+        "$build/seeds/$reader" >"$build/fuzz-$reader.log" 2>&1
+}
+report() {  # reader status
+    local reader=$1 status=$2 log="$build/fuzz-$1.log"
+    if [[ $status -ne 0 ]]; then
         tail -n 40 "$log" >&2
         echo "fuzz: $reader found a problem; the input is in $build/artifacts/" >&2
-        exit 1
+        return 1
     fi
     executions=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo '?')
-    echo "fuzz: $reader ok, $executions executions"
+    echo "fuzz: $reader ok, $executions executions (log: $log)"
+}
+
+mkdir -p "$build/artifacts"
+for reader in "${readers[@]}"; do
+    mkdir -p "$build/corpus/$reader" "$build/seeds/$reader"
+    write_seeds "$reader" "$build/seeds/$reader"
+done
+# Side by side in groups of one per core; each reader still gets its full N seconds.
+failed=0
+parallel=$(nproc)
+for ((first = 0; first < ${#readers[@]}; first += parallel)); do
+    group=("${readers[@]:first:parallel}")
+    echo "fuzz: ${group[*]} for ${seconds}s"
+    pids=()
+    for reader in "${group[@]}"; do
+        fuzz "$reader" &
+        pids+=($!)
+    done
+    for i in "${!group[@]}"; do
+        status=0
+        wait "${pids[i]}" || status=$?
+        report "${group[i]}" "$status" || failed=1
+    done
+    [[ $failed -eq 0 ]] || exit 1
 done

@@ -6,6 +6,8 @@ set -euo pipefail
 packages=(
     # build
     cmake g++ ninja-build pkg-config
+    # compiler cache (CMake uses it when present; scripts/test.sh reuses objects across clones)
+    ccache
     # fuzzing (scripts/fuzz.sh): clang with its libFuzzer/sanitizer runtimes
     clang libclang-rt-14-dev
     # GL: loader, EGL headers, Mesa's software rasterizer for GPU-less machines

@@ -43,12 +43,6 @@ auto argumentErrors(Function&& function) {
     }
 }
 
-void checkRange(double value, double low, double high, std::string_view name) {
-    if (!(value >= low && value <= high)) {
-        throw py::value_error(fmt::format("{} {} is outside {}..{}", name, value, low, high));
-    }
-}
-
 /// `subscan materials --json`.
 py::list materials() {
     py::list list;

@@ -79,12 +79,6 @@ glm::dmat4 matrixArgument(const py::handle& object) {
     return matrix;
 }
 
-void checkRange(double value, double low, double high, std::string_view name) {
-    if (!(value >= low && value <= high)) {
-        throw py::value_error(fmt::format("{} {} is outside {}..{}", name, value, low, high));
-    }
-}
-
 /// Camera.orbit: the CLI's --yaw, --pitch, --distance, --up, --fovy, --width and --height,
 /// with the CLI's ranges.
 Camera orbit(const CloudData& cloud, double yaw, double pitch, std::optional<double> distance,
@@ -177,7 +171,7 @@ Camera lookAt(const py::handle& eyeObject, const py::handle& targetObject,
     return checked(camera);
 }
 
-Camera fromJson(const py::handle& object) {
+Camera cameraFromPythonJson(const py::handle& object) {
     nlohmann::json json;
     if (py::isinstance<py::str>(object)) {
         try {
@@ -250,7 +244,7 @@ sensor and none is given, or the sensor is more than 20 extents from the points.
 A camera at `eye` looking at `target` (both in the cloud's coordinates) with `up` towards the
 top of the picture. Give near and far, or a cloud whose bounding sphere they then hug.
 )doc")
-        .def_static("from_json", &fromJson, py::arg("json"),
+        .def_static("from_json", &cameraFromPythonJson, py::arg("json"),
                     "A camera from camera.json's text (str) or its dict; ValueError names a "
                     "missing or bad field.")
         .def_static(

@@ -41,6 +41,12 @@ const Bounds& CloudData::framed() const {
     return framed_;
 }
 
+void checkRange(double value, double low, double high, std::string_view name) {
+    if (!(value >= low && value <= high)) {
+        throw py::value_error(fmt::format("{} {} is outside {}..{}", name, value, low, high));
+    }
+}
+
 std::string pathArgument(const py::handle& argument) {
     try {
         return py::module_::import("os").attr("fspath")(argument).cast<std::string>();

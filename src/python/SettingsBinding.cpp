@@ -72,7 +72,7 @@ struct SettingsSection {
     }
 };
 
-SettingsHandle fromJson(const py::handle& object) {
+SettingsHandle settingsFromPythonJson(const py::handle& object) {
     return std::make_shared<SettingsData>(
         SettingsData{patched(RenderSettings{}, parseJson(object, "the settings"))});
 }
@@ -133,7 +133,7 @@ it: sections raster, surface, shading, scattering and temporal, each a set of ke
 
 Settings(**sections) starts from the defaults and writes the given sections' keys over them.
 )doc")
-        .def(py::init([](const py::kwargs& sections) { return fromJson(sections); }))
+        .def(py::init([](const py::kwargs& sections) { return settingsFromPythonJson(sections); }))
         .def_static(
             "load",
             [](const py::object& path) {
@@ -149,7 +149,7 @@ Settings(**sections) starts from the defaults and writes the given sections' key
                 writeSettingsFile(pathArgument(path), self.value);
             },
             py::arg("path"), "Writes the settings file (all keys), atomically.")
-        .def_static("from_json", &fromJson, py::arg("json"),
+        .def_static("from_json", &settingsFromPythonJson, py::arg("json"),
                     "Settings from the settings file's text (str) or its dict, over the "
                     "defaults; ValueError names an unknown key or a bad value.")
         .def(

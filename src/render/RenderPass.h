@@ -91,6 +91,12 @@ struct FrameContext {
 constexpr GLbitfield kPyramidWritesBarrier =
     GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT;
 
+/// Between the dispatches of a pass that reads its own image writes back: through image loads,
+/// texture fetches or a texture upload.
+constexpr GLbitfield kImageWritesBarrier = GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                                           GL_TEXTURE_FETCH_BARRIER_BIT |
+                                           GL_TEXTURE_UPDATE_BARRIER_BIT;
+
 /// Who computes the full-resolution level of the surface pipeline (push, mask, normals, shading,
 /// encoding): each pass its own (PerPass: every intermediate image exists, for stage views,
 /// exports, scattering and evaluation), or FinishSurfacePass in one dispatch (Fused:

@@ -8,9 +8,6 @@ namespace subscan {
 
 namespace {
 
-constexpr GLbitfield kImageBarriers = GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                                      GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT;
-
 glm::vec4 rgbVector(const Rgb& value) {
     return {static_cast<float>(value[0]), static_cast<float>(value[1]),
             static_cast<float>(value[2]), 0.0f};
@@ -108,7 +105,7 @@ void SingleScatteringPass::execute(FrameContext& frame) {
         : frame.lightMaps != nullptr && settings.lightPath == LightPath::LightMap ? MappedLights
                                                                                   : MarchedLights;
     stages_.runOverRegion(stage, frame.region(0));
-    glMemoryBarrier(kImageBarriers);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

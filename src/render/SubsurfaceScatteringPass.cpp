@@ -9,9 +9,6 @@ namespace subscan {
 
 namespace {
 
-constexpr GLbitfield kImageBarriers = GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                                      GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT;
-
 glm::vec4 weightVector(const std::array<float, 3>& weight) {
     return {weight[0], weight[1], weight[2], 0.0f};
 }
@@ -86,7 +83,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     source.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     sum.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     stages_.runOverRegion(Prepare, region);
-    glMemoryBarrier(kImageBarriers);
+    glMemoryBarrier(kImageWritesBarrier);
 
     for (const BlurStep& step : chain.steps) {
         params.blur.x = static_cast<float>(step.sigma);
@@ -95,7 +92,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
         (step.fromPrevious ? blurred : source).bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
         half.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
         stages_.runOverRegion(Blur, region);
-        glMemoryBarrier(kImageBarriers);
+        glMemoryBarrier(kImageWritesBarrier);
 
         params.blur.z = 1.0f;
         params.weight = weightVector(step.weight);
@@ -104,7 +101,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
         blurred.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
         sum.bindImage(SUBSCAN_IMAGE_OUT1, GL_READ_WRITE);
         stages_.runOverRegion(BlurAccumulate, region);
-        glMemoryBarrier(kImageBarriers);
+        glMemoryBarrier(kImageWritesBarrier);
     }
 
     sum.bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
@@ -115,7 +112,7 @@ void SubsurfaceScatteringPass::execute(FrameContext& frame) {
     }
     radiance.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     stages_.runOverRegion(Combine, region);
-    glMemoryBarrier(kImageBarriers);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

@@ -66,6 +66,9 @@ template <class... Visitors>
 struct Overloaded : Visitors... {
     using Visitors::operator()...;
 };
+// Clang 14 (the sanitized build) deduces an aggregate's template arguments only through a guide.
+template <class... Visitors>
+Overloaded(Visitors...) -> Overloaded<Visitors...>;
 
 bool sameCamera(const Camera& a, const Camera& b) {
     return a.width == b.width && a.height == b.height && a.fovyDegrees == b.fovyDegrees &&
