@@ -30,12 +30,12 @@ void nearestByKdTree(const std::vector<glm::vec3>& points, const std::vector<glm
                      std::span<const std::uint32_t> which, std::vector<float>& nearest) {
     const PositionsAdaptor adaptor{points};
     const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    constexpr std::size_t kNeighbours = 8;
-    std::array<std::uint32_t, kNeighbours> indices{};
-    std::array<float, kNeighbours> squaredDistances{};
+    constexpr std::size_t kCandidates = 8;
+    std::array<std::uint32_t, kCandidates> indices{};
+    std::array<float, kCandidates> squaredDistances{};
     for (const std::uint32_t q : which) {
         const std::size_t found =
-            tree.knnSearch(&queries[q].x, kNeighbours, indices.data(), squaredDistances.data());
+            tree.knnSearch(&queries[q].x, kCandidates, indices.data(), squaredDistances.data());
         for (std::size_t k = 0; k < found; ++k) {
             if (squaredDistances[k] > 0.0f) {
                 nearest[q] = std::min(nearest[q], squaredDistances[k]);

@@ -483,7 +483,7 @@ TEST(LightMapsGLTest, FrontLitPlateMatchesTheClosedFormThroughTheLightMap) {
     // their pixels (before the registration, lightMapRegistration, the map's medians were
     // 1.11 / 0.97 / 1.12 / 1.04 / 1.06 at g = 0 and 1.20 / 0.95 / 1.23 / 1.08 / 1.12 at g = 0.5).
     for (const float g : {0.0f, 0.5f}) {
-        for (const auto [light, view] :
+        for (const auto& [light, view] :
              {std::pair{0.0, 60.0}, {60.0, 0.0}, {30.0, 60.0}, {60.0, 30.0}, {30.0, 30.0}}) {
             for (const LightPath path : {LightPath::Screen, LightPath::LightMap}) {
                 const std::vector<double> ratios =

@@ -131,7 +131,7 @@ TEST(ScanCommandTest, AStationIsPlacedAsXYZOrAsRendersXCommaYCommaZ) {
     EXPECT_GT(scans[0].size(), 100u);
     EXPECT_EQ(scans[0], scans[1]);
     // Two coordinates, or one that is not a number: usage errors.
-    for (const std::string& bad : {"5,1.5", "5,x,3"}) {
+    for (const std::string bad : {"5,1.5", "5,x,3"}) {
         const test::CommandResult result =
             runSubscan({"scan", "synthetic:outdoor", "-o", (dir / "bad.ply").string(), "--mode",
                         "station", "--station", bad});

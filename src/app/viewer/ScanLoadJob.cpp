@@ -30,7 +30,7 @@ void ScanLoadJob::load() {
         progress_.store(fraction, std::memory_order_relaxed);
     };
     try {
-        PreparedScan prepared{source_, loadScan(source_, reportProgress), 0.0};
+        PreparedScan prepared{source_, loadScan(source_, reportProgress), {}};
         prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
         result_ = std::move(prepared);
     } catch (const LoadCancelled&) {

@@ -395,7 +395,7 @@ TEST(E57ReaderTest, ValuesAsWideAsSixtyFourBits) {
                          static_cast<double>(-y62) * 1e-18, 0.0);
     test::expectPosition(cloud, 2, static_cast<double>(hi) * 1e-18,
                          static_cast<double>(y62) * 1e-18, static_cast<double>(z33) * 1e-9);
-    test::expectPosition(cloud, 3, 12345678901234567 * 1e-18, 3e-18, 5e-9);
+    test::expectPosition(cloud, 3, static_cast<double>(12345678901234567) * 1e-18, 3e-18, 5e-9);
 }
 
 TEST(E57ReaderTest, TwoScansAreJoinedEachWithItsPose) {
