@@ -107,7 +107,7 @@ fuzz() {  # reader: fuzzes it for $seconds; its output goes to its log
         "$build/seeds/$reader" >"$build/fuzz-$reader.log" 2>&1
 }
 report() {  # reader status
-    local reader=$1 status=$2 log="$build/fuzz-$1.log"
+    local reader=$1 status=$2 log="$build/fuzz-$1.log" executions
     if [[ $status -ne 0 ]]; then
         tail -n 40 "$log" >&2
         echo "fuzz: $reader found a problem; the input is in $build/artifacts/" >&2

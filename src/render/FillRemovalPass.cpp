@@ -71,8 +71,7 @@ void FillRemovalPass::execute(FrameContext& frame) {
         mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     }
     stages_.runOverRegion(fused ? SurfaceDepth : Mask, frame.region(0));
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

@@ -138,8 +138,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     ComputeStages::setRegionUniforms(shader, region);
     Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
                         SUBSCAN_IMAGE_GROUP_SIZE);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
     if (output_ == Output::Temporal) {
         history_->end(frame, mode);
     }

@@ -12,8 +12,7 @@ void HiddenPointRemovalPass::execute(FrameContext& frame) {
     frame.resources.texture("color").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     visibility.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     stages_.runOverRegion(0, frame.region(0));
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

@@ -14,8 +14,7 @@ void LightMapPass::execute(FrameContext& frame) {
     // Every texel: the map is read anywhere a shaded point projects, and the surface depth is
     // +inf outside the points' region.
     stages_.runOverImage(0, frame.width(), frame.height());
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

@@ -71,8 +71,7 @@ void PresentPass::execute(FrameContext& frame) {
     } else {
         stages_.runOverRegion(0, outputRegion(frame));
     }
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

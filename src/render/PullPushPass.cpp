@@ -56,8 +56,7 @@ void PullPushPass::execute(FrameContext& frame) {
     for (unsigned level = levels - 1; level-- > lastLevel;) {
         run(Push, level);
     }
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

@@ -91,8 +91,8 @@ struct FrameContext {
 constexpr GLbitfield kPyramidWritesBarrier =
     GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT;
 
-/// Between the dispatches of a pass that reads its own image writes back: through image loads,
-/// texture fetches or a texture upload.
+/// After a dispatch's image writes, before anything reads them: image loads, texture fetches,
+/// or texture uploads and downloads.
 constexpr GLbitfield kImageWritesBarrier = GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                                            GL_TEXTURE_FETCH_BARRIER_BIT |
                                            GL_TEXTURE_UPDATE_BARRIER_BIT;

@@ -95,8 +95,7 @@ void ShadePass::execute(FrameContext& frame) {
     }
     radiance.bindImage(SUBSCAN_IMAGE_OUT3, GL_WRITE_ONLY);
     stages_.runOverRegion(0, frame.region(0));
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

@@ -90,8 +90,7 @@ void StageViewPass::execute(FrameContext& frame) {
     const unsigned level = static_cast<unsigned>(std::clamp(
         frame.settings.raster.stageLevel, 0, static_cast<int>(frame.pyramid.info.x) - 1));
     stages_.runOverImage(0, frame.width(), frame.height(), level);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
 }
 
 }  // namespace subscan

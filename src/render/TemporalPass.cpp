@@ -183,8 +183,7 @@ void TemporalPass::execute(FrameContext& frame) {
     }
     variants.runOverRegion(static_cast<std::size_t>(mode) + (writesPicture_ ? 3 : 0),
                            frame.region(0));
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glMemoryBarrier(kImageWritesBarrier);
     history_.end(frame, mode);
 }
 
