@@ -1,6 +1,9 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -15,6 +18,34 @@ namespace {
 constexpr int kExitError = 1;
 constexpr int kExitUsage = 2;
 
+/// Pages of the manual (docs/ in the source tree) beside each command's reference in
+/// docs/cli.md; tests/docs checks that every page and anchor a --help names exists.
+constexpr std::pair<std::string_view, std::string_view> kTopicPages[] = {
+    {"render", "docs/pipeline.md"},
+    {"turntable", "docs/temporal.md"},
+    {"eval", "docs/eval.md"},
+    {"bench", "bench/README.md"},
+    {"materials", "docs/scattering.md"},
+    {"fit-profile", "docs/scattering.md"},
+    {"scan", "docs/surveys.md"},
+    {"info", "docs/formats.md"},
+    {"convert", "docs/formats.md"},
+};
+
+/// Ends every command's --help with the manual's pages that cover it.
+void addManualFooters(CLI::App& app) {
+    app.footer("Manual: README.md and docs/ in the subscan sources (docs/cli.md: every command)");
+    for (CLI::App* command : app.get_subcommands({})) {
+        std::string footer = fmt::format("Manual: docs/cli.md#subscan-{}", command->get_name());
+        for (const auto& [name, page] : kTopicPages) {
+            if (name == command->get_name()) {
+                footer += fmt::format(" and {}", page);
+            }
+        }
+        command->footer(footer);
+    }
+}
+
 }  // namespace
 
 int run(int argc, char** argv) {
@@ -28,6 +59,7 @@ int run(int argc, char** argv) {
                                         addEvalCommand(app),      addBenchCommand(app),
                                         addMaterialsCommand(app), addFitProfileCommand(app),
                                         addViewCommand(app),      addTurntableCommand(app)};
+    addManualFooters(app);
 
     try {
         app.parse(argc, argv);

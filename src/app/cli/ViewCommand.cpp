@@ -109,7 +109,7 @@ Command addViewCommand(CLI::App& parent) {
                      "classification")
         ->check(CLI::IsMember(coloringNames()));
     view->add_option("--script", options->scriptFile,
-                     "JSON list of timed camera actions (see README)")
+                     "JSON list of timed camera actions (docs/cli.md#subscan-view)")
         ->check(CLI::ExistingFile);
     view->add_option("--screenshot", options->screenshot,
                      "PNG of the window (panel included) to write at exit, with its camera.json");
