@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the README's pictures in docs/images from the Stanford Happy Buddha scan in
+# Regenerates the documentation's pictures in docs/images from the Stanford Happy Buddha scan in
 # ../shared/data (or $SUBSCAN_TEST_DATA).
 set -euo pipefail
 cd "$(dirname "$0")/.."

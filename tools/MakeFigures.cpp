@@ -1,4 +1,4 @@
-// Renders the README's figures: the stages of the surface pipeline side by side (like the
+// Renders the documentation's figures: the stages of the surface pipeline side by side (like the
 // paper's Figure 2), a points/splats/surface comparison, and the surface beside marble and skin
 // (like the paper's Figure 8), the two scattering paths under a grazing key light, shadows of a
 // side light, and light through thin parts lit from behind. Run by scripts/make-figures.sh.

@@ -77,7 +77,7 @@ uint occupiedCells(ivec2 pixel) {
 /// and only where the densest neighbour holds points in 3 cells or more: with 2, one cell more
 /// or less is half of the count, noise rather than area. Sparse clouds show the area less
 /// exactly (a cell holds one point or several alike), yet the rule still moves their outlines
-/// closer to the truth (README, "Measured quality").
+/// closer to the truth (docs/eval.md, "Measured quality").
 bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
     // The 4-neighbours without points first: off the outline (nearly every pixel) none is, and
     // the counts and the fill's reach below are skipped (llvmpipe skips a loop only where

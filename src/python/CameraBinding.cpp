@@ -193,7 +193,7 @@ Camera cameraFromPythonJson(const py::handle& object) {
 
 void bindCamera(py::module_& module) {
     py::class_<Camera>(module, "Camera", R"doc(
-A pinhole camera in camera.json's conventions (README, "Pixel convention"): right-handed,
+A pinhole camera in camera.json's conventions (docs/cli.md, "Pixel convention"): right-handed,
 looking down -Z in view space, Y up; `view` maps the cloud's own coordinates to view space.
 
 Camera(width=1280, height=720, fovy=45.0, near=0.01, far=100.0, view=identity)

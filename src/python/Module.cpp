@@ -1,4 +1,4 @@
-// The Python module `subscan`: the library from numpy (README.md, "Python").
+// The Python module `subscan`: the library from numpy (docs/python.md).
 #include <pybind11/pybind11.h>
 
 #include "core/Error.h"
@@ -8,7 +8,7 @@ namespace py = pybind11;
 
 PYBIND11_MODULE(subscan, module) {
     module.doc() = R"doc(
-subscan: raw point clouds rendered as lit, translucent surfaces (see README.md, "Python").
+subscan: raw point clouds rendered as lit, translucent surfaces (see docs/python.md).
 
     import subscan
     cloud = subscan.load("scan.ply")                 # or subscan.Cloud(numpy_points, colors)

@@ -33,8 +33,8 @@ class TemporalHistory {
     /// The jitter of the next frame through `camera` (without jitter), pipeline pixels: Halton
     /// (2, 3), cycling through TemporalSettings::maxFrames points so a still camera's mean
     /// covers the whole pattern; none while the camera moves, where the jitter's own change
-    /// from frame to frame costs more steadiness than its anti-aliasing gains (README,
-    /// "Temporal filter and turntables").
+    /// from frame to frame costs more steadiness than its anti-aliasing gains (docs/temporal.md,
+    /// "How it works").
     glm::dvec2 nextJitter(const Camera& camera, const TemporalSettings& settings);
     /// Forget the history: the next frame starts afresh (a cut in an animation).
     void restart() { previous_.reset(); }

@@ -334,7 +334,7 @@ TEST(RealScansDataTest, ClassificationColoursAutzensGroundWhereItsGroundPointsAr
     ASSERT_EQ(image.width, kWidth);
     const Camera camera = readCameraFile(buffers / "camera.json");
 
-    // Which point each pixel should show, from the scan and camera.json alone (the README's
+    // Which point each pixel should show, from the scan and camera.json alone (docs/cli.md's
     // pixel convention): the nearest, and with it its class.
     const PointCloud cloud = loadScan(source.string()).cloud;
     ASSERT_TRUE(cloud.hasClassifications());

@@ -86,7 +86,7 @@ TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
         evaluate(test::glTestContext(), *source.scene, source.points, settings, local);
     const EvaluationReport withGlobal =
         evaluate(test::glTestContext(), *source.scene, source.points, settings, global);
-    // README's targets (coverage >= 0.97, leakage <= 0.03, occlusion errors <= 0.01) with a
+    // docs/eval.md's targets (coverage >= 0.97, leakage <= 0.03, occlusion errors <= 0.01) with a
     // margin for two small views instead of four at 1024 px (measured 2026-12-03: 0.992,
     // 0.007, 0.008 against the global h's 0.780, 0.000, 0.004).
     EXPECT_GE(withLocal.surface.coverage, 0.96);

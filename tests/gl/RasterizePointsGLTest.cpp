@@ -60,7 +60,7 @@ struct Reference {
 };
 
 /// The CPU reference: projects the stored (float, cloud-relative) positions in double with the
-/// README's pixel convention.
+/// pixel convention of docs/cli.md.
 Reference rasterizeOnCpu(const PointCloud& cloud, const Camera& camera) {
     const std::size_t pixels = static_cast<std::size_t>(camera.width * camera.height);
     Reference reference{std::vector<std::uint32_t>(pixels, kEmpty),

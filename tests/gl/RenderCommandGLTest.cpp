@@ -126,7 +126,7 @@ TEST(RenderCommandGLTest, DepthPfmIsReproducibleFromTheScanAndCameraJson) {
                     camera.string(), "--export-buffers", exported.string()});
     ASSERT_EQ(result.exitCode, 0) << result.err;
 
-    // From here on only the scan, camera.json and the README's pixel convention are used.
+    // From here on only the scan, camera.json and the pixel convention of docs/cli.md are used.
     std::ifstream cameraStream(exported / "camera.json");
     const nlohmann::json exportedCamera = nlohmann::json::parse(cameraStream);
     EXPECT_EQ(exportedCamera["width"], kWidth);

@@ -34,7 +34,7 @@ void expectNear(const glm::dvec3& actual, const glm::dvec3& expected, double tol
 }
 
 /// Window pixel (from the top left) and linear depth of a scene point, by the pixel convention
-/// of the README: x = (ndc.x + 1) / 2 * W, y = (1 - ndc.y) / 2 * H.
+/// of docs/cli.md: x = (ndc.x + 1) / 2 * W, y = (1 - ndc.y) / 2 * H.
 struct Projected {
     glm::dvec2 pixel;
     double depth;
