@@ -8,16 +8,10 @@
 namespace subscan::laz {
 
 /// LASzip's predictive integer decoder (see IntegerModels.h for the coding).
-class IntegerDecompressor {
+class IntegerDecompressor : public IntegerCoderBase {
   public:
     explicit IntegerDecompressor(std::uint32_t bits = 16, std::uint32_t contexts = 1)
-        : models_(bits, contexts) {}
-
-    /// Back to the initial state, as at the start of a chunk.
-    void reset() {
-        k_ = 0;
-        models_.reset();
-    }
+        : IntegerCoderBase(bits, contexts) {}
 
     std::int32_t decompress(ArithmeticDecoder& decoder, std::int32_t prediction,
                             std::uint32_t context = 0) {
@@ -34,14 +28,8 @@ class IntegerDecompressor {
         return static_cast<std::int32_t>(real);
     }
 
-    /// k of the last decompressed value; item coders use it to pick the next context.
-    std::uint32_t lastK() const { return k_; }
-
   private:
     std::int32_t readCorrector(ArithmeticDecoder& decoder, SymbolModel& kModel);
-
-    IntegerModels models_;
-    std::uint32_t k_ = 0;
 };
 
 }  // namespace subscan::laz

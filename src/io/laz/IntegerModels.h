@@ -29,4 +29,24 @@ struct IntegerModels {
     std::vector<SymbolModel> correctorModels;  // index k - 1
 };
 
+/// The part of the IntegerCompressor and the IntegerDecompressor that is the same: the models and
+/// k of the last value coded.
+class IntegerCoderBase {
+  public:
+    /// Back to the initial state, as at the start of a chunk.
+    void reset() {
+        k_ = 0;
+        models_.reset();
+    }
+
+    /// k of the last value coded; item coders use it to pick the next context.
+    std::uint32_t lastK() const { return k_; }
+
+  protected:
+    IntegerCoderBase(std::uint32_t bits, std::uint32_t contexts) : models_(bits, contexts) {}
+
+    IntegerModels models_;
+    std::uint32_t k_ = 0;
+};
+
 }  // namespace subscan::laz
