@@ -54,7 +54,23 @@ class LayeredItemDecoder {
     virtual void decode(std::byte* item, std::uint32_t& context) = 0;
 };
 
+/// Encoder of one item of a layered-chunked point, the mirror of the LayeredItemDecoder.
+class LayeredItemEncoder {
+  public:
+    virtual ~LayeredItemEncoder() = default;
+    virtual std::size_t layerCount() const = 0;
+    /// Starts a chunk from its first point (which the chunk stores raw). `context` is the
+    /// scanner channel so far.
+    virtual void start(const std::byte* item, std::uint32_t& context) = 0;
+    virtual void encode(const std::byte* item, std::uint32_t& context) = 0;
+    /// Ends the chunk: appends the item's layers to `layers`, each empty where its fields kept
+    /// the first point's values throughout (the decoder then keeps them).
+    virtual void finish(std::vector<std::vector<std::byte>>& layers) = 0;
+};
+
 std::unique_ptr<PointwiseItemDecoder> makePointwiseItemDecoder(const ItemSpec& item);
 std::unique_ptr<LayeredItemDecoder> makeLayeredItemDecoder(const ItemSpec& item);
+/// POINT14, RGB14, RGBNIR14 or BYTE14 (version 3); throws subscan::Error for other items.
+std::unique_ptr<LayeredItemEncoder> makeLayeredItemEncoder(const ItemSpec& item);
 
 }  // namespace subscan::laz
