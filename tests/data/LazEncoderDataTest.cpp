@@ -125,17 +125,21 @@ TEST_P(LazEncoderReencodeTest, EveryChunkReencodesToTheSameBytes) {
 
 // lone_star.copc.laz is in the shared folder: point format 6, 15 COPC nodes of 212 to 126,731
 // points, written by laz-perf (PDAL's COPC writer). Only x, y, z and intensity vary within its
-// chunks. The other two, checked when present, make every field vary: PDAL's test files
+// chunks. The others, checked when present, make every field vary: PDAL's test files
 // test/data/laz/las_with_several_extra_byte_bloc.laz (point format 8 with 3 extra bytes, GPS
-// time, NIR; written by LASzip 3.4 r3 itself, in 14 chunks of 50,000 points) and
-// test/data/copc/1.2-with-color.copc.laz (point format 7, 65 COPC nodes, laz-perf).
+// time, NIR; written by LASzip 3.4 r3 itself, in 14 chunks of 50,000 points),
+// test/data/copc/1.2-with-color.copc.laz (point format 7, 65 COPC nodes, laz-perf) and
+// test/data/tindex/autzen_clip_native.copc.laz (point format 7, laz-perf, scanner channels 0
+// and 1 alternating: RGB's contexts switch with them).
 INSTANTIATE_TEST_SUITE_P(
     WrittenByOthers, LazEncoderReencodeTest,
     ::testing::Values(LayeredFile{"LoneStarCopc", "lone_star.copc.laz", nullptr},
                       LayeredFile{"SeveralExtraByteBlocks", "las_with_several_extra_byte_bloc.laz",
                                   "PDAL's test/data/laz/las_with_several_extra_byte_bloc.laz"},
                       LayeredFile{"WithColorCopc", "1.2-with-color.copc.laz",
-                                  "PDAL's test/data/copc/1.2-with-color.copc.laz"}),
+                                  "PDAL's test/data/copc/1.2-with-color.copc.laz"},
+                      LayeredFile{"TwoScannerChannelsCopc", "autzen_clip_native.copc.laz",
+                                  "PDAL's test/data/tindex/autzen_clip_native.copc.laz"}),
     [](const ::testing::TestParamInfo<LayeredFile>& file) { return file.param.testName; });
 
 TEST(LazEncoderDataTest, LoneStarCopcIsManyNodesOfVariableSize) {

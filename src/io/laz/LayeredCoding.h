@@ -257,10 +257,10 @@ class Point14Channels {
     std::uint32_t current_ = 0;
 };
 
-/// Shared by RGB14, RGBNIR14 and BYTE14: the per-channel last values, started from the previous
-/// channel's when a channel first occurs. As in the reference coder, a switch to a channel
-/// already seen in this chunk keeps predicting from the previous channel's last values (and
-/// updates those), so files written by it decode identically.
+/// Shared by RGB14, RGBNIR14 and BYTE14: the last values per context (see LazItems.h), started
+/// from the previous context's when a context first occurs. As in the reference coder, a switch
+/// to a context already seen in this chunk keeps predicting from the previous context's last
+/// values (and updates those), so files written by it decode identically.
 template <class Last>
 struct ChannelLastValues {
     std::array<Last, kScannerChannels> last{};

@@ -142,6 +142,9 @@ class ChunkDecoder {
         for (std::uint64_t i = 1; i < pointCount; ++i) {
             std::byte* record = records + i * layout_.recordLength;
             std::size_t itemOffset = 0;
+            // Every point starts from context 0, which POINT14 changes only where the scanner
+            // channel changes (LASzip's reader, and so its writer, work so).
+            context = 0;
             for (std::size_t k = 0; k < layered_.size(); ++k) {
                 layered_[k]->decode(record + itemOffset, context);
                 itemOffset += layout_.items[k].size;

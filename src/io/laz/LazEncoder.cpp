@@ -117,6 +117,7 @@ std::vector<std::byte> ChunkEncoder::encode(std::span<const std::byte> records) 
     for (std::uint32_t i = 1; i < pointCount; ++i) {
         const std::byte* record = records.data() + std::size_t{i} * recordLength;
         std::size_t itemOffset = 0;
+        context = 0;  // as the decoder: POINT14 sets it only where the channel changes
         for (std::size_t k = 0; k < items_.size(); ++k) {
             items_[k]->encode(record + itemOffset, context);
             itemOffset += layout_.items[k].size;

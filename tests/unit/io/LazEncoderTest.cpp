@@ -285,6 +285,53 @@ TEST(LazEncoderTest, ScannerChannelsSwitchAwayAndBack) {
     expectChunkDecodesTo(encoder.encode(records), records, layout);
 }
 
+/// The bytes of layer `layer` of a chunk with `layers` layers.
+std::vector<std::byte> layerBytes(const std::vector<std::byte>& chunk, const laz::LazLayout& layout,
+                                  std::size_t layers, std::size_t layer) {
+    const std::vector<std::uint32_t> sizes = layerSizes(chunk, layout, layers);
+    std::size_t at = layout.recordLength + 4 + 4 * layers;
+    for (std::size_t i = 0; i < layer; ++i) {
+        at += sizes[i];
+    }
+    return {chunk.begin() + static_cast<std::ptrdiff_t>(at),
+            chunk.begin() + static_cast<std::ptrdiff_t>(at + sizes[layer])};
+}
+
+TEST(LazEncoderTest, OtherItemsFollowTheChannelOnlyWhereItChanges) {
+    // LASzip codes RGB, NIR and extra bytes in the scanner channel's context only at the points
+    // where the channel changes, in context 0 elsewhere. So 30 points of channel 0, then 30 of
+    // channel 1, code their colours and extra bytes as 30 of channel 0, one of channel 1 and 29
+    // of channel 0 do: context 0, 1 at point 30, 0 again.
+    const std::size_t length = test::las14RecordLength(7, 1);
+    const laz::LazLayout layout = laz::layeredLazLayout(7, length);
+    constexpr std::size_t kLayers = 9 + 1 + 1;
+    std::vector<std::byte> stay = test::randomLas14Records({7, 1, false, 31}, 60);
+    for (std::size_t i = 0; i < 60; ++i) {
+        std::byte* p = stay.data() + i * length;
+        for (std::size_t c = 0; c < 3; ++c) {
+            storeLittleEndian(p + 30 + 2 * c, static_cast<std::uint16_t>((c + 1) * 7919 * i));
+        }
+        p[36] = static_cast<std::byte>(13 * i);  // the extra byte
+    }
+    std::vector<std::byte> back = stay;
+    for (std::size_t i = 30; i < 60; ++i) {
+        std::byte& flags = stay[i * length + 15];
+        flags = (flags & std::byte{0xCF}) | std::byte{0x10};
+    }
+    back[30 * length + 15] = (back[30 * length + 15] & std::byte{0xCF}) | std::byte{0x10};
+    laz::ChunkEncoder encoder(layout);
+    const std::vector<std::byte> stayChunk = encoder.encode(stay);
+    const std::vector<std::byte> backChunk = encoder.encode(back);
+    for (const std::size_t layer : {kLayers - 2, kLayers - 1}) {
+        SCOPED_TRACE(fmt::format("layer {}", layer));
+        const std::vector<std::byte> colours = layerBytes(stayChunk, layout, kLayers, layer);
+        EXPECT_FALSE(colours.empty());
+        EXPECT_EQ(colours, layerBytes(backChunk, layout, kLayers, layer));
+    }
+    expectChunkDecodesTo(stayChunk, stay, layout);
+    expectChunkDecodesTo(backChunk, back, layout);
+}
+
 TEST(LazEncoderTest, GpsTimeSequencesRoundTrip) {
     const std::size_t length = test::las14RecordLength(6, 0);
     const laz::LazLayout layout = laz::layeredLazLayout(6, length);
