@@ -264,6 +264,15 @@ class Generator {
 
 }  // namespace
 
+void PrintTo(const Las14Format& format, std::ostream* out) {
+    *out << "format " << format.pointFormat << " with " << format.extraBytes << " extra bytes";
+}
+
+std::string las14FormatName(const Las14Format& format) {
+    return "Format" + std::to_string(format.pointFormat) + "With" +
+           std::to_string(format.extraBytes) + "ExtraBytes";
+}
+
 std::size_t las14RecordLength(int pointFormat, std::size_t extraBytes) {
     switch (pointFormat) {
         case 6:
