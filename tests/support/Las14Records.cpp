@@ -55,7 +55,9 @@ void storePoint(const Las14Point& point, int pointFormat, std::byte* p) {
     for (std::size_t c = 0; c < colours; ++c, at += 2) {
         put(p + at, point.rgbNir[c]);
     }
-    std::memcpy(p + at, point.extra.data(), point.extra.size());
+    if (!point.extra.empty()) {
+        std::memcpy(p + at, point.extra.data(), point.extra.size());
+    }
 }
 
 enum class RunKind { Quiet, Busy, Pulses, Extremes, FlightLines, OneField };
