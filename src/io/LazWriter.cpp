@@ -128,7 +128,9 @@ std::vector<std::byte> encodeLazPrefix(std::span<const std::byte> header,
     setField(file, las::header_field::kPointDataOffset,
              static_cast<std::uint32_t>(pointDataOffset));
     setField(file, las::header_field::kVlrCount, static_cast<std::uint32_t>(vlrs.size() + 1));
-    file[las::header_field::kPointFormat] |= kCompressedBit;
+    // The format with bit 7 set and bit 6 (which some writers also set) clear.
+    file[las::header_field::kPointFormat] =
+        (file[las::header_field::kPointFormat] & std::byte{0x3F}) | kCompressedBit;
     // Formats 6-10 count points in the 64-bit fields only.
     setField(file, las::header_field::kLegacyPointCount, std::uint32_t{0});
     std::fill_n(file.begin() + las::header_field::kLegacyReturnCounts, 5 * 4, std::byte{0});
