@@ -64,8 +64,7 @@ LasHeader parseLasHeader(std::span<const std::byte> head, std::uint64_t fileSize
 /// The payload of the first VLR (between the header and the point data) with this user id and
 /// record id. The VLR area belongs to other readers too: a malformed one merely ends the search.
 std::optional<std::span<const std::byte>> findLasVlr(std::span<const std::byte> head,
-                                                     const LasHeader& header,
-                                                     std::string_view user,
+                                                     const LasHeader& header, std::string_view user,
                                                      std::uint16_t recordId);
 
 }  // namespace subscan

@@ -35,10 +35,10 @@ constexpr std::size_t kVlrCount = 100;
 constexpr std::size_t kPointFormat = 104;
 constexpr std::size_t kRecordLength = 105;
 constexpr std::size_t kLegacyPointCount = 107;
-constexpr std::size_t kScale = 131;         // x, y, z doubles
-constexpr std::size_t kOffset = 155;        // x, y, z doubles
-constexpr std::size_t kBounds = 179;        // max x, min x, max y, min y, max z, min z doubles
-constexpr std::size_t kEvlrOffset = 235;    // LAS 1.4 only, like the two below
+constexpr std::size_t kScale = 131;       // x, y, z doubles
+constexpr std::size_t kOffset = 155;      // x, y, z doubles
+constexpr std::size_t kBounds = 179;      // max x, min x, max y, min y, max z, min z doubles
+constexpr std::size_t kEvlrOffset = 235;  // LAS 1.4 only, like the two below
 constexpr std::size_t kEvlrCount = 243;
 constexpr std::size_t kPointCount64 = 247;
 }  // namespace header_field
@@ -99,8 +99,7 @@ std::size_t requiredHeaderSize(int versionMinor) {
 }  // namespace
 
 std::optional<std::span<const std::byte>> findLasVlr(std::span<const std::byte> head,
-                                                     const LasHeader& header,
-                                                     std::string_view user,
+                                                     const LasHeader& header, std::string_view user,
                                                      std::uint16_t recordId) {
     const std::uint32_t vlrCount = loadField<std::uint32_t>(head, header_field::kVlrCount);
     std::size_t position = header.headerSize;
