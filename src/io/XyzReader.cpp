@@ -833,7 +833,8 @@ class PointLineParser {
           // A PTS file with count lines only still needs room for the count.
           values_(layout.columnCount == 0 ? 1 : layout.usedColumns(), 0.0) {}
 
-    void parse(std::string_view text, const std::function<void(std::span<const double>)>& point);
+    void parse(std::string_view text,
+               const std::function<void(std::span<const double>, std::size_t)>& point);
     void finish() const {
         if (block_) {
             block_->check();
@@ -886,8 +887,8 @@ std::size_t PointLineParser::parseLine(const char* p, const char* end, std::stri
     }
 }
 
-void PointLineParser::parse(std::string_view text,
-                            const std::function<void(std::span<const double>)>& point) {
+void PointLineParser::parse(
+    std::string_view text, const std::function<void(std::span<const double>, std::size_t)>& point) {
     LineReader lines(text, 0, lineNumber_);
     std::string_view line;
     while (lines.next(line)) {
@@ -901,7 +902,7 @@ void PointLineParser::parse(std::string_view text,
         }
         const std::size_t count = parseLine(p, end, line, lines.lineNumber());
         if (count == columnCount_) {
-            point(values_);
+            point(values_, lines.lineNumber());
             if (block_) {
                 ++block_->points;
             }
@@ -1017,8 +1018,9 @@ std::size_t PointTextReader::expectedPoints(std::size_t bytes) const {
         std::min({estimate, static_cast<double>(atMost), static_cast<double>(kMaxPoints)}));
 }
 
-void PointTextReader::parse(std::string_view lines,
-                            const std::function<void(std::span<const double>)>& point) {
+void PointTextReader::parse(
+    std::string_view lines,
+    const std::function<void(std::span<const double>, std::size_t)>& point) {
     state_->parser->parse(lines, point);
 }
 
@@ -1036,7 +1038,7 @@ PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
     attributes.intensity = layout.intensity.has_value();
     PointCloudBuilder builder(attributes, reader.expectedPoints(text.size() - reader.dataOffset()));
     std::uint64_t pointLines = 0;
-    const auto addPoint = [&](std::span<const double> values) {
+    const auto addPoint = [&](std::span<const double> values, std::size_t) {
         builder.add(makeRecord(layout, values));
         if (++pointLines > kMaxPoints) {
             throw Error(fmt::format("it has more than the {} points subscan can hold", kMaxPoints));

@@ -74,9 +74,10 @@ class PointTextReader {
 
     /// Parses `lines`, the file's next whole lines from dataOffset() on (only the file's last
     /// line may lack its line end). `point` receives the values of each point line, at least
-    /// layout().usedColumns() of them. Throws subscan::Error, naming the line, at a line that
-    /// is neither a point nor a PTS count.
-    void parse(std::string_view lines, const std::function<void(std::span<const double>)>& point);
+    /// layout().usedColumns() of them, and the line's number. Throws subscan::Error, naming the
+    /// line, at a line that is neither a point nor a PTS count.
+    void parse(std::string_view lines,
+               const std::function<void(std::span<const double>, std::size_t)>& point);
     /// At the end of the file: checks the point count of the last PTS block.
     void finish() const;
 
