@@ -33,6 +33,15 @@ T loadLittleEndian(const void* p) {
     return value;
 }
 
+/// Stores `value` little-endian at `p` (no alignment needed).
+template <class T>
+void storeLittleEndian(void* p, T value) {
+    if constexpr (std::endian::native == std::endian::big) {
+        value = byteSwapped(value);
+    }
+    std::memcpy(p, &value, sizeof(T));
+}
+
 /// Reads a T stored big-endian at `p` (no alignment needed).
 template <class T>
 T loadBigEndian(const void* p) {

@@ -16,6 +16,7 @@
 
 #include "core/Error.h"
 #include "io/ByteOrder.h"
+#include "io/LasFormat.h"
 #include "io/LasHeader.h"
 #include "io/laz/Copc.h"
 #include "io/laz/LazDecoder.h"
@@ -24,41 +25,11 @@ namespace subscan {
 
 namespace {
 
-/// Byte offsets of the public header block fields we use (LAS 1.4 R15, table 3; the fields up to
-/// byte 227 sit at the same place in every version since 1.0).
-namespace header_field {
-constexpr std::size_t kVersionMajor = 24;
-constexpr std::size_t kVersionMinor = 25;
-constexpr std::size_t kHeaderSize = 94;
-constexpr std::size_t kPointDataOffset = 96;
-constexpr std::size_t kVlrCount = 100;
-constexpr std::size_t kPointFormat = 104;
-constexpr std::size_t kRecordLength = 105;
-constexpr std::size_t kLegacyPointCount = 107;
-constexpr std::size_t kScale = 131;       // x, y, z doubles
-constexpr std::size_t kOffset = 155;      // x, y, z doubles
-constexpr std::size_t kBounds = 179;      // max x, min x, max y, min y, max z, min z doubles
-constexpr std::size_t kEvlrOffset = 235;  // LAS 1.4 only, like the two below
-constexpr std::size_t kEvlrCount = 243;
-constexpr std::size_t kPointCount64 = 247;
-}  // namespace header_field
+// The header and VLR layout (LasFormat.h); this file is compiled on its own, not in a batch.
+using namespace las;
 
 constexpr std::string_view kSignature = "LASF";
-constexpr std::size_t kHeaderSizeUpTo12 = 227;
-constexpr std::size_t kHeaderSize13 = 235;  // adds the waveform data offset
-constexpr std::size_t kHeaderSize14 = 375;  // adds EVLRs and 64-bit point counts
 constexpr int kLatestMinorVersion = 4;
-
-// laszip marks compressed point data with bit 7 of the point format byte (bit 6 too in its
-// layered-chunk variant) and describes the compressor in a VLR.
-constexpr std::uint8_t kCompressionBits = 0xC0;
-constexpr std::size_t kVlrHeaderSize = 54;
-constexpr std::size_t kVlrUserIdOffset = 2;
-constexpr std::size_t kVlrUserIdSize = 16;
-constexpr std::size_t kVlrRecordIdOffset = 18;
-constexpr std::size_t kVlrLengthOffset = 20;
-constexpr std::string_view kLaszipUserId = "laszip encoded";
-constexpr std::uint16_t kLaszipRecordId = 22204;
 constexpr std::string_view kCopcUserId = "copc";
 constexpr std::uint16_t kCopcInfoRecordId = 1;
 
@@ -249,7 +220,7 @@ LasHeader parseLasHeader(std::span<const std::byte> head, std::uint64_t fileSize
                                  loadField<double>(head, bounds + 24),
                                  loadField<double>(head, bounds + 40)};
     if (header.versionMinor >= 4) {
-        header.evlrOffset = loadField<std::uint64_t>(head, header_field::kEvlrOffset);
+        header.evlrOffset = loadField<std::uint64_t>(head, header_field::kFirstEvlrOffset);
         header.evlrCount = loadField<std::uint32_t>(head, header_field::kEvlrCount);
     }
     return header;

@@ -13,6 +13,7 @@
 #include "core/Error.h"
 #include "io/ByteOrder.h"
 #include "io/InputFile.h"
+#include "io/LasFormat.h"
 #include "io/LasHeader.h"
 #include "io/LazChunkStream.h"
 #include "io/RecordSourceSupport.h"
@@ -24,8 +25,6 @@ namespace subscan {
 
 namespace {
 
-constexpr std::size_t kLasHeadBytes = 375;  // a LAS 1.4 header, the largest
-constexpr std::size_t kPointDataOffsetField = 96;
 /// Records read from an uncompressed file at once: 64 Ki records, at most 4 MiB of a format 10
 /// file with extra bytes; large enough that the calls cost nothing next to the copying.
 constexpr std::size_t kRecordsPerBlock = 1 << 16;
@@ -36,12 +35,6 @@ constexpr std::uint16_t kGeoKeysRecord = 34735;
 constexpr std::string_view kSpecUser = "LASF_Spec";
 constexpr std::uint16_t kExtraBytesRecord = 4;
 
-// An extended VLR's header (R15, table 19); its payload follows.
-constexpr std::size_t kEvlrHeaderSize = 60;
-constexpr std::size_t kEvlrUserOffset = 2;
-constexpr std::size_t kEvlrUserSize = 16;
-constexpr std::size_t kEvlrRecordIdOffset = 18;
-constexpr std::size_t kEvlrLengthOffset = 20;
 /// WKT and extra-bytes descriptors are a few kilobytes; a larger payload is something else.
 constexpr std::uint64_t kLargestEvlrRead = 16u << 20;
 
@@ -61,24 +54,25 @@ std::optional<std::vector<std::byte>> findEvlr(const InputFile& file, const LasH
     std::uint64_t position = header.evlrOffset;
     for (std::uint32_t i = 0; i < header.evlrCount; ++i) {
         if (position < header.pointDataOffset || position > file.size() ||
-            file.size() - position < kEvlrHeaderSize) {
+            file.size() - position < las::kEvlrHeaderSize) {
             return std::nullopt;
         }
-        const std::vector<std::byte> record = file.read(position, kEvlrHeaderSize);
+        const std::vector<std::byte> record = file.read(position, las::kEvlrHeaderSize);
         const std::string_view userId(
-            reinterpret_cast<const char*>(record.data() + kEvlrUserOffset), kEvlrUserSize);
-        const auto length = loadLittleEndian<std::uint64_t>(record.data() + kEvlrLengthOffset);
-        if (length > file.size() - position - kEvlrHeaderSize) {
+            reinterpret_cast<const char*>(record.data() + las::kVlrUserIdOffset),
+            las::kVlrUserIdSize);
+        const auto length = loadLittleEndian<std::uint64_t>(record.data() + las::kVlrLengthOffset);
+        if (length > file.size() - position - las::kEvlrHeaderSize) {
             return std::nullopt;
         }
         if (userId.substr(0, userId.find('\0')) == user &&
-            loadLittleEndian<std::uint16_t>(record.data() + kEvlrRecordIdOffset) == recordId) {
+            loadLittleEndian<std::uint16_t>(record.data() + las::kVlrRecordIdOffset) == recordId) {
             if (length > kLargestEvlrRead) {
                 return std::nullopt;
             }
-            return file.read(position + kEvlrHeaderSize, static_cast<std::size_t>(length));
+            return file.read(position + las::kEvlrHeaderSize, static_cast<std::size_t>(length));
         }
-        position += kEvlrHeaderSize + length;
+        position += las::kEvlrHeaderSize + length;
     }
     return std::nullopt;
 }
@@ -240,13 +234,13 @@ class LasRecordSource final : public PointRecordSource {
     /// The header and the VLRs, up to the point data.
     void readHead() {
         head_.resize(
-            static_cast<std::size_t>(std::min<std::uint64_t>(file_.size(), kLasHeadBytes)));
+            static_cast<std::size_t>(std::min<std::uint64_t>(file_.size(), las::kHeaderSize14)));
         file_.read(0, head_);
-        if (head_.size() < kPointDataOffsetField + 4) {
+        if (head_.size() < las::header_field::kPointDataOffset + 4) {
             return;  // parseLasHeader says what is wrong with so short a file
         }
         const auto pointDataOffset =
-            loadLittleEndian<std::uint32_t>(head_.data() + kPointDataOffsetField);
+            loadLittleEndian<std::uint32_t>(head_.data() + las::header_field::kPointDataOffset);
         if (pointDataOffset > head_.size() && pointDataOffset <= file_.size()) {
             head_.resize(pointDataOffset);
             file_.read(0, head_);

@@ -35,7 +35,8 @@ class LazChunkStream {
     LazChunkStream& operator=(const LazChunkStream&) = delete;
 
     /// Replaces `records` with the next chunk's records and returns true, or empties it and
-    /// returns false after the last chunk. Throws subscan::Error naming the chunk that cannot be read or decoded.
+    /// returns false after the last chunk. Throws subscan::Error naming the chunk that cannot be
+    /// read or decoded.
     bool next(std::vector<std::byte>& records);
 
   private:

@@ -191,6 +191,10 @@ void checkCompatible(const PointRecordSourceInfo& input, const PointRecordSource
 
 }  // namespace
 
+std::size_t PointRecordFormat::recordLength() const {
+    return las14::standardSize(pointFormat) + extraBytes;
+}
+
 std::unique_ptr<PointRecordSource> openPointRecordSource(const std::filesystem::path& path,
                                                          unsigned threads) {
     const std::string name = path.string();

@@ -86,10 +86,6 @@ std::size_t las14::standardSize(int pointFormat) {
     return pointFormat == 8 ? 38 : pointFormat == 7 ? 36 : 30;
 }
 
-std::size_t PointRecordFormat::recordLength() const {
-    return las14::standardSize(pointFormat) + extraBytes;
-}
-
 void appendFloatDescriptor(std::vector<std::byte>& descriptors, std::string_view name,
                            std::string_view description) {
     const std::vector<std::byte> descriptor = newDescriptor(kFloatType, 0, name, description);

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "core/PointCloud.h"
 
@@ -27,6 +28,15 @@ void appendLittleEndian(std::string& out, T value) {
     char bytes[sizeof(T)];
     std::memcpy(bytes, &value, sizeof(T));
     out.append(bytes, sizeof(T));
+}
+
+template <class T>
+void appendLittleEndian(std::vector<std::byte>& out, T value) {
+    static_assert(std::endian::native == std::endian::little,
+                  "the writers copy values in memory order as little-endian");
+    const std::size_t at = out.size();
+    out.resize(at + sizeof(T));
+    std::memcpy(out.data() + at, &value, sizeof(T));
 }
 
 /// Collects a file's bytes and hands them to the stream a few megabytes at a time: a big cloud

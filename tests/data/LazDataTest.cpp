@@ -62,20 +62,10 @@ constexpr std::size_t kRecordLengthField = 105;
 constexpr std::size_t kLegacyCountField = 107;
 constexpr std::size_t kScaleField = 131;
 constexpr std::size_t kOffsetField = 155;
-constexpr std::size_t kHeaderSizeField = 94;
 constexpr std::size_t kVlrHeaderSize = 54;
 
-/// Offset of the payload of the VLR with this user id, or 0.
 std::size_t vlrPayload(const std::string& file, std::string_view user) {
-    std::size_t position = fieldAt<std::uint16_t>(file, kHeaderSizeField);
-    const auto count = fieldAt<std::uint32_t>(file, 100);
-    for (std::uint32_t i = 0; i < count; ++i) {
-        if (std::string_view(file.data() + position + 2, user.size()) == user) {
-            return position + kVlrHeaderSize;
-        }
-        position += kVlrHeaderSize + fieldAt<std::uint16_t>(file, position + 20);
-    }
-    return 0;
+    return test::lasVlrPayloadOffset(file, user);
 }
 
 TEST(LazDataTest, AutzenLazDecodesToExactlyTheRecordsOfTheLasFile) {

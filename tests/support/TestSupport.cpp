@@ -21,6 +21,8 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
+#include "io/ByteOrder.h"
+#include "io/LasFormat.h"
 
 extern char** environ;
 
@@ -56,6 +58,21 @@ std::filesystem::path TempDir::write(std::string_view name, std::string_view byt
 
 std::span<const std::byte> asBytes(std::string_view text) {
     return {reinterpret_cast<const std::byte*>(text.data()), text.size()};
+}
+
+std::size_t lasVlrPayloadOffset(std::string_view file, std::string_view userId) {
+    const auto field = [&](std::size_t offset) {
+        return loadLittleEndian<std::uint16_t>(file.data() + offset);
+    };
+    std::size_t position = field(las::header_field::kHeaderSize);
+    const auto count = loadLittleEndian<std::uint32_t>(file.data() + las::header_field::kVlrCount);
+    for (std::uint32_t i = 0; i < count && position + las::kVlrHeaderSize <= file.size(); ++i) {
+        if (file.substr(position + las::kVlrUserIdOffset, userId.size()) == userId) {
+            return position + las::kVlrHeaderSize;
+        }
+        position += las::kVlrHeaderSize + field(position + las::kVlrLengthOffset);
+    }
+    return 0;
 }
 
 LoadedScan decode(std::string_view bytes, std::string_view fileName) {

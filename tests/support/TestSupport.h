@@ -37,6 +37,9 @@ class TempDir {
 
 std::span<const std::byte> asBytes(std::string_view text);
 
+/// Where the payload of the first VLR with this user id lies in a LAS file, or 0 (none).
+std::size_t lasVlrPayloadOffset(std::string_view file, std::string_view userId);
+
 /// The whole file's bytes (empty when it cannot be read).
 std::string fileBytes(const std::filesystem::path& file);
 

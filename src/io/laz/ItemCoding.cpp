@@ -56,46 +56,27 @@ void Median5::add(std::int32_t v) {
 }
 
 namespace {
-// Multiples of the last difference run from -10 to 500 (LASzip's GPS time coder).
-constexpr std::int32_t kMaxMultiple = 500;
-constexpr std::int32_t kMinMultiple = -10;
-// Symbol of "a full new time" in the multiple model; the symbols after it switch sequences.
-constexpr std::uint32_t kFullTimeCode = kMaxMultiple - kMinMultiple + 1;  // 511
 // A corrupt stream could switch sequences without end; a valid one switches once per point.
 constexpr int kMaxSequenceSwitches = 4;
 }  // namespace
 
-GpsTimeDecoder::GpsTimeDecoder(bool pointwise)
-    : pointwise_(pointwise),
-      multiModel_(pointwise ? 516 : 515),
-      zeroDiffModel_(pointwise ? 6 : 5) {}
-
-void GpsTimeDecoder::reset(std::uint64_t firstTimeBits) {
-    multiModel_.reset();
-    zeroDiffModel_.reset();
-    integers_.reset();
-    last_ = 0;
-    next_ = 0;
-    times_ = {static_cast<std::int64_t>(firstTimeBits), 0, 0, 0};
-    lastDiffs_ = {};
-    extremeCounters_ = {};
-}
-
 void GpsTimeDecoder::readFullTime(ArithmeticDecoder& decoder) {
-    next_ = (next_ + 1) & 3;
-    const auto high = static_cast<std::uint32_t>(integers_.decompress(
-        decoder, static_cast<std::int32_t>(static_cast<std::uint64_t>(times_[last_]) >> 32), 8));
-    times_[next_] =
+    GpsTimeSequences<IntegerDecompressor>& s = state_;
+    s.next = (s.next + 1) & 3;
+    const auto high = static_cast<std::uint32_t>(s.integers.decompress(
+        decoder, static_cast<std::int32_t>(static_cast<std::uint64_t>(s.times[s.last]) >> 32), 8));
+    s.times[s.next] =
         static_cast<std::int64_t>((static_cast<std::uint64_t>(high) << 32) | decoder.readInt());
-    last_ = next_;
-    lastDiffs_[last_] = 0;
-    extremeCounters_[last_] = 0;
+    s.last = s.next;
+    s.lastDiffs[s.last] = 0;
+    s.extremeCounters[s.last] = 0;
 }
 
 void GpsTimeDecoder::decode(ArithmeticDecoder& decoder) {
+    GpsTimeSequences<IntegerDecompressor>& s = state_;
     for (int switches = 0; switches <= kMaxSequenceSwitches; ++switches) {
-        if (lastDiffs_[last_] == 0) {
-            std::uint32_t code = decoder.decodeSymbol(zeroDiffModel_);
+        if (s.lastDiffs[s.last] == 0) {
+            std::uint32_t code = decoder.decodeSymbol(s.zeroDiffModel);
             if (pointwise_) {
                 if (code == 0) {
                     return;  // unchanged
@@ -103,70 +84,64 @@ void GpsTimeDecoder::decode(ArithmeticDecoder& decoder) {
                 --code;
             }
             if (code == 0) {  // a difference that fits 32 bits
-                lastDiffs_[last_] = integers_.decompress(decoder, 0, 0);
-                times_[last_] += lastDiffs_[last_];
-                extremeCounters_[last_] = 0;
+                s.lastDiffs[s.last] = s.integers.decompress(decoder, 0, 0);
+                s.times[s.last] += s.lastDiffs[s.last];
+                s.extremeCounters[s.last] = 0;
                 return;
             }
             if (code == 1) {
                 readFullTime(decoder);
                 return;
             }
-            last_ = (last_ + code - 1) & 3;
+            s.last = (s.last + code - 1) & 3;
             continue;
         }
 
-        std::uint32_t multi = decoder.decodeSymbol(multiModel_);
-        const std::int32_t lastDiff = lastDiffs_[last_];
-        // An extreme multiple (0, the largest or the most negative) four times in a row becomes
-        // the sequence's new difference.
-        const auto countExtreme = [&](std::int32_t diff) {
-            if (++extremeCounters_[last_] > 3) {
-                lastDiffs_[last_] = diff;
-                extremeCounters_[last_] = 0;
-            }
-        };
+        std::uint32_t multi = decoder.decodeSymbol(s.multiModel);
+        const std::int32_t lastDiff = s.lastDiffs[s.last];
         if (multi == 1) {
-            times_[last_] += integers_.decompress(decoder, lastDiff, 1);
-            extremeCounters_[last_] = 0;
+            s.times[s.last] += s.integers.decompress(decoder, lastDiff, 1);
+            s.extremeCounters[s.last] = 0;
             return;
         }
-        if (multi < kFullTimeCode) {
+        if (multi < kGpsTimeFullCode) {
             std::int32_t diff;
             if (multi == 0) {
-                diff = integers_.decompress(decoder, 0, 7);
-                countExtreme(diff);
-            } else if (multi < static_cast<std::uint32_t>(kMaxMultiple)) {
-                diff = integers_.decompress(
+                diff = s.integers.decompress(decoder, 0, 7);
+                s.countExtreme(diff);
+            } else if (multi < static_cast<std::uint32_t>(kGpsTimeMaxMultiple)) {
+                diff = s.integers.decompress(
                     decoder, wrappingMultiply(static_cast<std::int32_t>(multi), lastDiff),
                     multi < 10 ? 2 : 3);
-            } else if (multi == static_cast<std::uint32_t>(kMaxMultiple)) {
-                diff = integers_.decompress(decoder, wrappingMultiply(kMaxMultiple, lastDiff), 4);
-                countExtreme(diff);
+            } else if (multi == static_cast<std::uint32_t>(kGpsTimeMaxMultiple)) {
+                diff = s.integers.decompress(decoder,
+                                             wrappingMultiply(kGpsTimeMaxMultiple, lastDiff), 4);
+                s.countExtreme(diff);
             } else {
-                const std::int32_t negative = kMaxMultiple - static_cast<std::int32_t>(multi);
-                if (negative > kMinMultiple) {
-                    diff = integers_.decompress(decoder, wrappingMultiply(negative, lastDiff), 5);
+                const std::int32_t negative =
+                    kGpsTimeMaxMultiple - static_cast<std::int32_t>(multi);
+                if (negative > kGpsTimeMinMultiple) {
+                    diff = s.integers.decompress(decoder, wrappingMultiply(negative, lastDiff), 5);
                 } else {
-                    diff =
-                        integers_.decompress(decoder, wrappingMultiply(kMinMultiple, lastDiff), 6);
-                    countExtreme(diff);
+                    diff = s.integers.decompress(
+                        decoder, wrappingMultiply(kGpsTimeMinMultiple, lastDiff), 6);
+                    s.countExtreme(diff);
                 }
             }
-            times_[last_] += diff;
+            s.times[s.last] += diff;
             return;
         }
         if (pointwise_) {
-            if (multi == kFullTimeCode) {
+            if (multi == kGpsTimeFullCode) {
                 return;  // v2's "unchanged" sits where v3 has the full time
             }
             --multi;
         }
-        if (multi == kFullTimeCode) {
+        if (multi == kGpsTimeFullCode) {
             readFullTime(decoder);
             return;
         }
-        last_ = (last_ + multi - kFullTimeCode) & 3;
+        s.last = (s.last + multi - kGpsTimeFullCode) & 3;
     }
     throw Error("the LAZ point data is corrupt (GPS time sequences switch without end)");
 }

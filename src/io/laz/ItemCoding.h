@@ -73,30 +73,69 @@ class LazySymbolModels {
     std::uint32_t symbols_;
 };
 
-/// GPS time as LASzip predicts it: up to four interleaved sequences (flight lines, returns), each
-/// with its last time and its last difference in the time's integer (bit-pattern) units. A new
-/// time is a multiple of the last difference plus a corrector, a switch to another sequence, or
-/// a full new time. The two generations number their codes differently (`pointwise`: GPSTIME11
-/// v2, which also codes "unchanged"; otherwise POINT14 v3, which is asked only on a change).
+// GPS time as LASzip predicts it: up to four interleaved sequences (flight lines, returns), each
+// with its last time and its last difference in the time's integer (bit-pattern) units. A new
+// time is a multiple of the last difference plus a corrector, a switch to another sequence, or
+// a full new time. The two generations number their codes differently (`pointwise`: GPSTIME11
+// v2, which also codes "unchanged"; otherwise POINT14 v3, which is asked only on a change).
+
+/// Multiples of the last difference run from -10 to 500.
+inline constexpr std::int32_t kGpsTimeMaxMultiple = 500;
+inline constexpr std::int32_t kGpsTimeMinMultiple = -10;
+/// Symbol of "a full new time" in the multiple model; the symbols after it switch sequences.
+inline constexpr std::uint32_t kGpsTimeFullCode =
+    kGpsTimeMaxMultiple - kGpsTimeMinMultiple + 1;  // 511
+
+/// The state both sides of the GPS time coder keep; `IntegerCoder` is the IntegerCompressor or
+/// the IntegerDecompressor.
+template <class IntegerCoder>
+struct GpsTimeSequences {
+    explicit GpsTimeSequences(bool pointwise)
+        : multiModel(pointwise ? 516 : 515), zeroDiffModel(pointwise ? 6 : 5) {}
+
+    void reset(std::uint64_t firstTimeBits) {
+        multiModel.reset();
+        zeroDiffModel.reset();
+        integers.reset();
+        last = 0;
+        next = 0;
+        times = {static_cast<std::int64_t>(firstTimeBits), 0, 0, 0};
+        lastDiffs = {};
+        extremeCounters = {};
+    }
+
+    /// An extreme multiple (0, the largest or the most negative) four times in a row makes
+    /// `diff` the sequence's new difference.
+    void countExtreme(std::int32_t diff) {
+        if (++extremeCounters[last] > 3) {
+            lastDiffs[last] = diff;
+            extremeCounters[last] = 0;
+        }
+    }
+
+    SymbolModel multiModel;
+    SymbolModel zeroDiffModel;
+    IntegerCoder integers{32, 9};
+    std::uint32_t last = 0;  // the sequence of the last time
+    std::uint32_t next = 0;  // the sequence a full new time starts
+    std::array<std::int64_t, 4> times{};
+    std::array<std::int32_t, 4> lastDiffs{};
+    std::array<std::int32_t, 4> extremeCounters{};
+};
+
 class GpsTimeDecoder {
   public:
-    explicit GpsTimeDecoder(bool pointwise);
-    void reset(std::uint64_t firstTimeBits);
+    /// The default is POINT14's coder, so that it default-constructs like the GpsTimeEncoder.
+    explicit GpsTimeDecoder(bool pointwise = false) : pointwise_(pointwise), state_(pointwise) {}
+    void reset(std::uint64_t firstTimeBits) { state_.reset(firstTimeBits); }
     void decode(ArithmeticDecoder& decoder);
-    std::uint64_t timeBits() const { return static_cast<std::uint64_t>(times_[last_]); }
+    std::uint64_t timeBits() const { return static_cast<std::uint64_t>(state_.times[state_.last]); }
 
   private:
     void readFullTime(ArithmeticDecoder& decoder);
 
     bool pointwise_;
-    SymbolModel multiModel_;
-    SymbolModel zeroDiffModel_;
-    IntegerDecompressor integers_{32, 9};
-    std::uint32_t last_ = 0;
-    std::uint32_t next_ = 0;
-    std::array<std::int64_t, 4> times_{};
-    std::array<std::int32_t, 4> lastDiffs_{};
-    std::array<std::int32_t, 4> extremeCounters_{};
+    GpsTimeSequences<IntegerDecompressor> state_;
 };
 
 /// The RGB predictor of RGB12 v2 and RGB14 v3: a mask of which bytes changed, the low and high

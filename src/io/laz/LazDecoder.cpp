@@ -22,9 +22,6 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "the LAZ item decoders store fields in host byte order");
 
-constexpr std::size_t kRecordHeaderSize = 34;  // up to and including the item count
-constexpr std::size_t kItemSize = 6;
-
 const char* itemName(ItemType type) {
     switch (type) {
         case ItemType::Byte:
@@ -49,43 +46,6 @@ const char* itemName(ItemType type) {
             return "BYTE14";
     }
     return "unknown";
-}
-
-/// The items a record of `pointFormat` consists of, before any extra bytes (LAS 1.4 R15
-/// section 2.6 restated as LASzip items), with their sizes.
-std::vector<ItemSpec> itemsOfPointFormat(int pointFormat) {
-    const ItemSpec point10{ItemType::Point10, 20, 2};
-    const ItemSpec gpsTime{ItemType::GpsTime11, 8, 2};
-    const ItemSpec rgb12{ItemType::Rgb12, 6, 2};
-    const ItemSpec wave13{ItemType::WavePacket13, 29, 1};
-    const ItemSpec point14{ItemType::Point14, 30, 3};
-    const ItemSpec rgb14{ItemType::Rgb14, 6, 3};
-    const ItemSpec rgbNir14{ItemType::RgbNir14, 8, 3};
-    const ItemSpec wave14{ItemType::WavePacket14, 29, 3};
-    switch (pointFormat) {
-        case 0:
-            return {point10};
-        case 1:
-            return {point10, gpsTime};
-        case 2:
-            return {point10, rgb12};
-        case 3:
-            return {point10, gpsTime, rgb12};
-        case 4:
-            return {point10, gpsTime, wave13};
-        case 5:
-            return {point10, gpsTime, rgb12, wave13};
-        case 6:
-            return {point14};
-        case 7:
-            return {point14, rgb14};
-        case 8:
-            return {point14, rgbNir14};
-        case 9:
-            return {point14, wave14};
-        default:
-            return {point14, rgbNir14, wave14};
-    }
 }
 
 /// The item decoders of one thread, reused from chunk to chunk (models are reset, not rebuilt).
@@ -182,6 +142,9 @@ class ChunkDecoder {
         for (std::uint64_t i = 1; i < pointCount; ++i) {
             std::byte* record = records + i * layout_.recordLength;
             std::size_t itemOffset = 0;
+            // Every point starts from context 0, which POINT14 changes only where the scanner
+            // channel changes (LASzip's reader, and so its writer, work so).
+            context = 0;
             for (std::size_t k = 0; k < layered_.size(); ++k) {
                 layered_[k]->decode(record + itemOffset, context);
                 itemOffset += layout_.items[k].size;
@@ -201,11 +164,46 @@ std::string chunkName(std::size_t index, std::size_t count, const Chunk& chunk) 
 
 }  // namespace
 
+std::vector<ItemSpec> pointFormatItems(int pointFormat) {
+    const ItemSpec point10{ItemType::Point10, 20, 2};
+    const ItemSpec gpsTime{ItemType::GpsTime11, 8, 2};
+    const ItemSpec rgb12{ItemType::Rgb12, 6, 2};
+    const ItemSpec wave13{ItemType::WavePacket13, 29, 1};
+    const ItemSpec point14{ItemType::Point14, 30, 3};
+    const ItemSpec rgb14{ItemType::Rgb14, 6, 3};
+    const ItemSpec rgbNir14{ItemType::RgbNir14, 8, 3};
+    const ItemSpec wave14{ItemType::WavePacket14, 29, 3};
+    switch (pointFormat) {
+        case 0:
+            return {point10};
+        case 1:
+            return {point10, gpsTime};
+        case 2:
+            return {point10, rgb12};
+        case 3:
+            return {point10, gpsTime, rgb12};
+        case 4:
+            return {point10, gpsTime, wave13};
+        case 5:
+            return {point10, gpsTime, rgb12, wave13};
+        case 6:
+            return {point14};
+        case 7:
+            return {point14, rgb14};
+        case 8:
+            return {point14, rgbNir14};
+        case 9:
+            return {point14, wave14};
+        default:
+            return {point14, rgbNir14, wave14};
+    }
+}
+
 LazLayout parseLaszipRecord(std::span<const std::byte> payload, int pointFormat,
                             std::size_t recordLength) {
-    if (payload.size() < kRecordHeaderSize) {
+    if (payload.size() < kLaszipRecordHeaderSize) {
         throw Error(fmt::format("the laszip VLR has {} bytes, fewer than the {} it needs",
-                                payload.size(), kRecordHeaderSize));
+                                payload.size(), kLaszipRecordHeaderSize));
     }
     LazLayout layout;
     layout.compressor = loadLittleEndian<std::uint16_t>(payload.data());
@@ -227,17 +225,18 @@ LazLayout parseLaszipRecord(std::span<const std::byte> payload, int pointFormat,
     if (layout.chunkSize == 0) {
         throw Error("the laszip VLR declares a chunk size of 0 points");
     }
-    if (payload.size() < kRecordHeaderSize + kItemSize * itemCount) {
+    if (payload.size() < kLaszipRecordHeaderSize + kLaszipItemSize * itemCount) {
         throw Error(fmt::format("the laszip VLR declares {} items but has room for only {}",
-                                itemCount, (payload.size() - kRecordHeaderSize) / kItemSize));
+                                itemCount,
+                                (payload.size() - kLaszipRecordHeaderSize) / kLaszipItemSize));
     }
 
-    const std::vector<ItemSpec> expected = itemsOfPointFormat(pointFormat);
+    const std::vector<ItemSpec> expected = pointFormatItems(pointFormat);
     const bool layered = layout.compressor == kCompressorLayeredChunked;
     const std::uint16_t wantedVersion = layered ? 3 : 2;
     const ItemType extraBytes = pointFormat >= 6 ? ItemType::Byte14 : ItemType::Byte;
     for (std::uint16_t i = 0; i < itemCount; ++i) {
-        const std::byte* p = payload.data() + kRecordHeaderSize + kItemSize * i;
+        const std::byte* p = payload.data() + kLaszipRecordHeaderSize + kLaszipItemSize * i;
         ItemSpec item{static_cast<ItemType>(loadLittleEndian<std::uint16_t>(p)),
                       loadLittleEndian<std::uint16_t>(p + 2),
                       loadLittleEndian<std::uint16_t>(p + 4)};

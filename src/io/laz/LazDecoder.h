@@ -34,6 +34,15 @@ struct Chunk {
     std::uint64_t pointCount = 0;
 };
 
+/// The laszip VLR's payload: a header of this size (up to and including the item count), then
+/// each item's type, size and version.
+inline constexpr std::size_t kLaszipRecordHeaderSize = 34;
+inline constexpr std::size_t kLaszipItemSize = 6;
+
+/// The items a record of `pointFormat` (0-10) consists of, before any extra bytes (LAS 1.4 R15
+/// section 2.6 restated as LASzip items): their sizes, and the coder versions subscan reads.
+std::vector<ItemSpec> pointFormatItems(int pointFormat);
+
 /// Parses the payload of the laszip VLR (user "laszip encoded", record 22204) and checks it
 /// against the header's point format (0-10) and record length. Throws subscan::Error naming the
 /// unsupported variant (compressor, item type or version).

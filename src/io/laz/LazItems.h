@@ -42,19 +42,39 @@ class PointwiseItemDecoder {
 
 /// Decoder of one item of a layered-chunked point (compressor 3, item version 3): each item has
 /// one or more layers, separate arithmetic streams whose byte counts precede them in the chunk.
-/// The scanner channel that POINT14 decodes is the context every item uses.
+/// The items after POINT14 pick their models by a context that POINT14 sets: to the scanner
+/// channel of the chunk's first point, and of each point whose channel differs from the last
+/// one's; every other point is coded in context 0. (LASzip's reader and writer start every point
+/// from context 0; laz-perf does the same. Items of a chunk on one channel other than 0 thus
+/// switch to context 0 at its second point.)
 class LayeredItemDecoder {
   public:
     virtual ~LayeredItemDecoder() = default;
     virtual std::size_t layerCount() const = 0;
     /// Starts a chunk: the first point raw, then the item's layers (empty ones leave the field as
-    /// in the first point for the whole chunk). `context` is the scanner channel so far.
+    /// in the first point for the whole chunk). `context`: see above.
     virtual void start(const std::byte* item, std::span<const std::span<const std::byte>> layers,
                        std::uint32_t& context) = 0;
     virtual void decode(std::byte* item, std::uint32_t& context) = 0;
 };
 
+/// Encoder of one item of a layered-chunked point, the mirror of the LayeredItemDecoder.
+class LayeredItemEncoder {
+  public:
+    virtual ~LayeredItemEncoder() = default;
+    virtual std::size_t layerCount() const = 0;
+    /// Starts a chunk from its first point (which the chunk stores raw). `context`: as the
+    /// decoder's.
+    virtual void start(const std::byte* item, std::uint32_t& context) = 0;
+    virtual void encode(const std::byte* item, std::uint32_t& context) = 0;
+    /// Ends the chunk: appends the item's layers to `layers`, each empty where its fields kept
+    /// the first point's values throughout (the decoder then keeps them).
+    virtual void finish(std::vector<std::vector<std::byte>>& layers) = 0;
+};
+
 std::unique_ptr<PointwiseItemDecoder> makePointwiseItemDecoder(const ItemSpec& item);
 std::unique_ptr<LayeredItemDecoder> makeLayeredItemDecoder(const ItemSpec& item);
+/// POINT14, RGB14, RGBNIR14 or BYTE14 (version 3); throws subscan::Error for other items.
+std::unique_ptr<LayeredItemEncoder> makeLayeredItemEncoder(const ItemSpec& item);
 
 }  // namespace subscan::laz

@@ -1,9 +1,9 @@
-// LAZ without real files: an arithmetic encoder written here from the LASzip description (the
-// mirror of the decoder: same models, carry propagation, end padding) builds small files of the
-// variants no shared file has — point formats 0 with BYTE extra bytes, 7 and 8 with BYTE14,
-// chunks of one point, variable chunks — and the malformed cases. The entropy models are the
-// decoder's own (shared by coder and decoder in LASzip too); the real files in LazDataTest check
-// them against an independent encoder.
+// LAZ without real files: the library's arithmetic encoder and integer compressor (the mirrors
+// of the decoders) build, field by field here, small files of the variants no shared file has —
+// point formats 0 with BYTE extra bytes, 7 and 8 with BYTE14, chunks of one point, variable
+// chunks — and the malformed cases. The entropy models are the decoder's own (shared by coder and
+// decoder in LASzip too); the real files in LazDataTest check them against an independent
+// encoder.
 #include <array>
 #include <cstdint>
 #include <cstdlib>
@@ -22,6 +22,8 @@
 #include "io/LasReader.h"
 #include "io/ReadContext.h"
 #include "io/laz/ArithmeticDecoder.h"
+#include "io/laz/ArithmeticEncoder.h"
+#include "io/laz/IntegerCompressor.h"
 #include "io/laz/IntegerDecompressor.h"
 #include "io/laz/ItemCoding.h"
 #include "support/TestSupport.h"
@@ -34,157 +36,14 @@ using laz::SymbolModel;
 using test::appendBytes;
 using ::testing::HasSubstr;
 
-class Encoder {
-  public:
-    void encodeBit(BitModel& model, std::uint32_t bit) {
-        const std::uint32_t split = model.bit0Probability * (length_ >> laz::kBitLengthShift);
-        if (bit == 0) {
-            length_ = split;
-            ++model.bit0Count;
-        } else {
-            add(split);
-            length_ -= split;
-        }
-        renormaliseIfNeeded();
-        if (--model.bitsUntilUpdate == 0) {
-            model.update();
-        }
-    }
+using Encoder = laz::ArithmeticEncoder;
+using laz::IntegerCompressor;
 
-    void encodeSymbol(SymbolModel& model, std::uint32_t symbol) {
-        if (symbol == model.lastSymbol) {
-            const std::uint32_t lower = model.distribution[symbol] * (length_ >> 15);
-            add(lower);
-            length_ -= lower;
-        } else {
-            length_ >>= 15;
-            const std::uint32_t lower = model.distribution[symbol] * length_;
-            add(lower);
-            length_ = model.distribution[symbol + 1] * length_ - lower;
-        }
-        renormaliseIfNeeded();
-        ++model.counts[symbol];
-        if (--model.symbolsUntilUpdate == 0) {
-            model.update();
-        }
-    }
-
-    void writeBits(std::uint32_t bits, std::uint32_t value) {
-        if (bits > 19) {
-            writeBits(16, value & 0xFFFF);
-            writeBits(bits - 16, value >> 16);
-            return;
-        }
-        length_ >>= bits;
-        add(value * length_);
-        renormaliseIfNeeded();
-    }
-
-    std::string finish() {
-        bool anotherByte = true;
-        if (length_ > 2 * laz::kMinLength) {
-            add(laz::kMinLength);
-            length_ = laz::kMinLength >> 1;
-        } else {
-            add(laz::kMinLength >> 1);
-            length_ = laz::kMinLength >> 9;
-            anotherByte = false;
-        }
-        renormalise();
-        out_.append(anotherByte ? 3 : 2, '\0');
-        return out_;
-    }
-
-  private:
-    void add(std::uint32_t value) {
-        const std::uint32_t before = base_;
-        base_ += value;
-        if (base_ < before) {  // carry into the bytes already written
-            std::size_t i = out_.size();
-            while (i > 0 && static_cast<unsigned char>(out_[i - 1]) == 0xFF) {
-                out_[--i] = '\0';
-            }
-            if (i > 0) {
-                ++out_[i - 1];
-            }
-        }
-    }
-    void renormaliseIfNeeded() {
-        if (length_ < laz::kMinLength) {
-            renormalise();
-        }
-    }
-    void renormalise() {
-        do {
-            out_.push_back(static_cast<char>(base_ >> 24));
-            base_ <<= 8;
-            length_ <<= 8;
-        } while (length_ < laz::kMinLength);
-    }
-
-    std::string out_;
-    std::uint32_t base_ = 0;
-    std::uint32_t length_ = laz::kMaxLength;
-};
-
-/// The corrector coder of LASzip's integer compressor, encoding side.
-class IntegerCompressor {
-  public:
-    IntegerCompressor(std::uint32_t bits, std::uint32_t contexts)
-        : bits_(bits < 32 ? bits : 32), kModels_(contexts, SymbolModel(bits_ + 1)) {
-        for (std::uint32_t k = 1; k <= bits_; ++k) {
-            correctors_.emplace_back(1u << std::min(k, 8u));
-        }
-    }
-
-    void compress(Encoder& encoder, std::int32_t prediction, std::int32_t real,
-                  std::uint32_t context = 0) {
-        std::int64_t corrector = static_cast<std::int64_t>(real) - prediction;
-        if (bits_ < 32) {
-            const std::int64_t range = std::int64_t{1} << bits_;
-            if (corrector < -range / 2) {
-                corrector += range;
-            } else if (corrector > range / 2 - 1) {
-                corrector -= range;
-            }
-        } else {
-            corrector = static_cast<std::int32_t>(corrector);  // wraps like the coder
-        }
-        const auto c = static_cast<std::int32_t>(corrector);
-        std::uint32_t magnitude = c <= 0 ? static_cast<std::uint32_t>(-static_cast<std::int64_t>(c))
-                                         : static_cast<std::uint32_t>(c - 1);
-        k_ = 0;
-        while (magnitude != 0) {
-            magnitude >>= 1;
-            ++k_;
-        }
-        encoder.encodeSymbol(kModels_[context], k_);
-        if (k_ == 32) {
-            return;  // the corrector is the range's minimum; nothing more is coded
-        }
-        if (k_ == 0) {
-            encoder.encodeBit(zero_, static_cast<std::uint32_t>(c));
-            return;
-        }
-        auto value = static_cast<std::uint32_t>(
-            c < 0 ? c + static_cast<std::int32_t>((1u << k_) - 1) : c - 1);
-        if (k_ <= 8) {
-            encoder.encodeSymbol(correctors_[k_ - 1], value);
-        } else {
-            const std::uint32_t low = k_ - 8;
-            encoder.encodeSymbol(correctors_[k_ - 1], value >> low);
-            encoder.writeBits(low, value & ((1u << low) - 1));
-        }
-    }
-    std::uint32_t k() const { return k_; }
-
-  private:
-    std::uint32_t bits_;
-    std::vector<SymbolModel> kModels_;
-    BitModel zero_;
-    std::vector<SymbolModel> correctors_;
-    std::uint32_t k_ = 0;
-};
+/// A finished stream's bytes as the test's file builders hold them.
+std::string finished(Encoder& encoder) {
+    const std::vector<std::byte> bytes = encoder.finish();
+    return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
 
 TEST(LazReaderTest, DecoderReadsWhatTheEncoderWrote) {
     Encoder encoder;
@@ -218,7 +77,7 @@ TEST(LazReaderTest, DecoderReadsWhatTheEncoderWrote) {
         integers.compress(encoder, 7, s.integer, i % 3);
         shorts.compress(encoder, 60000, s.shortValue);
     }
-    const std::string bytes = encoder.finish();
+    const std::string bytes = finished(encoder);
 
     laz::ArithmeticDecoder decoder(test::asBytes(bytes));
     BitModel bitIn;
@@ -296,7 +155,7 @@ struct LazFile {
             integers.compress(encoder, lastSize, size, 1);
             lastSize = size;
         }
-        return table + encoder.finish();
+        return table + finished(encoder);
     }
 
     std::string bytes() const {
@@ -429,10 +288,10 @@ struct Format0Points {
             const std::int32_t diffX = xyz[i][0] - xyz[i - 1][0];
             dx.compress(encoder, xMedian.get(), diffX, 1);  // context: single return
             xMedian.add(diffX);
-            const std::uint32_t kx = dx.k();
+            const std::uint32_t kx = dx.lastK();
             dy.compress(encoder, yMedian.get(), 0, 1 + (kx < 20 ? kx & ~1u : 20));
             yMedian.add(0);
-            const std::uint32_t k = (dx.k() + dy.k()) / 2;
+            const std::uint32_t k = (dx.lastK() + dy.lastK()) / 2;
             dz.compress(encoder, lastHeight, xyz[i][2], 1 + (k < 18 ? k & ~1u : 18));
             lastHeight = xyz[i][2];
             for (int b = 0; b < 2; ++b) {
@@ -440,7 +299,7 @@ struct Format0Points {
                                      static_cast<std::uint8_t>(extra[i][b] - extra[i - 1][b]));
             }
         }
-        return bytes + encoder.finish();
+        return bytes + finished(encoder);
     }
 };
 
@@ -575,7 +434,7 @@ struct Layered14Points {
             // The median index of m = 0 (1 of 1), time unchanged, is 0; context: single return.
             dx.compress(xy, xMedian.get(), diff, 1);
             xMedian.add(diff);
-            const std::uint32_t k = dx.k();
+            const std::uint32_t k = dx.lastK();
             dy.compress(xy, yMedian.get(), 0, 1 + (k < 20 ? k & ~1u : 20));
             yMedian.add(0);
             encodeRgb(rgb, rgbModels, rgbNir[i - 1], rgbNir[i]);
@@ -602,13 +461,13 @@ struct Layered14Points {
         // layer(s), one per extra byte. A one-point chunk has no layers at all.
         std::vector<std::string> layers(9);
         if (count > 1) {
-            layers[0] = xy.finish();
-            layers.push_back(rgb.finish());
+            layers[0] = finished(xy);
+            layers.push_back(finished(rgb));
             if (format == 8) {
-                layers.push_back(nir.finish());
+                layers.push_back(finished(nir));
             }
             for (Encoder& encoder : bytes) {
-                layers.push_back(encoder.finish());
+                layers.push_back(finished(encoder));
             }
         } else {
             layers.resize(9 + (format == 8 ? 2 : 1) + extraBytes);

@@ -1,4 +1,4 @@
-#include "io/laz/ArithmeticDecoder.h"
+#include "io/laz/ArithmeticModels.h"
 
 #include <algorithm>
 

@@ -1,0 +1,778 @@
+#include "lod/OctreeIndexer.h"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <tuple>
+#include <utility>
+
+#include <fmt/format.h>
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "core/Error.h"
+
+namespace subscan::lod {
+
+namespace {
+
+using laz::VoxelKey;
+
+/// Levels deeper than this are not made: a node there is about 1e-9 of the cube, below any
+/// scanner's precision, so what still shares it shares one position.
+constexpr int kDeepestLevel = 30;
+/// Records read from the source at a time.
+constexpr std::size_t kPiecePoints = std::size_t{1} << 20;
+/// Working bytes a chunk's point needs beside its record: its position (24), its place in the
+/// node lists (8) and in the sampling grid (8), with room for the vectors' growth.
+constexpr std::size_t kChunkBytesPerPoint = 56;
+
+struct KeyOrder {
+    bool operator()(const VoxelKey& a, const VoxelKey& b) const {
+        return std::tie(a.level, a.x, a.y, a.z) < std::tie(b.level, b.x, b.y, b.z);
+    }
+};
+template <class Value>
+using KeyMap = std::map<VoxelKey, Value, KeyOrder>;
+
+VoxelKey childKey(const VoxelKey& key, int octant) {
+    return {key.level + 1, 2 * key.x + (octant & 1), 2 * key.y + ((octant >> 1) & 1),
+            2 * key.z + ((octant >> 2) & 1)};
+}
+
+VoxelKey parentKey(const VoxelKey& key) {
+    return {key.level - 1, key.x >> 1, key.y >> 1, key.z >> 1};
+}
+
+/// Positions of records: file coordinate = stored int32 * scale + offset.
+glm::dvec3 recordPosition(const std::byte* record, const Quantization& quantization) {
+    std::int32_t stored[3];
+    std::memcpy(stored, record, sizeof stored);
+    return glm::dvec3(stored[0], stored[1], stored[2]) * quantization.scale + quantization.offset;
+}
+
+double nodeSide(const OctreeCube& cube, int level) {
+    return 2.0 * cube.halfSize / static_cast<double>(std::int64_t{1} << level);
+}
+
+glm::dvec3 nodeMin(const OctreeCube& cube, const VoxelKey& key) {
+    const double side = nodeSide(cube, key.level);
+    return cube.center - cube.halfSize + glm::dvec3(key.x, key.y, key.z) * side;
+}
+
+void checkCancelled(const IndexSettings& settings) {
+    if (settings.cancelled != nullptr && settings.cancelled->load()) {
+        throw Error("interrupted; no output was written");
+    }
+}
+
+void report(const IndexSettings& settings, double fraction, std::string_view phase) {
+    if (settings.progress) {
+        settings.progress(std::clamp(fraction, 0.0, 1.0), phase);
+    }
+}
+
+/// A folder of temporary files, removed with everything in it when this goes away.
+class TemporaryFolder {
+  public:
+    explicit TemporaryFolder(const std::filesystem::path& parent) {
+        std::string pattern = (parent / "subscan-index-XXXXXX").string();
+        if (::mkdtemp(pattern.data()) == nullptr) {
+            throw Error(fmt::format("{}: cannot make a temporary folder there: {}", parent.string(),
+                                    std::strerror(errno)));
+        }
+        path_ = pattern;
+    }
+    ~TemporaryFolder() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path_, ignored);
+    }
+    TemporaryFolder(const TemporaryFolder&) = delete;
+    TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+
+    const std::filesystem::path& path() const { return path_; }
+
+  private:
+    std::filesystem::path path_;
+};
+
+void writeBytes(const std::filesystem::path& path, std::span<const std::byte> bytes, bool append) {
+    std::FILE* file = std::fopen(path.c_str(), append ? "ab" : "wb");
+    const bool written =
+        file != nullptr && std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+    const bool closed = file != nullptr && std::fclose(file) == 0;
+    if (!written || !closed) {
+        throw Error(fmt::format("{}: cannot write temporary data (is the disk full?)",
+                                path.parent_path().string()));
+    }
+}
+
+std::vector<std::byte> readBytes(const std::filesystem::path& path, std::uint64_t offset,
+                                 std::size_t size) {
+    std::vector<std::byte> bytes(size);
+    std::ifstream file(path, std::ios::binary);
+    file.seekg(static_cast<std::streamoff>(offset));
+    file.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+    if (!file) {
+        throw Error(fmt::format("{}: cannot read back temporary data", path.string()));
+    }
+    return bytes;
+}
+
+/// The points a node holds: indices into its chunk's records.
+using PointList = std::vector<std::uint32_t>;
+
+/// Greedy Poisson-disk acceptance, with its working arrays kept from node to node: a point is
+/// accepted when no point accepted before lies closer than the node's spacing. A node's cube is
+/// 128 spacings wide (kRootGridCells), so accepted points are listed per cell of the spacing's
+/// size in a dense 128^3 grid indexed in Morton order (a point closer than the spacing lies in
+/// one of the 27 cells around a candidate's). Candidates are visited block by block (16^3
+/// cells, in Morton order) and in a pseudo-random order fixed by the node's key within a block:
+/// the grid and the candidates' positions are then read from cache, where a random order over
+/// the whole node missed it at every step.
+class EvenSampler {
+  public:
+    EvenSampler() : heads_(std::size_t{1} << (3 * kAxisBits), kNone) {
+        for (std::uint32_t v = 0; v < kCells; ++v) {
+            std::uint32_t spread = 0;
+            for (int bit = 0; bit < kAxisBits; ++bit) {
+                spread |= ((v >> bit) & 1u) << (3 * bit);
+            }
+            spread_[v] = spread;
+        }
+    }
+
+    /// Moves the points of `children` that the node at `key` accepts into `parent`; the rest
+    /// stay.
+    void sample(std::span<const glm::dvec3> positions, const OctreeCube& cube, const VoxelKey& key,
+                std::span<PointList*> children, PointList& parent) {
+        candidates_.clear();
+        for (const PointList* child : children) {
+            candidates_.insert(candidates_.end(), child->begin(), child->end());
+        }
+        const double spacing = cube.rootSpacing / static_cast<double>(std::int64_t{1} << key.level);
+        accept(positions, spacing, nodeMin(cube, key), key);
+        std::size_t at = 0;
+        for (PointList* child : children) {
+            std::size_t kept = 0;
+            for (const std::uint32_t point : *child) {
+                if (accepted_[at++] != 0) {
+                    parent.push_back(point);
+                } else {
+                    (*child)[kept++] = point;
+                }
+            }
+            child->resize(kept);
+        }
+    }
+
+  private:
+    static constexpr int kAxisBits = 7;  // 128 cells per axis
+    static constexpr std::uint32_t kCells = 1u << kAxisBits;
+    static_assert(kCells == kRootGridCells);
+    static constexpr int kBlockShift = 3 * 4;  // blocks of 16^3 cells
+    static constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+
+    std::uint32_t cellIndex(const glm::ivec3& cell) const {
+        return spread_[cell.x] | (spread_[cell.y] << 1) | (spread_[cell.z] << 2);
+    }
+
+    void accept(std::span<const glm::dvec3> positions, double spacing, const glm::dvec3& origin,
+                const VoxelKey& key) {
+        const std::size_t count = candidates_.size();
+        // Each candidate's position in cell units and its cell (points on the cube's far faces
+        // belong to its last cells, as node membership has it).
+        local_.resize(count);
+        cellOf_.resize(count);
+        constexpr std::size_t kBlocks = std::size_t{1} << (3 * kAxisBits - kBlockShift);
+        std::array<std::uint32_t, kBlocks + 1> blockStart{};
+        for (std::size_t i = 0; i < count; ++i) {
+            const glm::dvec3 scaled = (positions[candidates_[i]] - origin) / spacing;
+            local_[i] = glm::vec3(scaled);
+            const glm::ivec3 cell =
+                glm::clamp(glm::ivec3(glm::floor(scaled)), glm::ivec3(0), glm::ivec3(kCells - 1));
+            cellOf_[i] = cellIndex(cell);
+            ++blockStart[(cellOf_[i] >> kBlockShift) + 1];
+        }
+        for (std::size_t b = 0; b < kBlocks; ++b) {
+            blockStart[b + 1] += blockStart[b];
+        }
+        order_.resize(count);
+        std::array<std::uint32_t, kBlocks> fill{};
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const std::uint32_t block = cellOf_[i] >> kBlockShift;
+            order_[blockStart[block] + fill[block]++] = i;
+        }
+        // Fisher-Yates within each block with a splitmix64 stream seeded by the key: the same
+        // input gives the same file.
+        std::uint64_t state = (static_cast<std::uint64_t>(key.level) << 60) ^
+                              (static_cast<std::uint64_t>(key.x) << 40) ^
+                              (static_cast<std::uint64_t>(key.y) << 20) ^
+                              static_cast<std::uint64_t>(key.z);
+        for (std::size_t b = 0; b < kBlocks; ++b) {
+            for (std::uint32_t i = blockStart[b + 1]; i > blockStart[b] + 1; --i) {
+                state += 0x9E3779B97F4A7C15ull;
+                std::uint64_t z = state;
+                z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+                z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+                z ^= z >> 31;
+                const std::uint32_t span = i - blockStart[b];
+                std::swap(order_[i - 1], order_[blockStart[b] + z % span]);
+            }
+        }
+
+        next_.resize(count);
+        accepted_.assign(count, 0);
+        touched_.clear();
+        for (const std::uint32_t i : order_) {
+            const glm::vec3 p = local_[i];
+            const glm::ivec3 cell =
+                glm::clamp(glm::ivec3(glm::floor(p)), glm::ivec3(0), glm::ivec3(kCells - 1));
+            // The candidate's own cell first: at the deep levels most candidates are turned
+            // away by a point there.
+            bool free = isFarFromCell(p, cellOf_[i]);
+            const glm::ivec3 low = glm::max(cell - 1, glm::ivec3(0));
+            const glm::ivec3 high = glm::min(cell + 1, glm::ivec3(kCells - 1));
+            for (int z = low.z; z <= high.z && free; ++z) {
+                const std::uint32_t zBits = spread_[z] << 2;
+                for (int y = low.y; y <= high.y && free; ++y) {
+                    const std::uint32_t yzBits = zBits | (spread_[y] << 1);
+                    for (int x = low.x; x <= high.x && free; ++x) {
+                        const std::uint32_t near = yzBits | spread_[x];
+                        free = near == cellOf_[i] || isFarFromCell(p, near);
+                    }
+                }
+            }
+            if (free) {
+                accepted_[i] = 1;
+                std::uint32_t& head = heads_[cellOf_[i]];
+                if (head == kNone) {
+                    touched_.push_back(cellOf_[i]);
+                }
+                next_[i] = head;
+                head = i;
+            }
+        }
+        for (const std::uint32_t cell : touched_) {
+            heads_[cell] = kNone;  // the grid is clean for the next node
+        }
+    }
+
+    /// Whether every point accepted in `cell` lies at least one spacing (one cell) from `p`.
+    bool isFarFromCell(const glm::vec3& p, std::uint32_t cell) const {
+        for (std::uint32_t j = heads_[cell]; j != kNone; j = next_[j]) {
+            const glm::vec3 d = local_[j] - p;
+            if (glm::dot(d, d) < 1.0f) {
+                return false;
+            }
+        }
+        return true;
+    }
+
+    std::array<std::uint32_t, kCells> spread_{};
+    std::vector<std::uint32_t> heads_;  // per cell, the last accepted point's candidate index
+    PointList candidates_;
+    std::vector<glm::vec3> local_;
+    std::vector<std::uint32_t> cellOf_;
+    std::vector<std::uint32_t> order_;
+    std::vector<std::uint32_t> next_;
+    std::vector<std::uint8_t> accepted_;
+    std::vector<std::uint32_t> touched_;
+};
+
+/// Gathers the records of `points` into one contiguous block.
+std::vector<std::byte> gatherRecords(std::span<const std::byte> records, std::size_t length,
+                                     const PointList& points) {
+    std::vector<std::byte> gathered(points.size() * length);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        std::memcpy(gathered.data() + i * length, records.data() + points[i] * length, length);
+    }
+    return gathered;
+}
+
+/// One chunk's points indexed in memory: the subtree below `root`. Every node but the root is
+/// finished and written to the sink; the root's accepted points are returned (the levels above
+/// draw from them).
+class ChunkIndexer {
+  public:
+    ChunkIndexer(const OctreeCube& cube, const Quantization& quantization, std::size_t length,
+                 std::size_t maxNodePoints, NodeSink& sink)
+        : cube_(cube),
+          quantization_(quantization),
+          length_(length),
+          maxNodePoints_(maxNodePoints),
+          sink_(sink) {}
+
+    struct Result {
+        std::vector<std::byte> rootRecords;
+        std::size_t rootPoints = 0;
+        std::vector<std::pair<VoxelKey, std::size_t>> written;  // every node written, by key
+    };
+
+    Result index(const VoxelKey& root, std::vector<std::byte> records) {
+        records_ = std::move(records);
+        const std::size_t count = records_.size() / length_;
+        positions_.resize(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            positions_[i] = recordPosition(records_.data() + i * length_, quantization_);
+        }
+        PointList all(count);
+        for (std::uint32_t i = 0; i < count; ++i) {
+            all[i] = i;
+        }
+        Result result;
+        PointList rootPoints = build(root, std::move(all), result);
+        result.rootPoints = rootPoints.size();
+        result.rootRecords = gatherRecords(records_, length_, rootPoints);
+        return result;
+    }
+
+  private:
+    /// Builds the subtree of `key` over `points`, writes every finished node below it and
+    /// returns the points `key` holds (a leaf: all of them; the caller's sampling then decides
+    /// which stay).
+    PointList build(const VoxelKey& key, PointList points, Result& result) {
+        const double side = nodeSide(cube_, key.level + 1);
+        if (points.size() <= maxNodePoints_ || key.level >= kDeepestLevel ||
+            side <
+                std::min({quantization_.scale.x, quantization_.scale.y, quantization_.scale.z})) {
+            return points;
+        }
+        std::array<PointList, 8> parts;
+        const glm::dvec3 middle = nodeMin(cube_, key) + side;
+        for (const std::uint32_t point : points) {
+            const glm::dvec3& p = positions_[point];
+            const int octant =
+                (p.x >= middle.x ? 1 : 0) | (p.y >= middle.y ? 2 : 0) | (p.z >= middle.z ? 4 : 0);
+            parts[octant].push_back(point);
+        }
+        PointList().swap(points);
+        std::array<PointList, 8> held;
+        std::vector<PointList*> children;
+        std::vector<VoxelKey> childKeys;
+        for (int octant = 0; octant < 8; ++octant) {
+            if (!parts[octant].empty()) {
+                const VoxelKey child = childKey(key, octant);
+                held[octant] = build(child, std::move(parts[octant]), result);
+                children.push_back(&held[octant]);
+                childKeys.push_back(child);
+            }
+        }
+        PointList mine;
+        sampler_.sample(positions_, cube_, key, children, mine);
+        for (std::size_t i = 0; i < children.size(); ++i) {
+            write(childKeys[i], *children[i], result);
+        }
+        return mine;
+    }
+
+    void write(const VoxelKey& key, const PointList& points, Result& result) {
+        if (points.empty()) {
+            return;
+        }
+        const std::vector<std::byte> gathered = gatherRecords(records_, length_, points);
+        sink_.writeNode(key, gathered, points.size());
+        result.written.emplace_back(key, points.size());
+    }
+
+    OctreeCube cube_;
+    Quantization quantization_;
+    std::size_t length_;
+    std::size_t maxNodePoints_;
+    NodeSink& sink_;
+    std::vector<std::byte> records_;
+    std::vector<glm::dvec3> positions_;
+    EvenSampler sampler_;
+};
+
+/// Cells of a count grid at `level` (2^level per axis), flattened x fastest.
+std::size_t gridIndex(const VoxelKey& key, int level) {
+    const std::size_t n = std::size_t{1} << level;
+    return (static_cast<std::size_t>(key.z) * n + static_cast<std::size_t>(key.y)) * n +
+           static_cast<std::size_t>(key.x);
+}
+
+struct Chunking {
+    int gridLevel = 0;
+    std::vector<VoxelKey> chunks;
+    std::vector<std::uint32_t> chunkOfCell;  // per cell of the grid
+};
+
+/// Cuts the cloud into chunks of at most `maxPoints` (where the grid allows) from its point
+/// counts per cell of a 2^gridLevel grid: top-down, a node with few enough points is a chunk.
+Chunking cutIntoChunks(std::vector<std::uint32_t> counts, int gridLevel, std::size_t maxPoints) {
+    // Sums per node of every coarser level, finest first.
+    std::vector<std::vector<std::uint64_t>> sums(gridLevel + 1);
+    sums[gridLevel].assign(counts.begin(), counts.end());
+    for (int level = gridLevel - 1; level >= 0; --level) {
+        const std::int32_t n = 1 << level;
+        sums[level].assign(static_cast<std::size_t>(n) * n * n, 0);
+        for (std::int32_t z = 0; z < 2 * n; ++z) {
+            for (std::int32_t y = 0; y < 2 * n; ++y) {
+                for (std::int32_t x = 0; x < 2 * n; ++x) {
+                    sums[level][gridIndex({level, x / 2, y / 2, z / 2}, level)] +=
+                        sums[level + 1][gridIndex({level + 1, x, y, z}, level + 1)];
+                }
+            }
+        }
+    }
+    Chunking chunking;
+    chunking.gridLevel = gridLevel;
+    chunking.chunkOfCell.assign(counts.size(), 0xFFFFFFFFu);
+    std::vector<VoxelKey> pending{{0, 0, 0, 0}};
+    while (!pending.empty()) {
+        const VoxelKey key = pending.back();
+        pending.pop_back();
+        const std::uint64_t count = sums[key.level][gridIndex(key, key.level)];
+        if (count == 0) {
+            continue;
+        }
+        if (count > maxPoints && key.level < gridLevel) {
+            for (int octant = 0; octant < 8; ++octant) {
+                pending.push_back(childKey(key, octant));
+            }
+            continue;
+        }
+        const auto id = static_cast<std::uint32_t>(chunking.chunks.size());
+        chunking.chunks.push_back(key);
+        const std::int32_t span = 1 << (gridLevel - key.level);
+        for (std::int32_t z = 0; z < span; ++z) {
+            for (std::int32_t y = 0; y < span; ++y) {
+                for (std::int32_t x = 0; x < span; ++x) {
+                    const VoxelKey cell{gridLevel, key.x * span + x, key.y * span + y,
+                                        key.z * span + z};
+                    chunking.chunkOfCell[gridIndex(cell, gridLevel)] = id;
+                }
+            }
+        }
+    }
+    return chunking;
+}
+
+class Indexer {
+  public:
+    Indexer(PointRecordSource& source, NodeSink& sink, const IndexSettings& settings)
+        : source_(source),
+          sink_(sink),
+          settings_(settings),
+          info_(source.info()),
+          length_(info_.format.recordLength()),
+          threads_(settings.threads != 0 ? settings.threads
+                                         : std::max(1u, std::thread::hardware_concurrency())) {
+        summary_.cube = octreeCubeFor(info_.min, info_.max);
+        // Each thread indexes one chunk at a time; a quarter of the budget stays for the
+        // distribution's buffers and the sink's encoding.
+        const std::size_t perPoint = length_ + kChunkBytesPerPoint;
+        maxChunkPoints_ = std::max<std::size_t>(settings.maxNodePoints * 8,
+                                                settings.memoryBytes * 3 / 4 / threads_ / perPoint);
+        maxChunkPoints_ = std::min<std::size_t>(maxChunkPoints_, 0xFFFFFFFFu);
+    }
+
+    IndexSummary run() {
+        if (info_.pointCount == 0) {
+            throw Error(fmt::format("{}: holds no points; there is nothing to index", info_.name));
+        }
+        if (info_.pointCount <= maxChunkPoints_) {
+            indexInMemory();
+        } else {
+            indexOutOfCore();
+        }
+        report(settings_, 1.0, "done");
+        return summary_;
+    }
+
+  private:
+    void count(const VoxelKey& key, std::size_t points) {
+        if (summary_.levels.size() <= static_cast<std::size_t>(key.level)) {
+            summary_.levels.resize(key.level + 1);
+        }
+        summary_.levels[key.level].nodes += 1;
+        summary_.levels[key.level].points += points;
+        summary_.points += points;
+        summary_.largestNode = std::max(summary_.largestNode, points);
+    }
+
+    void countWritten(const ChunkIndexer::Result& result) {
+        for (const auto& [key, points] : result.written) {
+            count(key, points);
+        }
+    }
+
+    void writeNode(const VoxelKey& key, std::span<const std::byte> records, std::size_t points) {
+        sink_.writeNode(key, records, points);
+        count(key, points);
+    }
+
+    /// Reads the whole source in pieces, calling `each(records, count)`.
+    template <class Each>
+    void readAll(double from, double to, std::string_view phase, const Each& each) {
+        source_.rewind();
+        std::vector<std::byte> piece;
+        std::uint64_t done = 0;
+        for (;;) {
+            checkCancelled(settings_);
+            piece.clear();
+            const std::size_t read = source_.read(piece, kPiecePoints);
+            if (read == 0) {
+                break;
+            }
+            each(piece, read);
+            done += read;
+            report(settings_,
+                   from + (to - from) * static_cast<double>(done) /
+                              static_cast<double>(info_.pointCount),
+                   phase);
+        }
+        if (done != info_.pointCount) {
+            throw Error(fmt::format("{}: gave {} points where its header promised {}", info_.name,
+                                    done, info_.pointCount));
+        }
+    }
+
+    void indexInMemory() {
+        std::vector<std::byte> records;
+        records.reserve(info_.pointCount * length_);
+        readAll(0.0, 0.3, "reading", [&](const std::vector<std::byte>& piece, std::size_t) {
+            records.insert(records.end(), piece.begin(), piece.end());
+        });
+        summary_.chunks = 1;
+        ChunkIndexer indexer(summary_.cube, info_.quantization, length_, settings_.maxNodePoints,
+                             sink_);
+        report(settings_, 0.3, "indexing");
+        const ChunkIndexer::Result result = indexer.index({0, 0, 0, 0}, std::move(records));
+        countWritten(result);
+        writeNode({0, 0, 0, 0}, result.rootRecords, result.rootPoints);
+    }
+
+    void indexOutOfCore() {
+        TemporaryFolder folder(settings_.temporaryDirectory);
+        // 128 cells per axis hold any cloud up to 2^27 points in chunks of millions; finer
+        // grids for more (256^3 counters: 64 MB).
+        const int gridLevel = info_.pointCount <= (std::uint64_t{1} << 27) ? 7 : 8;
+        const std::size_t cells = std::size_t{1} << (3 * gridLevel);
+        std::vector<std::uint32_t> counts(cells, 0);
+        readAll(0.0, 0.15, "counting", [&](const std::vector<std::byte>& piece, std::size_t n) {
+            for (std::size_t i = 0; i < n; ++i) {
+                const glm::dvec3 p = recordPosition(piece.data() + i * length_, info_.quantization);
+                ++counts[gridIndex(nodeKeyAt(summary_.cube, p, gridLevel), gridLevel)];
+            }
+        });
+        const Chunking chunking = cutIntoChunks(std::move(counts), gridLevel, maxChunkPoints_);
+        summary_.chunks = chunking.chunks.size();
+
+        distribute(chunking, folder.path());
+        indexChunks(chunking, folder.path());
+        buildTop(chunking, folder.path());
+    }
+
+    std::filesystem::path chunkFile(const std::filesystem::path& folder, std::size_t id) const {
+        return folder / fmt::format("chunk-{}.bin", id);
+    }
+
+    /// Appends every record to its chunk's file, buffering up to a quarter of the budget.
+    void distribute(const Chunking& chunking, const std::filesystem::path& folder) {
+        std::vector<std::vector<std::byte>> buffers(chunking.chunks.size());
+        std::size_t buffered = 0;
+        const std::size_t budget = std::max<std::size_t>(settings_.memoryBytes / 4, 1 << 20);
+        const auto flush = [&] {
+            for (std::size_t id = 0; id < buffers.size(); ++id) {
+                if (!buffers[id].empty()) {
+                    writeBytes(chunkFile(folder, id), buffers[id], true);
+                    std::vector<std::byte>().swap(buffers[id]);
+                }
+            }
+            buffered = 0;
+        };
+        readAll(0.15, 0.35, "distributing",
+                [&](const std::vector<std::byte>& piece, std::size_t n) {
+                    for (std::size_t i = 0; i < n; ++i) {
+                        const std::byte* record = piece.data() + i * length_;
+                        const glm::dvec3 p = recordPosition(record, info_.quantization);
+                        const VoxelKey cell = nodeKeyAt(summary_.cube, p, chunking.gridLevel);
+                        const std::uint32_t id =
+                            chunking.chunkOfCell[gridIndex(cell, chunking.gridLevel)];
+                        buffers[id].insert(buffers[id].end(), record, record + length_);
+                    }
+                    buffered += n * length_;
+                    if (buffered > budget) {
+                        flush();
+                    }
+                });
+        flush();
+    }
+
+    /// Indexes the chunks on `threads_` threads; each chunk's top node goes to roots.bin.
+    void indexChunks(const Chunking& chunking, const std::filesystem::path& folder) {
+        std::mutex mutex;
+        std::size_t nextChunk = 0;
+        std::uint64_t pointsDone = 0;
+        std::exception_ptr failure;
+        const std::filesystem::path roots = folder / "roots.bin";
+        writeBytes(roots, {}, false);
+        std::uint64_t rootsSize = 0;
+
+        const auto work = [&] {
+            for (;;) {
+                std::size_t id = 0;
+                {
+                    std::lock_guard lock(mutex);
+                    if (failure || nextChunk == chunking.chunks.size()) {
+                        return;
+                    }
+                    id = nextChunk++;
+                }
+                try {
+                    checkCancelled(settings_);
+                    const std::filesystem::path file = chunkFile(folder, id);
+                    const auto size = static_cast<std::size_t>(std::filesystem::file_size(file));
+                    std::vector<std::byte> records = readBytes(file, 0, size);
+                    std::filesystem::remove(file);
+                    const std::size_t points = size / length_;
+                    ChunkIndexer indexer(summary_.cube, info_.quantization, length_,
+                                         settings_.maxNodePoints, sink_);
+                    const ChunkIndexer::Result result =
+                        indexer.index(chunking.chunks[id], std::move(records));
+                    std::lock_guard lock(mutex);
+                    countWritten(result);
+                    writeBytes(roots, result.rootRecords, true);
+                    rootPlaces_[chunking.chunks[id]] = {rootsSize, result.rootPoints};
+                    rootsSize += result.rootRecords.size();
+                    pointsDone += points;
+                    report(settings_,
+                           0.35 + 0.6 * static_cast<double>(pointsDone) /
+                                      static_cast<double>(info_.pointCount),
+                           "indexing");
+                } catch (...) {
+                    std::lock_guard lock(mutex);
+                    if (!failure) {
+                        failure = std::current_exception();
+                    }
+                }
+            }
+        };
+        {
+            std::vector<std::jthread> workers;
+            for (unsigned thread = 1; thread < threads_; ++thread) {
+                workers.emplace_back(work);
+            }
+            // The calling thread works too and reports progress between its chunks.
+            work();
+        }
+        if (failure) {
+            std::rethrow_exception(failure);
+        }
+    }
+
+    /// The levels above the chunks: each node samples its children's points, depth first, so
+    /// only the nodes along one path and their children are in memory at once.
+    void buildTop(const Chunking& chunking, const std::filesystem::path& folder) {
+        KeyMap<bool> above;  // every strict ancestor of a chunk
+        for (const VoxelKey& chunk : chunking.chunks) {
+            for (VoxelKey key = chunk; key.level > 0;) {
+                key = parentKey(key);
+                above[key] = true;
+            }
+        }
+        const std::filesystem::path roots = folder / "roots.bin";
+        if (above.empty()) {  // the root is the only chunk
+            const auto& [offset, points] = rootPlaces_.at(VoxelKey{0, 0, 0, 0});
+            writeNode({0, 0, 0, 0}, readBytes(roots, offset, points * length_), points);
+            return;
+        }
+        std::vector<std::byte> rootRecords = buildAbove({0, 0, 0, 0}, above, roots);
+        writeNode({0, 0, 0, 0}, rootRecords, rootRecords.size() / length_);
+    }
+
+    /// Returns the records `key` holds after sampling its children, whose rest it writes.
+    std::vector<std::byte> buildAbove(const VoxelKey& key, const KeyMap<bool>& above,
+                                      const std::filesystem::path& roots) {
+        checkCancelled(settings_);
+        std::vector<VoxelKey> childKeys;
+        std::vector<std::byte> records;  // the children's points, child after child
+        std::vector<std::size_t> childStart;
+        for (int octant = 0; octant < 8; ++octant) {
+            const VoxelKey child = childKey(key, octant);
+            std::vector<std::byte> held;
+            if (const auto place = rootPlaces_.find(child); place != rootPlaces_.end()) {
+                held = readBytes(roots, place->second.first, place->second.second * length_);
+            } else if (above.contains(child)) {
+                held = buildAbove(child, above, roots);
+            } else {
+                continue;
+            }
+            childKeys.push_back(child);
+            childStart.push_back(records.size() / length_);
+            records.insert(records.end(), held.begin(), held.end());
+        }
+        childStart.push_back(records.size() / length_);
+
+        const std::size_t count = records.size() / length_;
+        std::vector<glm::dvec3> positions(count);
+        for (std::size_t i = 0; i < count; ++i) {
+            positions[i] = recordPosition(records.data() + i * length_, info_.quantization);
+        }
+        std::vector<PointList> lists(childKeys.size());
+        std::vector<PointList*> children;
+        for (std::size_t c = 0; c < childKeys.size(); ++c) {
+            for (std::size_t i = childStart[c]; i < childStart[c + 1]; ++i) {
+                lists[c].push_back(static_cast<std::uint32_t>(i));
+            }
+            children.push_back(&lists[c]);
+        }
+        PointList mine;
+        EvenSampler().sample(positions, summary_.cube, key, children, mine);
+        for (std::size_t c = 0; c < childKeys.size(); ++c) {
+            if (!lists[c].empty()) {
+                writeNode(childKeys[c], gatherRecords(records, length_, lists[c]), lists[c].size());
+            }
+        }
+        return gatherRecords(records, length_, mine);
+    }
+
+    PointRecordSource& source_;
+    NodeSink& sink_;
+    const IndexSettings& settings_;
+    PointRecordSourceInfo info_;
+    std::size_t length_;
+    unsigned threads_;
+    std::size_t maxChunkPoints_ = 0;
+    IndexSummary summary_;
+    KeyMap<std::pair<std::uint64_t, std::size_t>> rootPlaces_;  // in roots.bin: offset, points
+};
+
+}  // namespace
+
+OctreeCube octreeCubeFor(const glm::dvec3& min, const glm::dvec3& max) {
+    OctreeCube cube;
+    cube.center = (min + max) * 0.5;
+    const glm::dvec3 size = max - min;
+    const double extent = std::max({size.x, size.y, size.z});
+    // A hair larger than the bounds, so that the largest coordinates fall inside; at least a
+    // millimetre-sized cube around a single point.
+    cube.halfSize = std::max(extent * 0.5 * (1.0 + 1e-9), 1e-3);
+    cube.rootSpacing = 2.0 * cube.halfSize / kRootGridCells;
+    return cube;
+}
+
+laz::VoxelKey nodeKeyAt(const OctreeCube& cube, const glm::dvec3& position, int level) {
+    const double cells = static_cast<double>(std::int64_t{1} << level);
+    const glm::dvec3 relative = (position - (cube.center - cube.halfSize)) / (2.0 * cube.halfSize);
+    const glm::dvec3 cell = glm::clamp(glm::floor(relative * cells), 0.0, cells - 1.0);
+    return {level, static_cast<std::int32_t>(cell.x), static_cast<std::int32_t>(cell.y),
+            static_cast<std::int32_t>(cell.z)};
+}
+
+IndexSummary buildOctree(PointRecordSource& source, NodeSink& sink, const IndexSettings& settings) {
+    return Indexer(source, sink, settings).run();
+}
+
+}  // namespace subscan::lod
