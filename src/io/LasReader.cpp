@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,7 @@
 #include "core/Error.h"
 #include "io/ByteOrder.h"
 #include "io/LasFormat.h"
+#include "io/LasHeader.h"
 #include "io/laz/Copc.h"
 #include "io/laz/LazDecoder.h"
 
@@ -48,41 +50,6 @@ ClassificationField classificationField(int pointFormat) {
     return pointFormat < kFirstExtendedFormat ? kLegacyClassification : kExtendedClassification;
 }
 
-struct PointFormatLayout {
-    std::size_t recordSize;
-    std::optional<std::size_t> colorOffset;  // three uint16 (R, G, B) where the format has them
-    int firstMinorVersion;                   // the LAS 1.x version that introduced the format
-};
-
-// LAS 1.4 R15, section 2.6: formats 0-5 extend the 20-byte legacy core, formats 6-10 the 30-byte
-// core that LAS 1.4 introduced (wider return and class fields, 16-bit scan angle, GPS time).
-constexpr std::array<PointFormatLayout, 11> kPointFormats{{
-    {20, std::nullopt, 0},
-    {28, std::nullopt, 0},
-    {26, 20, 2},
-    {34, 28, 2},
-    {57, std::nullopt, 3},
-    {63, 28, 3},
-    {30, std::nullopt, 4},
-    {36, 30, 4},
-    {38, 30, 4},
-    {59, std::nullopt, 4},
-    {67, 30, 4},
-}};
-
-struct LasHeader {
-    int versionMinor = 0;
-    std::size_t headerSize = 0;
-    std::size_t pointDataOffset = 0;
-    int pointFormat = 0;
-    std::size_t recordLength = 0;
-    std::uint64_t pointCount = 0;
-    glm::dvec3 scale{1.0};
-    glm::dvec3 offset{0.0};
-    Bounds declaredBounds;
-    std::optional<std::span<const std::byte>> laszipRecord;  // LAZ and COPC files
-};
-
 template <class T>
 T loadField(std::span<const std::byte> file, std::size_t offset) {
     return loadLittleEndian<T>(file.data() + offset);
@@ -100,18 +67,18 @@ std::size_t requiredHeaderSize(int versionMinor) {
     return versionMinor == 3 ? kHeaderSize13 : kHeaderSize14;
 }
 
-/// The payload of the first VLR (between the header and the point data) with this user id and
-/// record id. The VLR area belongs to other readers too: a malformed one merely ends the search.
-std::optional<std::span<const std::byte>> findVlr(std::span<const std::byte> file,
-                                                  const LasHeader& header, std::string_view user,
-                                                  std::uint16_t recordId) {
-    const std::uint32_t vlrCount = loadField<std::uint32_t>(file, header_field::kVlrCount);
+}  // namespace
+
+std::optional<std::span<const std::byte>> findLasVlr(std::span<const std::byte> head,
+                                                     const LasHeader& header, std::string_view user,
+                                                     std::uint16_t recordId) {
+    const std::uint32_t vlrCount = loadField<std::uint32_t>(head, header_field::kVlrCount);
     std::size_t position = header.headerSize;
     for (std::uint32_t i = 0; i < vlrCount; ++i) {
         if (header.pointDataOffset - position < kVlrHeaderSize) {
             return std::nullopt;
         }
-        const std::byte* record = file.data() + position;
+        const std::byte* record = head.data() + position;
         const std::string_view userId(reinterpret_cast<const char*>(record + kVlrUserIdOffset),
                                       kVlrUserIdSize);
         const std::size_t payload = loadLittleEndian<std::uint16_t>(record + kVlrLengthOffset);
@@ -120,12 +87,14 @@ std::optional<std::span<const std::byte>> findVlr(std::span<const std::byte> fil
         }
         if (userId.substr(0, userId.find('\0')) == user &&
             loadLittleEndian<std::uint16_t>(record + kVlrRecordIdOffset) == recordId) {
-            return file.subspan(position + kVlrHeaderSize, payload);
+            return head.subspan(position + kVlrHeaderSize, payload);
         }
         position += kVlrHeaderSize + payload;
     }
     return std::nullopt;
 }
+
+namespace {
 
 void checkScaleAndOffset(const LasHeader& header) {
     for (int axis = 0; axis < 3; ++axis) {
@@ -144,27 +113,29 @@ void checkScaleAndOffset(const LasHeader& header) {
     }
 }
 
-/// Validates the public header block against the file; every size it returns is in range.
-LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
-    if (file.size() < kSignature.size() ||
-        std::memcmp(file.data(), kSignature.data(), kSignature.size()) != 0) {
+}  // namespace
+
+LasHeader parseLasHeader(std::span<const std::byte> head, std::uint64_t fileSize,
+                         ReadContext& context) {
+    if (head.size() < kSignature.size() ||
+        std::memcmp(head.data(), kSignature.data(), kSignature.size()) != 0) {
         throw Error("it does not start with the LAS signature 'LASF'");
     }
-    if (file.size() < kHeaderSizeUpTo12) {
+    if (fileSize < kHeaderSizeUpTo12) {
         throw Error(
             fmt::format("the file has only {} bytes, fewer than the {} bytes of the smallest "
                         "LAS header (file truncated?)",
-                        file.size(), kHeaderSizeUpTo12));
+                        fileSize, kHeaderSizeUpTo12));
     }
-    const auto formatByte = loadField<std::uint8_t>(file, header_field::kPointFormat);
+    const auto formatByte = loadField<std::uint8_t>(head, header_field::kPointFormat);
     LasHeader header;
-    const int major = loadField<std::uint8_t>(file, header_field::kVersionMajor);
-    header.versionMinor = loadField<std::uint8_t>(file, header_field::kVersionMinor);
+    const int major = loadField<std::uint8_t>(head, header_field::kVersionMajor);
+    header.versionMinor = loadField<std::uint8_t>(head, header_field::kVersionMinor);
     if (major != 1 || header.versionMinor > kLatestMinorVersion) {
         throw Error(fmt::format("LAS version {}.{} is not supported (supported: 1.0 to 1.{})",
                                 major, header.versionMinor, kLatestMinorVersion));
     }
-    header.headerSize = loadField<std::uint16_t>(file, header_field::kHeaderSize);
+    header.headerSize = loadField<std::uint16_t>(head, header_field::kHeaderSize);
     const std::size_t required = requiredHeaderSize(header.versionMinor);
     if (header.headerSize < required) {
         throw Error(
@@ -172,24 +143,27 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
                         "bytes that version needs",
                         header.versionMinor, header.headerSize, required));
     }
-    if (header.headerSize > file.size()) {
+    if (header.headerSize > fileSize) {
         throw Error(
             fmt::format("the file has only {} bytes, fewer than its {}-byte LAS header "
                         "(file truncated?)",
-                        file.size(), header.headerSize));
+                        fileSize, header.headerSize));
     }
-    header.pointDataOffset = loadField<std::uint32_t>(file, header_field::kPointDataOffset);
+    header.pointDataOffset = loadField<std::uint32_t>(head, header_field::kPointDataOffset);
     if (header.pointDataOffset < header.headerSize) {
         throw Error(fmt::format("the LAS point data offset {} lies inside the {}-byte header",
                                 header.pointDataOffset, header.headerSize));
     }
-    if (header.pointDataOffset > file.size()) {
+    if (header.pointDataOffset > fileSize) {
         throw Error(
             fmt::format("the LAS point data offset {} lies beyond the end of the file "
                         "({} bytes; file truncated?)",
-                        header.pointDataOffset, file.size()));
+                        header.pointDataOffset, fileSize));
     }
-    header.laszipRecord = findVlr(file, header, kLaszipUserId, kLaszipRecordId);
+    if (head.size() < header.pointDataOffset) {
+        throw std::logic_error("parseLasHeader needs the file's bytes up to its point data");
+    }
+    header.laszipRecord = findLasVlr(head, header, kLaszipUserId, kLaszipRecordId);
     if ((formatByte & kCompressionBits) != 0 && !header.laszipRecord) {
         throw Error(fmt::format(
             "the LAS point format byte {} marks compressed (LAZ) points, but the file has no "
@@ -197,11 +171,11 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
             formatByte));
     }
     header.pointFormat = formatByte & ~kCompressionBits;
-    if (header.pointFormat >= static_cast<int>(kPointFormats.size())) {
+    if (header.pointFormat >= static_cast<int>(kLasPointFormats.size())) {
         throw Error(fmt::format("the LAS point data format {} is unknown (supported: 0 to {})",
-                                header.pointFormat, kPointFormats.size() - 1));
+                                header.pointFormat, kLasPointFormats.size() - 1));
     }
-    const PointFormatLayout& layout = kPointFormats[header.pointFormat];
+    const LasPointFormatLayout& layout = kLasPointFormats[header.pointFormat];
     if (layout.firstMinorVersion > header.versionMinor) {
         context.warnings.push_back(fmt::format(
             "point format {} is not defined before LAS 1.{}, but the file says LAS 1.{}; read "
@@ -209,7 +183,7 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
             header.pointFormat, layout.firstMinorVersion, header.versionMinor,
             layout.firstMinorVersion));
     }
-    header.recordLength = loadField<std::uint16_t>(file, header_field::kRecordLength);
+    header.recordLength = loadField<std::uint16_t>(head, header_field::kRecordLength);
     if (header.recordLength < layout.recordSize) {
         throw Error(
             fmt::format("the LAS point record length {} is shorter than the {} bytes "
@@ -218,12 +192,12 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
     }
 
     const std::uint32_t legacyCount =
-        loadField<std::uint32_t>(file, header_field::kLegacyPointCount);
+        loadField<std::uint32_t>(head, header_field::kLegacyPointCount);
     header.pointCount = legacyCount;
     if (header.versionMinor >= 4) {
         // 1.4 writers leave the legacy count 0 when it cannot hold the count (formats 6-10 or
         // more than 2^32 points); older writers that ignore the new field leave that one 0.
-        const auto count64 = loadField<std::uint64_t>(file, header_field::kPointCount64);
+        const auto count64 = loadField<std::uint64_t>(head, header_field::kPointCount64);
         if (count64 != 0) {
             if (legacyCount != 0 && legacyCount != count64) {
                 context.warnings.push_back(fmt::format(
@@ -235,18 +209,24 @@ LasHeader parseHeader(std::span<const std::byte> file, ReadContext& context) {
         }
     }
 
-    header.scale = loadDoubleTriple(file, header_field::kScale);
-    header.offset = loadDoubleTriple(file, header_field::kOffset);
+    header.scale = loadDoubleTriple(head, header_field::kScale);
+    header.offset = loadDoubleTriple(head, header_field::kOffset);
     checkScaleAndOffset(header);
     const std::size_t bounds = header_field::kBounds;
-    header.declaredBounds.max = {loadField<double>(file, bounds),
-                                 loadField<double>(file, bounds + 16),
-                                 loadField<double>(file, bounds + 32)};
-    header.declaredBounds.min = {loadField<double>(file, bounds + 8),
-                                 loadField<double>(file, bounds + 24),
-                                 loadField<double>(file, bounds + 40)};
+    header.declaredBounds.max = {loadField<double>(head, bounds),
+                                 loadField<double>(head, bounds + 16),
+                                 loadField<double>(head, bounds + 32)};
+    header.declaredBounds.min = {loadField<double>(head, bounds + 8),
+                                 loadField<double>(head, bounds + 24),
+                                 loadField<double>(head, bounds + 40)};
+    if (header.versionMinor >= 4) {
+        header.evlrOffset = loadField<std::uint64_t>(head, header_field::kFirstEvlrOffset);
+        header.evlrCount = loadField<std::uint32_t>(head, header_field::kEvlrCount);
+    }
     return header;
 }
+
+namespace {
 
 enum class ColorDepth { None, EightBit, SixteenBit };
 
@@ -351,7 +331,7 @@ std::vector<std::byte> decompressLaz(std::span<const std::byte> file, const LasH
     }
     std::vector<laz::Chunk> chunks;
     const std::optional<std::span<const std::byte>> copcRecord =
-        findVlr(file, header, kCopcUserId, kCopcInfoRecordId);
+        findLasVlr(file, header, kCopcUserId, kCopcInfoRecordId);
     if (copcRecord) {
         const laz::CopcInfo info = laz::parseCopcInfo(*copcRecord);
         const std::vector<laz::CopcNode> nodes = laz::readCopcHierarchy(file, info);
@@ -421,7 +401,7 @@ std::string describe(const LasHeader& header) {
 }  // namespace
 
 LasRecords readLasRecords(std::span<const std::byte> file, ReadContext& context) {
-    const LasHeader header = parseHeader(file, context);
+    const LasHeader header = parseLasHeader(file, file.size(), context);
     context.formatDetail = describe(header);
     std::vector<std::byte> storage;
     const std::span<const std::byte> records = pointRecords(file, header, context, storage);
@@ -432,13 +412,13 @@ LasRecords readLasRecords(std::span<const std::byte> file, ReadContext& context)
 }
 
 PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
-    const LasHeader header = parseHeader(file, context);
+    const LasHeader header = parseLasHeader(file, file.size(), context);
     context.formatDetail = describe(header);
     std::vector<std::byte> storage;
     const std::byte* points = pointRecords(file, header, context, storage).data();
     const auto count = static_cast<std::size_t>(header.pointCount);
 
-    const std::optional<std::size_t> colorOffset = kPointFormats[header.pointFormat].colorOffset;
+    const std::optional<std::size_t> colorOffset = kLasPointFormats[header.pointFormat].colorOffset;
     const ColorDepth depth =
         colorOffset ? detectColorDepth(points, count, header.recordLength, *colorOffset)
                     : ColorDepth::None;

@@ -14,47 +14,12 @@
 
 #include "core/Error.h"
 #include "io/ByteOrder.h"
+#include "io/PlyHeader.h"
 #include "io/TextParsing.h"
 
 namespace subscan {
 
-namespace {
-
-enum class PlyEncoding { Ascii, BinaryLittleEndian, BinaryBigEndian };
-enum class PlyType : std::uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
-
-struct PlyProperty {
-    std::string name;
-    PlyType type = PlyType::Float32;  // the item type for lists
-    bool isList = false;
-    PlyType countType = PlyType::UInt8;
-};
-
-struct PlyElement {
-    std::string name;
-    std::uint64_t count = 0;
-    std::vector<PlyProperty> properties;
-
-    /// Byte size of one item when it has no lists, else nullopt.
-    std::optional<std::size_t> fixedStride() const;
-    std::optional<std::size_t> find(std::string_view propertyName) const {
-        for (std::size_t i = 0; i < properties.size(); ++i) {
-            if (properties[i].name == propertyName) {
-                return i;
-            }
-        }
-        return std::nullopt;
-    }
-};
-
-struct PlyHeader {
-    PlyEncoding encoding = PlyEncoding::Ascii;
-    std::string version;
-    std::vector<PlyElement> elements;
-    std::size_t bodyOffset = 0;
-};
-
-std::size_t sizeOf(PlyType type) {
+std::size_t plySizeOf(PlyType type) {
     switch (type) {
         case PlyType::Int8:
         case PlyType::UInt8:
@@ -72,9 +37,11 @@ std::size_t sizeOf(PlyType type) {
     return 0;
 }
 
-bool isInteger(PlyType type) {
+bool isPlyInteger(PlyType type) {
     return type != PlyType::Float32 && type != PlyType::Float64;
 }
+
+namespace {
 
 std::optional<PlyType> parseType(std::string_view name) {
     static constexpr std::array<std::pair<std::string_view, PlyType>, 16> kNames{{
@@ -103,19 +70,20 @@ std::optional<PlyType> parseType(std::string_view name) {
     return std::nullopt;
 }
 
+}  // namespace
+
 std::optional<std::size_t> PlyElement::fixedStride() const {
     std::size_t stride = 0;
     for (const PlyProperty& property : properties) {
         if (property.isList) {
             return std::nullopt;
         }
-        stride += sizeOf(property.type);
+        stride += plySizeOf(property.type);
     }
     return stride;
 }
 
-/// Reads the header up to and including the `end_header` line.
-PlyHeader parseHeader(std::string_view file) {
+PlyHeader parsePlyHeader(std::string_view file) {
     PlyHeader header;
     std::size_t position = 0;
     int lineNumber = 0;
@@ -206,7 +174,7 @@ PlyHeader parseHeader(std::string_view file) {
                 if (!countType || !itemType) {
                     fail("uses an unknown property type");
                 }
-                if (!isInteger(*countType)) {
+                if (!isPlyInteger(*countType)) {
                     fail("has a list count type that is not an integer type");
                 }
                 property.isList = true;
@@ -236,16 +204,7 @@ PlyHeader parseHeader(std::string_view file) {
     return header;
 }
 
-/// Which vertex properties hold what we keep; indices into PlyElement::properties.
-struct VertexLayout {
-    std::array<std::size_t, 3> position{};
-    std::optional<std::array<std::size_t, 3>> color;
-    std::optional<std::size_t> alpha;
-    std::optional<std::array<std::size_t, 3>> normal;
-    std::optional<std::size_t> intensity;
-};
-
-VertexLayout findVertexLayout(const PlyElement& vertex) {
+PlyVertexLayout findPlyVertexLayout(const PlyElement& vertex) {
     auto scalar = [&](std::string_view name) -> std::optional<std::size_t> {
         const auto index = vertex.find(name);
         if (index && vertex.properties[*index].isList) {
@@ -265,7 +224,7 @@ VertexLayout findVertexLayout(const PlyElement& vertex) {
         return std::nullopt;
     };
 
-    VertexLayout layout;
+    PlyVertexLayout layout;
     for (int axis = 0; axis < 3; ++axis) {
         const std::string_view name = std::array{"x", "y", "z"}[axis];
         const auto index = scalar(name);
@@ -288,12 +247,14 @@ VertexLayout findVertexLayout(const PlyElement& vertex) {
     return layout;
 }
 
+namespace {
+
 /// Colour channels: 8-bit as is, 16-bit scaled down, floats taken as 0..1.
 std::uint8_t toColorChannel(double value, PlyType type) {
     double scaled = value;
     if (type == PlyType::UInt16 || type == PlyType::Int16) {
         scaled = value / 257.0;
-    } else if (!isInteger(type)) {
+    } else if (!isPlyInteger(type)) {
         scaled = value * 255.0;
     }
     if (!(scaled > 0.0)) {
@@ -343,29 +304,7 @@ class PlyBodyReader {
 };
 
 double PlyBodyReader::loadBinary(PlyType type, const std::byte* p) const {
-    const bool big = header_.encoding == PlyEncoding::BinaryBigEndian;
-    auto load = [&]<class T>(T) -> double {
-        return static_cast<double>(big ? loadBigEndian<T>(p) : loadLittleEndian<T>(p));
-    };
-    switch (type) {
-        case PlyType::Int8:
-            return load(std::int8_t{});
-        case PlyType::UInt8:
-            return load(std::uint8_t{});
-        case PlyType::Int16:
-            return load(std::int16_t{});
-        case PlyType::UInt16:
-            return load(std::uint16_t{});
-        case PlyType::Int32:
-            return load(std::int32_t{});
-        case PlyType::UInt32:
-            return load(std::uint32_t{});
-        case PlyType::Float32:
-            return load(float{});
-        case PlyType::Float64:
-            return load(double{});
-    }
-    return 0.0;
+    return loadPlyValue(type, header_.encoding == PlyEncoding::BinaryBigEndian, p);
 }
 
 void PlyBodyReader::failTruncated(const PlyElement& element, std::uint64_t itemIndex) const {
@@ -408,7 +347,7 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
         const PlyProperty& property = element.properties[p];
         if (!property.isList) {
             if (binary()) {
-                const std::size_t size = sizeOf(property.type);
+                const std::size_t size = plySizeOf(property.type);
                 if (file_.size() - position_ < size) {
                     failTruncated(element, itemIndex);
                 }
@@ -421,7 +360,7 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
         }
         double countValue = 0.0;
         if (binary()) {
-            const std::size_t size = sizeOf(property.countType);
+            const std::size_t size = plySizeOf(property.countType);
             if (file_.size() - position_ < size) {
                 failTruncated(element, itemIndex);
             }
@@ -439,7 +378,7 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
         const auto count = static_cast<std::uint64_t>(countValue);
         const bool keep = faceList && *faceList == p;
         if (binary()) {
-            const std::size_t itemSize = sizeOf(property.type);
+            const std::size_t itemSize = plySizeOf(property.type);
             if (count > (file_.size() - position_) / itemSize) {
                 failTruncated(element, itemIndex);
             }
@@ -510,7 +449,7 @@ PointCloud PlyBodyReader::read() {
                         "subscan can hold",
                         vertex->count, kMaxPoints));
     }
-    const VertexLayout layout = findVertexLayout(*vertex);
+    const PlyVertexLayout layout = findPlyVertexLayout(*vertex);
     std::optional<std::size_t> faceList;
     if (face != nullptr) {
         faceList = findFaceList(*face);
@@ -573,7 +512,7 @@ PointCloud PlyBodyReader::read() {
                 }
                 std::vector<std::size_t> offsets(vertex->properties.size());
                 for (std::size_t p = 1; p < offsets.size(); ++p) {
-                    offsets[p] = offsets[p - 1] + sizeOf(vertex->properties[p - 1].type);
+                    offsets[p] = offsets[p - 1] + plySizeOf(vertex->properties[p - 1].type);
                 }
                 for (std::uint64_t i = 0; i < vertex->count; ++i) {
                     const std::byte* record = file_.data() + position_;
@@ -638,7 +577,7 @@ PointCloud PlyBodyReader::read() {
 
 PointCloud readPly(std::span<const std::byte> file, ReadContext& context) {
     const std::string_view text(reinterpret_cast<const char*>(file.data()), file.size());
-    const PlyHeader header = parseHeader(text);
+    const PlyHeader header = parsePlyHeader(text);
     static constexpr std::array kEncodingNames{"ascii", "binary_little_endian",
                                                "binary_big_endian"};
     context.formatDetail =

@@ -37,13 +37,19 @@ struct Quantization {
 
 /// What a source holds, known before its first record is read.
 struct PointRecordSourceInfo {
-    std::string name;             // the input's path (or synthetic:NAME), for messages
-    std::uint64_t pointCount = 0; // exact
+    std::string name;              // the input's path (or synthetic:NAME), for messages
+    std::uint64_t pointCount = 0;  // exact
     PointRecordFormat format;
     Quantization quantization;
-    glm::dvec3 min{0.0};  // bounds of the stored coordinates, in file coordinates
+    /// Bounds of the stored coordinates, in file coordinates: exact for inputs that are not
+    /// LAS; for LAS and LAZ as the header declares them (which a writer may have left stale).
+    glm::dvec3 min{0.0};
     glm::dvec3 max{0.0};
     std::string wkt;  // the coordinate reference system as OGC WKT; empty when unknown
+    /// What was dropped or assumed on the way to records (wave packets, a coordinate system
+    /// given only as GeoTIFF keys, colour filled in by a merge), one sentence each naming the
+    /// input.
+    std::vector<std::string> warnings;
 };
 
 /// Point records read in pieces, in file order. Out of core for LAS, LAZ, binary PLY and XYZ
@@ -60,7 +66,7 @@ class PointRecordSource {
 };
 
 /// Opens any scan subscan reads (a file, or synthetic:NAME) as records. `threads` bounds the
-/// decoding threads (LAZ chunks); 0 uses every core.
+/// decoding threads (LAZ chunks); 0 uses every core. An input without points is an error.
 std::unique_ptr<PointRecordSource> openPointRecordSource(const std::filesystem::path& path,
                                                          unsigned threads = 0);
 

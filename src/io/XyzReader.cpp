@@ -370,71 +370,45 @@ std::optional<Role> roleFromName(std::string_view lowercaseName) {
     return std::nullopt;
 }
 
-enum class ColorEncoding { Byte, UnitFloat, Word16 };
-
+using ColorEncoding = TextColorEncoding;
 using ColumnTriple = std::array<std::size_t, 3>;
+using Layout = PointTextLayout;
 
-/// Which column holds what we keep.
-struct Layout {
-    std::size_t columnCount = 0;
-    ColumnTriple position{0, 1, 2};
-    std::optional<ColumnTriple> color;
-    ColorEncoding colorEncoding = ColorEncoding::Byte;
-    bool colorEncodingFromName = false;  // rf gf bf: no need to look at the values
-    std::optional<ColumnTriple> normal;
-    std::optional<std::size_t> intensity;
-
-    /// How many leading values of a line the layout reads.
-    std::size_t usedColumns() const {
-        std::size_t last = std::max({position[0], position[1], position[2]});
-        if (color) {
-            last = std::max({last, (*color)[0], (*color)[1], (*color)[2]});
+/// The columns read, in file order, e.g. "x y z i r g b".
+std::string describeLayout(const Layout& layout) {
+    std::vector<std::pair<std::size_t, std::string_view>> named;
+    const auto addTriple = [&](const ColumnTriple& columns, std::array<std::string_view, 3> n) {
+        for (int k = 0; k < 3; ++k) {
+            named.emplace_back(columns[k], n[k]);
         }
-        if (normal) {
-            last = std::max({last, (*normal)[0], (*normal)[1], (*normal)[2]});
-        }
-        if (intensity) {
-            last = std::max(last, *intensity);
-        }
-        return last + 1;
+    };
+    addTriple(layout.position, {"x", "y", "z"});
+    if (layout.color) {
+        addTriple(*layout.color, layout.colorEncoding == ColorEncoding::UnitFloat
+                                     ? std::array<std::string_view, 3>{"rf", "gf", "bf"}
+                                     : std::array<std::string_view, 3>{"r", "g", "b"});
     }
-
-    /// The columns read, in file order, e.g. "x y z i r g b".
-    std::string describe() const {
-        std::vector<std::pair<std::size_t, std::string_view>> named;
-        const auto addTriple = [&](const ColumnTriple& columns, std::array<std::string_view, 3> n) {
-            for (int k = 0; k < 3; ++k) {
-                named.emplace_back(columns[k], n[k]);
-            }
-        };
-        addTriple(position, {"x", "y", "z"});
-        if (color) {
-            addTriple(*color, colorEncoding == ColorEncoding::UnitFloat
-                                  ? std::array<std::string_view, 3>{"rf", "gf", "bf"}
-                                  : std::array<std::string_view, 3>{"r", "g", "b"});
-        }
-        if (normal) {
-            addTriple(*normal, {"nx", "ny", "nz"});
-        }
-        if (intensity) {
-            named.emplace_back(*intensity, "i");
-        }
-        std::sort(named.begin(), named.end());
-        std::string text;
-        for (const auto& [column, name] : named) {
-            text += text.empty() ? "" : " ";
-            text += name;
-        }
-        if (color && colorEncoding == ColorEncoding::Word16) {
-            text += " (16-bit colour)";
-        }
-        if (columnCount > named.size()) {
-            const std::size_t ignored = columnCount - named.size();
-            text += fmt::format(", {} other column{} ignored", ignored, ignored == 1 ? "" : "s");
-        }
-        return text;
+    if (layout.normal) {
+        addTriple(*layout.normal, {"nx", "ny", "nz"});
     }
-};
+    if (layout.intensity) {
+        named.emplace_back(*layout.intensity, "i");
+    }
+    std::sort(named.begin(), named.end());
+    std::string text;
+    for (const auto& [column, name] : named) {
+        text += text.empty() ? "" : " ";
+        text += name;
+    }
+    if (layout.color && layout.colorEncoding == ColorEncoding::Word16) {
+        text += " (16-bit colour)";
+    }
+    if (layout.columnCount > named.size()) {
+        const std::size_t ignored = layout.columnCount - named.size();
+        text += fmt::format(", {} other column{} ignored", ignored, ignored == 1 ? "" : "s");
+    }
+    return text;
+}
 
 /// A line before the data that names columns (it has x, y and z among its words).
 struct HeaderLine {
@@ -847,39 +821,51 @@ struct PtsBlock {
     }
 };
 
-class PointLineReader {
+/// Parses point lines and PTS count lines, piece after piece.
+class PointLineParser {
   public:
-    PointLineReader(std::string_view text, const Prelude& prelude, const Layout& layout,
-                    ReadContext& context)
-        : text_(text), prelude_(prelude), layout_(layout), context_(context) {}
+    PointLineParser(const Prelude& prelude, const Layout& layout)
+        : separators_(prelude.sample.separators),
+          pts_(prelude.pts),
+          firstPointLine_(prelude.firstPointLine),
+          columnCount_(layout.columnCount),
+          lineNumber_(prelude.linesBeforeData),
+          // A PTS file with count lines only still needs room for the count.
+          values_(layout.columnCount == 0 ? 1 : layout.usedColumns(), 0.0) {}
 
-    PointCloud read();
+    void parse(std::string_view text,
+               const std::function<void(std::span<const double>, std::size_t)>& point);
+    void finish() const {
+        if (block_) {
+            block_->check();
+        }
+    }
 
   private:
     /// Parses the values of one non-blank line from `p`, keeping the first values_.size();
     /// returns how many there are.
     std::size_t parseLine(const char* p, const char* end, std::string_view line,
                           std::size_t lineNumber);
-    PointRecord makeRecord() const;
-    std::size_t expectedPoints() const;
 
-    std::string_view text_;
-    const Prelude& prelude_;
-    const Layout& layout_;
-    ReadContext& context_;
+    Separators separators_;
+    bool pts_;
+    std::size_t firstPointLine_;
+    std::size_t columnCount_;
+    std::size_t lineNumber_;
     std::vector<double> values_;
+    std::optional<PtsBlock> block_;
 };
 
-std::size_t PointLineReader::parseLine(const char* p, const char* end, std::string_view line,
+std::size_t PointLineParser::parseLine(const char* p, const char* end, std::string_view line,
                                        std::size_t lineNumber) {
-    const Separators separators = prelude_.sample.separators;
-    const char decimalPoint = separators.decimalPoint();
+    const char decimalPoint = separators_.decimalPoint();
     std::size_t count = 0;
     for (;;) {
         double value = 0.0;
         const char* next = parseValue(p, end, decimalPoint, value);
-        if (next == nullptr || (next != end && !isBlank(*next) && !separators.isSeparator(*next))) {
-            throwBadField(fieldAt(p, end, separators), line, lineNumber);
+        if (next == nullptr ||
+            (next != end && !isBlank(*next) && !separators_.isSeparator(*next))) {
+            throwBadField(fieldAt(p, end, separators_), line, lineNumber);
         }
         if (count < values_.size()) {
             values_[count] = value;
@@ -889,7 +875,7 @@ std::size_t PointLineReader::parseLine(const char* p, const char* end, std::stri
         while (p != end && isBlank(*p)) {
             ++p;
         }
-        if (p != end && separators.isSeparator(*p)) {
+        if (p != end && separators_.isSeparator(*p)) {
             ++p;
             while (p != end && isBlank(*p)) {
                 ++p;
@@ -901,58 +887,9 @@ std::size_t PointLineReader::parseLine(const char* p, const char* end, std::stri
     }
 }
 
-PointRecord PointLineReader::makeRecord() const {
-    PointRecord record;
-    const Layout& l = layout_;
-    record.position = {values_[l.position[0]], values_[l.position[1]], values_[l.position[2]]};
-    if (l.color) {
-        const ColumnTriple& c = *l.color;
-        record.color = {toColorChannel(values_[c[0]], l.colorEncoding),
-                        toColorChannel(values_[c[1]], l.colorEncoding),
-                        toColorChannel(values_[c[2]], l.colorEncoding), 255};
-    }
-    if (l.normal) {
-        const ColumnTriple& n = *l.normal;
-        record.normal = {saturateToFloat(values_[n[0]]), saturateToFloat(values_[n[1]]),
-                         saturateToFloat(values_[n[2]])};
-    }
-    if (l.intensity) {
-        record.intensity = saturateToFloat(values_[*l.intensity]);
-    }
-    return record;
-}
-
-/// Room for the points the file can hold, from the sampled line length: a count line or a
-/// short first line must not make us reserve gigabytes.
-std::size_t PointLineReader::expectedPoints() const {
-    const Sample& sample = prelude_.sample;
-    if (sample.lines.empty()) {
-        return 0;
-    }
-    const std::size_t bytes = text_.size() - prelude_.dataOffset;
-    // Every value takes at least a digit and a separator.
-    const std::size_t atMost = bytes / (2 * layout_.columnCount);
-    const double averageLine =
-        static_cast<double>(sample.bytes) / static_cast<double>(sample.lines.size());
-    // 10% more than the estimate, so slightly longer lines later need no second allocation.
-    const double estimate = 1.1 * static_cast<double>(bytes) / averageLine;
-    return static_cast<std::size_t>(
-        std::min({estimate, static_cast<double>(atMost), static_cast<double>(kMaxPoints)}));
-}
-
-PointCloud PointLineReader::read() {
-    // A PTS file with count lines only still needs room for the count.
-    values_.assign(layout_.columnCount == 0 ? 1 : layout_.usedColumns(), 0.0);
-    PointAttributes attributes;
-    attributes.color = layout_.color.has_value();
-    attributes.normal = layout_.normal.has_value();
-    attributes.intensity = layout_.intensity.has_value();
-    PointCloudBuilder builder(attributes, expectedPoints());
-
-    std::optional<PtsBlock> block;
-    std::uint64_t pointLines = 0;
-    std::size_t nextProgress = kProgressBytes;
-    LineReader lines(text_, prelude_.dataOffset, prelude_.linesBeforeData);
+void PointLineParser::parse(
+    std::string_view text, const std::function<void(std::span<const double>, std::size_t)>& point) {
+    LineReader lines(text, 0, lineNumber_);
     std::string_view line;
     while (lines.next(line)) {
         const char* p = line.data();
@@ -964,38 +901,44 @@ PointCloud PointLineReader::read() {
             continue;
         }
         const std::size_t count = parseLine(p, end, line, lines.lineNumber());
-        if (count == layout_.columnCount) {
-            builder.add(makeRecord());
-            if (++pointLines > kMaxPoints) {
-                throw Error(
-                    fmt::format("it has more than the {} points subscan can hold", kMaxPoints));
+        if (count == columnCount_) {
+            point(values_, lines.lineNumber());
+            if (block_) {
+                ++block_->points;
             }
-            if (block) {
-                ++block->points;
-            }
-        } else if (prelude_.pts && count == 1) {
+        } else if (pts_ && count == 1) {
             if (!isCount(values_[0])) {
                 throwTooFewValues(count, lines.lineNumber());
             }
-            if (block) {
-                block->check();
-            }
-            block = PtsBlock{lines.lineNumber(), static_cast<std::uint64_t>(values_[0]), 0};
+            finish();
+            block_ = PtsBlock{lines.lineNumber(), static_cast<std::uint64_t>(values_[0]), 0};
         } else {
             throw Error(fmt::format("line {} has {}, but the first point (line {}) has {}",
-                                    lines.lineNumber(), pluralValues(count),
-                                    prelude_.firstPointLine, layout_.columnCount));
-        }
-        if (lines.position() >= nextProgress) {
-            context_.reportProgress(lines.position(), text_.size());
-            nextProgress = lines.position() + kProgressBytes;
+                                    lines.lineNumber(), pluralValues(count), firstPointLine_,
+                                    columnCount_));
         }
     }
-    if (block) {
-        block->check();
+    lineNumber_ = lines.lineNumber();
+}
+
+PointRecord makeRecord(const Layout& l, std::span<const double> values) {
+    PointRecord record;
+    record.position = {values[l.position[0]], values[l.position[1]], values[l.position[2]]};
+    if (l.color) {
+        const ColumnTriple& c = *l.color;
+        record.color = {toColorChannel(values[c[0]], l.colorEncoding),
+                        toColorChannel(values[c[1]], l.colorEncoding),
+                        toColorChannel(values[c[2]], l.colorEncoding), 255};
     }
-    context_.reportProgress(text_.size(), text_.size());
-    return builder.finish(context_.warnings);
+    if (l.normal) {
+        const ColumnTriple& n = *l.normal;
+        record.normal = {saturateToFloat(values[n[0]]), saturateToFloat(values[n[1]]),
+                         saturateToFloat(values[n[2]])};
+    }
+    if (l.intensity) {
+        record.intensity = saturateToFloat(values[*l.intensity]);
+    }
+    return record;
 }
 
 /// Printable text: no control characters but line ends and tabs. Bytes above 127 are allowed,
@@ -1016,26 +959,102 @@ std::string_view withoutByteOrderMark(std::string_view text) {
 
 }  // namespace
 
-PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
-    const std::string_view text(reinterpret_cast<const char*>(file.data()), file.size());
-    if (text.starts_with("\xFF\xFE") || text.starts_with("\xFE\xFF")) {
+struct PointTextReader::State {
+    Prelude prelude;
+    Layout layout;
+    std::optional<PointLineParser> parser;
+};
+
+PointTextReader::PointTextReader(std::string_view head, ReadContext& context)
+    : state_(std::make_unique<State>()) {
+    if (head.starts_with("\xFF\xFE") || head.starts_with("\xFE\xFF")) {
         throw Error("it is UTF-16 text; save it as UTF-8 or ASCII");
     }
-    if (text.substr(0, kSniffBytes).find('\0') != std::string_view::npos) {
+    if (head.substr(0, kSniffBytes).find('\0') != std::string_view::npos) {
         throw Error("it contains NUL bytes: it is binary data, not a text list of points");
     }
-    const std::size_t start = text.starts_with(kUtf8ByteOrderMark) ? kUtf8ByteOrderMark.size() : 0;
-    const Prelude prelude = readPrelude(text, start);
-    const Layout layout = chooseLayout(prelude, context.warnings);
-    context.formatDetail = prelude.pts ? "PTS text" : "text";
-    if (prelude.columnCount > 0) {
-        context.formatDetail += ": " + layout.describe();
+    const std::size_t start = head.starts_with(kUtf8ByteOrderMark) ? kUtf8ByteOrderMark.size() : 0;
+    State& state = *state_;
+    state.prelude = readPrelude(head, start);
+    state.layout = chooseLayout(state.prelude, context.warnings);
+    context.formatDetail = state.prelude.pts ? "PTS text" : "text";
+    if (state.prelude.columnCount > 0) {
+        context.formatDetail += ": " + describeLayout(state.layout);
     }
-    if (prelude.sample.separators.decimalComma) {
+    if (state.prelude.sample.separators.decimalComma) {
         context.formatDetail += " (decimal commas)";
     }
-    PointLineReader reader(text, prelude, layout, context);
-    return reader.read();
+    state.parser.emplace(state.prelude, state.layout);
+    // The sampled lines point into `head`, which the caller may now drop; only their number and
+    // length (for expectedPoints) are kept.
+    std::fill(state.prelude.sample.lines.begin(), state.prelude.sample.lines.end(),
+              std::string_view{});
+}
+
+PointTextReader::~PointTextReader() = default;
+
+const PointTextLayout& PointTextReader::layout() const {
+    return state_->layout;
+}
+
+std::size_t PointTextReader::dataOffset() const {
+    return state_->prelude.dataOffset;
+}
+
+/// Room for the points the text can hold, from the sampled line length: a count line or a
+/// short first line must not make us reserve gigabytes.
+std::size_t PointTextReader::expectedPoints(std::size_t bytes) const {
+    const Sample& sample = state_->prelude.sample;
+    if (sample.lines.empty()) {
+        return 0;
+    }
+    // Every value takes at least a digit and a separator.
+    const std::size_t atMost = bytes / (2 * state_->layout.columnCount);
+    const double averageLine =
+        static_cast<double>(sample.bytes) / static_cast<double>(sample.lines.size());
+    // 10% more than the estimate, so slightly longer lines later need no second allocation.
+    const double estimate = 1.1 * static_cast<double>(bytes) / averageLine;
+    return static_cast<std::size_t>(
+        std::min({estimate, static_cast<double>(atMost), static_cast<double>(kMaxPoints)}));
+}
+
+void PointTextReader::parse(
+    std::string_view lines,
+    const std::function<void(std::span<const double>, std::size_t)>& point) {
+    state_->parser->parse(lines, point);
+}
+
+void PointTextReader::finish() const {
+    state_->parser->finish();
+}
+
+PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
+    const std::string_view text(reinterpret_cast<const char*>(file.data()), file.size());
+    PointTextReader reader(text, context);
+    const Layout& layout = reader.layout();
+    PointAttributes attributes;
+    attributes.color = layout.color.has_value();
+    attributes.normal = layout.normal.has_value();
+    attributes.intensity = layout.intensity.has_value();
+    PointCloudBuilder builder(attributes, reader.expectedPoints(text.size() - reader.dataOffset()));
+    std::uint64_t pointLines = 0;
+    const auto addPoint = [&](std::span<const double> values, std::size_t) {
+        builder.add(makeRecord(layout, values));
+        if (++pointLines > kMaxPoints) {
+            throw Error(fmt::format("it has more than the {} points subscan can hold", kMaxPoints));
+        }
+    };
+    // Pieces of whole lines, so that progress is reported between them.
+    for (std::size_t position = reader.dataOffset(); position < text.size();) {
+        const std::size_t lineEnd =
+            text.find('\n', std::min(text.size(), position + kProgressBytes));
+        const std::size_t end = lineEnd == std::string_view::npos ? text.size() : lineEnd + 1;
+        reader.parse(text.substr(position, end - position), addPoint);
+        context.reportProgress(end, text.size());
+        position = end;
+    }
+    reader.finish();
+    return builder.finish(context.warnings);
 }
 
 bool looksLikePointText(std::span<const std::byte> file) {

@@ -1,7 +1,13 @@
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
+#include <functional>
+#include <memory>
+#include <optional>
 #include <span>
+#include <string_view>
 
 #include "core/PointCloud.h"
 #include "io/ReadContext.h"
@@ -16,5 +22,68 @@ PointCloud readXyz(std::span<const std::byte> file, ReadContext& context);
 
 /// True when the start of `file` reads as lines of numbers, for files without a telling extension.
 bool looksLikePointText(std::span<const std::byte> file);
+
+/// How the colour columns of a point text are written: bytes, 0..1 floats or 16-bit values.
+enum class TextColorEncoding { Byte, UnitFloat, Word16 };
+
+/// Which column of a point line holds what.
+struct PointTextLayout {
+    std::size_t columnCount = 0;  // values on a point line; 0 in a PTS file of count lines only
+    std::array<std::size_t, 3> position{0, 1, 2};
+    std::optional<std::array<std::size_t, 3>> color;
+    TextColorEncoding colorEncoding = TextColorEncoding::Byte;
+    bool colorEncodingFromName = false;  // rf gf bf: no need to look at the values
+    std::optional<std::array<std::size_t, 3>> normal;
+    std::optional<std::size_t> intensity;
+
+    /// How many leading values of a line the layout reads.
+    std::size_t usedColumns() const {
+        std::size_t last = std::max({position[0], position[1], position[2]});
+        if (color) {
+            last = std::max({last, (*color)[0], (*color)[1], (*color)[2]});
+        }
+        if (normal) {
+            last = std::max({last, (*normal)[0], (*normal)[1], (*normal)[2]});
+        }
+        if (intensity) {
+            last = std::max(last, *intensity);
+        }
+        return last + 1;
+    }
+};
+
+/// A text list of points read in pieces: the layout is decided from the file's first lines (the
+/// header lines and a sample of point lines), then the point lines are parsed piece by piece,
+/// so a file of any size goes through a buffer of bounded size. readXyz is this reader given
+/// the whole file.
+class PointTextReader {
+  public:
+    /// `head` is the start of the file: all of it, or whole lines enough to hold the lines
+    /// before the points and the first hundred point lines. Throws subscan::Error when it is
+    /// not a list of points; layout warnings and the format detail go to `context`.
+    PointTextReader(std::string_view head, ReadContext& context);
+    ~PointTextReader();
+    PointTextReader(const PointTextReader&) = delete;
+    PointTextReader& operator=(const PointTextReader&) = delete;
+
+    const PointTextLayout& layout() const;
+    /// The file offset of the first point line (or PTS count line).
+    std::size_t dataOffset() const;
+    /// A generous estimate of the points in `bytes` of point lines, from the sampled lines.
+    std::size_t expectedPoints(std::size_t bytes) const;
+
+    /// Parses `lines`, the file's next whole lines from dataOffset() on (only the file's last
+    /// line may lack its line end). `point` receives the values of each point line, at least
+    /// layout().usedColumns() of them, and the line's number. Throws subscan::Error, naming the
+    /// line, at a line that is neither a point nor a PTS count.
+    void parse(std::string_view lines,
+               const std::function<void(std::span<const double>, std::size_t)>& point);
+    /// At the end of the file: checks the point count of the last PTS block.
+    void finish() const;
+
+  private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
 
 }  // namespace subscan

@@ -1,0 +1,224 @@
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/Error.h"
+#include "io/InputFile.h"
+#include "io/RecordSourceSupport.h"
+#include "io/XyzReader.h"
+
+// Text lists of points (XYZ, PTS, CSV...) as records, read in pieces of whole lines: a first
+// pass counts the points and finds their bounds, which choose the quantization; each read then
+// parses lines until it has the points asked for.
+namespace subscan {
+
+namespace {
+
+/// The start of the file that decides the layout: header lines and a hundred point lines fit
+/// many times over.
+constexpr std::size_t kTextHeadBytes = 4u << 20;
+/// Text parsed at once; a line longer than this is read whole all the same.
+constexpr std::size_t kTextPieceBytes = 1u << 20;
+
+/// A text file from an offset on, in pieces that end at a line end (or the file's end).
+class LinePieces {
+  public:
+    LinePieces(const InputFile& file, std::uint64_t offset) : file_(file), position_(offset) {}
+
+    /// The next piece, or false at the end of the file.
+    bool next(std::string_view& piece) {
+        buffer_.erase(0, used_);
+        used_ = 0;
+        for (;;) {
+            const std::size_t lineEnd = buffer_.rfind('\n');
+            if (lineEnd != std::string::npos &&
+                (buffer_.size() >= kTextPieceBytes || position_ == file_.size())) {
+                used_ = lineEnd + 1;
+                break;
+            }
+            if (position_ == file_.size()) {
+                used_ = buffer_.size();  // the last line, without its line end
+                break;
+            }
+            const std::size_t start = buffer_.size();
+            const auto size = static_cast<std::size_t>(
+                std::min<std::uint64_t>(kTextPieceBytes, file_.size() - position_));
+            buffer_.resize(start + size);
+            file_.read(position_, std::as_writable_bytes(std::span(buffer_)).subspan(start));
+            position_ += size;
+        }
+        piece = std::string_view(buffer_).substr(0, used_);
+        return !piece.empty();
+    }
+
+  private:
+    const InputFile& file_;
+    std::uint64_t position_;
+    std::string buffer_;
+    std::size_t used_ = 0;  // the bytes of buffer_ given out last
+};
+
+/// The start of the file cut after its last whole line (all of a small file).
+std::string readTextHead(const InputFile& file) {
+    std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(kTextHeadBytes, file.size())),
+                     '\0');
+    file.read(0, std::as_writable_bytes(std::span(head)));
+    if (head.size() < file.size()) {
+        const std::size_t lineEnd = head.rfind('\n');
+        if (lineEnd == std::string::npos) {
+            throw Error(
+                fmt::format("its first {} MiB hold no line end: it is not a text list of points",
+                            kTextHeadBytes >> 20));
+        }
+        head.resize(lineEnd + 1);
+    }
+    return head;
+}
+
+class TextRecordSource final : public PointRecordSource {
+  public:
+    TextRecordSource(const std::filesystem::path& path) : file_(path) {
+        info_.name = path.string();
+        ReadContext context;
+        start(context);
+        for (const std::string& warning : context.warnings) {
+            info_.warnings.push_back(fmt::format("{}: {}", info_.name, warning));
+        }
+        const PointTextLayout& layout = reader_->layout();
+        Bounds bounds;
+        std::uint64_t count = 0;
+        parseAll([&](std::span<const double> values, std::size_t line) {
+            const glm::dvec3 p = position(values);
+            for (int axis = 0; axis < 3; ++axis) {
+                if (!std::isfinite(p[axis])) {
+                    throw Error(fmt::format(
+                        "line {} has the {} coordinate {}; LAS records need finite coordinates",
+                        line, "xyz"[axis], p[axis]));
+                }
+            }
+            bounds.add(p);
+            ++count;
+        });
+        if (count == 0) {
+            throw Error("it holds no points, only PTS count lines");
+        }
+        writer_.emplace(layout.color.has_value(), layout.normal.has_value(), bounds);
+        const std::vector<std::string> warnings = std::move(info_.warnings);
+        info_ = convertedSourceInfo(info_.name, count, *writer_, bounds);
+        info_.warnings = warnings;
+        rewind();
+    }
+
+    const PointRecordSourceInfo& info() const override { return info_; }
+
+    std::size_t read(std::vector<std::byte>& records, std::size_t maxPoints) override {
+        try {
+            const std::size_t recordLength = info_.format.recordLength();
+            std::size_t done = 0;
+            while (done < maxPoints) {
+                if (pendingPoint_ == pending_.size() / recordLength) {
+                    pending_.clear();
+                    pendingPoint_ = 0;
+                    std::string_view piece;
+                    if (!pieces_->next(piece)) {
+                        break;
+                    }
+                    reader_->parse(piece, [&](std::span<const double> values, std::size_t) {
+                        writer_->append(pending_, point(values));
+                    });
+                    continue;
+                }
+                const std::size_t take =
+                    std::min(pending_.size() / recordLength - pendingPoint_, maxPoints - done);
+                const auto first =
+                    pending_.begin() + static_cast<std::ptrdiff_t>(pendingPoint_ * recordLength);
+                records.insert(records.end(), first,
+                               first + static_cast<std::ptrdiff_t>(take * recordLength));
+                pendingPoint_ += take;
+                done += take;
+            }
+            return done;
+        } catch (const Error& error) {
+            throwNamed(info_.name, error);
+        }
+    }
+
+    void rewind() override {
+        ReadContext context;
+        start(context);
+        pending_.clear();
+        pendingPoint_ = 0;
+    }
+
+  private:
+    /// A reader at the first point line.
+    void start(ReadContext& context) {
+        const std::string head = readTextHead(file_);
+        reader_.emplace(head, context);
+        pieces_.emplace(file_, reader_->dataOffset());
+    }
+
+    void parseAll(const std::function<void(std::span<const double>, std::size_t)>& point) {
+        std::string_view piece;
+        while (pieces_->next(piece)) {
+            reader_->parse(piece, point);
+        }
+        reader_->finish();
+    }
+
+    glm::dvec3 position(std::span<const double> values) const {
+        const auto& p = reader_->layout().position;
+        return {values[p[0]], values[p[1]], values[p[2]]};
+    }
+
+    ConvertedPoint point(std::span<const double> values) const {
+        const PointTextLayout& layout = reader_->layout();
+        ConvertedPoint point;
+        point.position = position(values);
+        if (layout.color) {
+            for (int k = 0; k < 3; ++k) {
+                const double value = values[(*layout.color)[k]];
+                point.rgb[k] =
+                    layout.colorEncoding == TextColorEncoding::UnitFloat ? colorWordFromUnit(value)
+                    : layout.colorEncoding == TextColorEncoding::Word16  ? colorWordFromWord(value)
+                                                                         : colorWordFromByte(value);
+            }
+        }
+        if (layout.normal) {
+            const auto& n = *layout.normal;
+            point.normal = {saturateToFloat(values[n[0]]), saturateToFloat(values[n[1]]),
+                            saturateToFloat(values[n[2]])};
+        }
+        if (layout.intensity) {
+            point.intensity = intensityWord(values[*layout.intensity]);
+        }
+        return point;
+    }
+
+    InputFile file_;
+    PointRecordSourceInfo info_;
+    std::optional<PointTextReader> reader_;
+    std::optional<LinePieces> pieces_;
+    std::optional<ConvertedRecordWriter> writer_;
+    std::vector<std::byte> pending_;  // the records of the piece parsed last
+    std::size_t pendingPoint_ = 0;    // the next of them to give out
+};
+
+}  // namespace
+
+std::unique_ptr<PointRecordSource> openTextRecordSource(const std::filesystem::path& path) {
+    try {
+        return std::make_unique<TextRecordSource>(path);
+    } catch (const Error& error) {
+        throwNamed(path.string(), error);
+    }
+}
+
+}  // namespace subscan
