@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <string_view>
 
 namespace subscan {
 
@@ -16,11 +17,15 @@ class ProgressBar {
     ProgressBar& operator=(const ProgressBar&) = delete;
 
     void update(double fraction);
+    /// With what is being done (e.g. "indexing, 44.0 M points") and, once a few per cent are
+    /// done, the time left at the rate so far.
+    void update(double fraction, std::string_view detail);
 
   private:
     std::string label_;
     bool enabled_;
     int lastPercent_ = -1;
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
 }  // namespace subscan

@@ -135,6 +135,10 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
     return runProgram(SUBSCAN_EXECUTABLE, arguments, variables);
 }
 
+std::string subscanExecutable() {
+    return SUBSCAN_EXECUTABLE;
+}
+
 CommandResult runProgram(const std::string& executable, const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment) {
     const TempDir capture;

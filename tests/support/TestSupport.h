@@ -72,6 +72,9 @@ struct CommandResult {
 CommandResult runSubscan(const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment = {});
 
+/// The subscan executable built with this test (for commands that must run through a shell).
+std::string subscanExecutable();
+
 /// Runs `executable` (a path) with `arguments` as runSubscan does, without its GL settings.
 CommandResult runProgram(const std::string& executable, const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment = {});

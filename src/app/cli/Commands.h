@@ -17,6 +17,7 @@ Command addBenchCommand(CLI::App& parent);
 Command addConvertCommand(CLI::App& parent);
 Command addEvalCommand(CLI::App& parent);
 Command addFitProfileCommand(CLI::App& parent);
+Command addIndexCommand(CLI::App& parent);
 Command addInfoCommand(CLI::App& parent);
 Command addMaterialsCommand(CLI::App& parent);
 Command addRenderCommand(CLI::App& parent);

@@ -30,6 +30,7 @@ constexpr std::pair<std::string_view, std::string_view> kTopicPages[] = {
     {"scan", "docs/surveys.md"},
     {"info", "docs/formats.md"},
     {"convert", "docs/formats.md"},
+    {"index", "docs/surveys.md"},
 };
 
 /// Ends every command's --help with the manual's pages that cover it.
@@ -54,11 +55,11 @@ int run(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "subscan 0.1.0");
 
-    const std::vector<Command> commands{addInfoCommand(app),      addRenderCommand(app),
-                                        addScanCommand(app),      addConvertCommand(app),
-                                        addEvalCommand(app),      addBenchCommand(app),
-                                        addMaterialsCommand(app), addFitProfileCommand(app),
-                                        addViewCommand(app),      addTurntableCommand(app)};
+    const std::vector<Command> commands{
+        addInfoCommand(app),      addRenderCommand(app),     addScanCommand(app),
+        addConvertCommand(app),   addEvalCommand(app),       addBenchCommand(app),
+        addMaterialsCommand(app), addFitProfileCommand(app), addViewCommand(app),
+        addTurntableCommand(app), addIndexCommand(app)};
     addManualFooters(app);
 
     try {

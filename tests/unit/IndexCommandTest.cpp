@@ -1,0 +1,147 @@
+// subscan index as a user runs it: a scan in, a COPC file out that gives back every record;
+// every way it can fail is one sentence, exit code 1, no output file and no temporary file.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/LasReader.h"
+#include "io/LasWriter.h"
+#include "io/MappedFile.h"
+#include "io/PointRecordSource.h"
+#include "support/PointRecordTestSupport.h"
+#include "support/TestSupport.h"
+
+namespace subscan {
+namespace {
+
+using test::runSubscan;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+std::vector<std::string> sortedRecords(std::span<const std::byte> bytes, std::size_t length) {
+    std::vector<std::string> records;
+    for (std::size_t at = 0; at + length <= bytes.size(); at += length) {
+        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), length);
+    }
+    std::sort(records.begin(), records.end());
+    return records;
+}
+
+/// The folder's entries, for "nothing but the input is left".
+std::vector<std::string> entries(const std::filesystem::path& folder) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// A LAS file of many points with every attribute (UTM coordinates), in `folder`.
+std::filesystem::path lasInput(const test::TempDir& folder) {
+    const std::filesystem::path input = folder / "input.las";
+    writeLas(input, test::utmCloudWithEveryAttribute());
+    return input;
+}
+
+TEST(IndexCommandTest, ALasFileBecomesACopcFileWithEveryRecord) {
+    const test::TempDir folder;
+    const std::filesystem::path input = lasInput(folder);
+    const std::filesystem::path output = folder / "out.copc.laz";
+    const test::CommandResult result =
+        runSubscan({"index", input.string(), "-o", output.string(), "--threads", "2"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.out, StartsWith(output.string() + ": "));
+    EXPECT_THAT(result.out, HasSubstr(" levels, "));
+    EXPECT_EQ(entries(folder.path()), (std::vector<std::string>{"input.las", "out.copc.laz"}));
+
+    // The input's records as LAS 1.4 (what the source gives) against the COPC file's.
+    const std::unique_ptr<PointRecordSource> source = openPointRecordSource(input);
+    const std::vector<std::byte> expected = test::readAllRecords(*source, 1000);
+    const MappedFile file(output);
+    ReadContext context;
+    const LasRecords written = readLasRecords(file.bytes(), context);
+    EXPECT_THAT(context.formatDetail, HasSubstr("COPC 1.0"));
+    EXPECT_EQ(written.recordLength, source->info().format.recordLength());
+    EXPECT_EQ(sortedRecords(written.bytes, written.recordLength),
+              sortedRecords(expected, written.recordLength));
+}
+
+TEST(IndexCommandTest, TheOutputMustBeACopcFileAndNotAnInput) {
+    const test::TempDir folder;
+    const std::filesystem::path input = lasInput(folder);
+    const test::CommandResult named =
+        runSubscan({"index", input.string(), "-o", (folder / "out.laz").string()});
+    EXPECT_EQ(named.exitCode, 1);
+    EXPECT_EQ(named.err, "subscan: " + (folder / "out.laz").string() +
+                             ": the output of index is a COPC file: name it *.copc.laz\n");
+
+    const std::filesystem::path copc = folder / "in.copc.laz";
+    std::filesystem::copy_file(input, copc);
+    const test::CommandResult over = runSubscan({"index", copc.string(), "-o", copc.string()});
+    EXPECT_EQ(over.exitCode, 1);
+    EXPECT_EQ(over.err,
+              "subscan: " + copc.string() + ": refusing to write the index over its input\n");
+    EXPECT_EQ(entries(folder.path()), (std::vector<std::string>{"in.copc.laz", "input.las"}));
+}
+
+TEST(IndexCommandTest, MissingAndTruncatedInputsLeaveNothing) {
+    const test::TempDir folder;
+    const std::filesystem::path output = folder / "out.copc.laz";
+    const test::CommandResult missing =
+        runSubscan({"index", (folder / "absent.las").string(), "-o", output.string()});
+    EXPECT_EQ(missing.exitCode, 1);
+    EXPECT_THAT(missing.err, StartsWith("subscan: " + (folder / "absent.las").string()));
+    EXPECT_EQ(test::lineCount(missing.err), 1u) << missing.err;
+
+    const std::filesystem::path input = lasInput(folder);
+    const std::string bytes = test::fileBytes(input);
+    const std::filesystem::path truncated =
+        folder.write("truncated.las", bytes.substr(0, bytes.size() - 100));
+    std::filesystem::remove(input);
+    const test::CommandResult cut =
+        runSubscan({"index", truncated.string(), "-o", output.string()});
+    EXPECT_EQ(cut.exitCode, 1);
+    EXPECT_THAT(cut.err, StartsWith("subscan: " + truncated.string()));
+    EXPECT_EQ(test::lineCount(cut.err), 1u) << cut.err;
+    EXPECT_EQ(entries(folder.path()), (std::vector<std::string>{"truncated.las"}));
+}
+
+TEST(IndexCommandTest, AFullDiskIsOneSentenceAndLeavesNothing) {
+    const test::TempDir folder;
+    const std::filesystem::path output = folder / "out.copc.laz";
+    // A file-size limit of 4 KiB (bash's ulimit -f counts 1024-byte blocks): the index of a
+    // sphere's 40,000 points (hundreds of KB) fails past it with EFBIG, as on a full disk, while
+    // the error sentence still fits the captured stderr, which the limit binds too. SIGXFSZ,
+    // which would kill the process, is ignored (an ignored signal stays ignored across exec).
+    const test::CommandResult result = test::runProgram(
+        "/bin/bash", {"-c", "ulimit -f 4 && trap '' XFSZ && exec \"$0\" index \"$1\" -o \"$2\"",
+                      test::subscanExecutable(), "synthetic:sphere?points=40000", output.string()});
+    EXPECT_EQ(result.exitCode, 1) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("is the disk full?"));
+    EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
+    EXPECT_TRUE(std::filesystem::is_empty(folder.path()));
+}
+
+TEST(IndexCommandTest, CtrlCStopsItAndLeavesNothing) {
+    const test::TempDir folder;
+    const std::filesystem::path output = folder / "out.copc.laz";
+    // A virtual scan of a million points takes over a second to make: the interrupt comes while
+    // the scan is made, and the indexer stops at its first step.
+    const test::CommandResult result = test::runProgram(
+        "/bin/bash",
+        {"-c",
+         "\"$0\" index 'synthetic:outdoor-station?points=1000000' -o \"$1\" --tmp \"$2\" & "
+         "sleep 0.3; kill -INT $!; wait $!",
+         test::subscanExecutable(), output.string(), folder.path().string()});
+    EXPECT_EQ(result.exitCode, 1) << result.err;
+    EXPECT_EQ(result.err, "subscan: interrupted; no output was written\n");
+    EXPECT_TRUE(std::filesystem::is_empty(folder.path()));
+}
+
+}  // namespace
+}  // namespace subscan
