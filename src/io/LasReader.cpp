@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/Error.h"
 #include "io/ByteOrder.h"
@@ -345,11 +346,16 @@ std::vector<std::byte> decompressLaz(std::span<const std::byte> file, const LasH
                 "the COPC hierarchy's nodes hold {} points, but the LAS header declares {}", points,
                 header.pointCount));
         }
+        // Points per level: what a level-of-detail loader would read down to that level.
+        std::vector<std::uint64_t> perLevel(static_cast<std::size_t>(laz::copcLevels(nodes)), 0);
+        for (const laz::CopcNode& node : nodes) {
+            perLevel[static_cast<std::size_t>(node.key.level)] += node.chunk.pointCount;
+        }
         context.formatDetail = fmt::format(
             "COPC 1.0 (LAZ, LAS 1.{}, point format {}): octree of {} levels, {} nodes, root "
-            "spacing {:.6g}",
+            "spacing {:.6g}; points per level {}",
             header.versionMinor, header.pointFormat, laz::copcLevels(nodes), nodes.size(),
-            info.rootSpacing);
+            info.rootSpacing, fmt::join(perLevel, ", "));
     } else {
         chunks = laz::readChunkTable(file, header.pointDataOffset, layout, header.pointCount);
         context.formatDetail = fmt::format(

@@ -646,7 +646,9 @@ TEST(LazReaderTest, CopcNodesAreReadThroughTheHierarchyPages) {
             << "point " << i;
     }
     const LoadedScan scan = test::decode(copc.bytes, "x.copc.laz");
-    EXPECT_THAT(scan.formatDetail, HasSubstr("octree of 2 levels, 2 nodes, root spacing 0.5"));
+    // The root's 18 points at level 0, the other node's 12 at level 1.
+    EXPECT_THAT(scan.formatDetail, HasSubstr("octree of 2 levels, 2 nodes, root spacing 0.5; "
+                                             "points per level 18, 12"));
     // Every record says ground (class 2, byte 16 of POINT14): so must the cloud of both nodes.
     EXPECT_EQ(scan.cloud.classifications, std::vector<std::uint8_t>(30, 2));
 }
