@@ -9,6 +9,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "io/Las14Writer.h"
 #include "io/PointRecordSource.h"
 #include "io/laz/Copc.h"
 #include "io/laz/LazDecoder.h"
@@ -65,12 +66,7 @@ class CopcWriter final : public NodeSink {
     std::uint64_t end_ = 0;
     std::vector<std::unique_ptr<laz::ChunkEncoder>> idleEncoders_;
     std::vector<Node> nodes_;  // in file order
-    std::uint64_t points_ = 0;
-    std::uint64_t pointsByReturn_[15] = {};
-    glm::ivec3 storedMin_{0};
-    glm::ivec3 storedMax_{0};
-    double gpsTimeMin_ = 0.0;
-    double gpsTimeMax_ = 0.0;
+    Las14Summary summary_;
     bool finished_ = false;
 };
 
