@@ -13,11 +13,14 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/Error.h"
+#include "io/LazWriter.h"
 #include "io/PointRecordSource.h"
 #include "support/PointRecordTestSupport.h"
 #include "support/TestSupport.h"
@@ -674,6 +677,53 @@ TEST(PointRecordSourceTest, ScansLoadedWholeBecomeRecordsToo) {
                 HasSubstr("/nonexistent/scan.las"));
 }
 
+std::vector<std::byte> bytesOf(std::string_view text) {
+    const auto* data = reinterpret_cast<const std::byte*>(text.data());
+    return {data, data + text.size()};
+}
+
+TEST(PointRecordSourceTest, LazOfUnevenChunksGivesTheRecordsOfTheSameLasFile) {
+    // Format 8 with 3 extra bytes described as three uchar fields, and the WKT as an extended
+    // VLR after the chunk table: the LAZ file is the LAS file's header and records encoded by
+    // subscan's LAZ writer, in chunks of 1, 7, 992 and 1000 points.
+    std::string descriptors;
+    for (const char* name : {"a", "b", "c"}) {
+        std::string d(kDescriptorSize, '\0');
+        d[2] = 1;  // unsigned char
+        std::memcpy(d.data() + 4, name, 1);
+        descriptors += d;
+    }
+    TestLas las = lasWithEveryField(8, 3, 2000);
+    las.vlrs.push_back({"LASF_Spec", 4, descriptors});
+    las.evlrs.push_back({"LASF_Projection", 2112, "LOCAL_CS[\"site\"]"});
+    const std::string lasBytes = las.bytes();
+    std::string records;
+    for (const std::string& record : las.records) {
+        records += record;
+    }
+    LazFileContents contents;
+    contents.header = bytesOf(std::string_view(lasBytes).substr(0, 375));
+    contents.vlrs.push_back({"LASF_Spec", 4, "", bytesOf(descriptors)});
+    contents.records = std::as_bytes(std::span(records));
+    contents.chunkPointCounts = {1, 7, 992, 1000};
+    contents.extendedVlrs.push_back({"LASF_Projection", 2112, "", bytesOf("LOCAL_CS[\"site\"]")});
+    const test::TempDir dir;
+    const auto lazPath = dir / "uneven.laz";
+    writeLaz(lazPath, contents);
+    const auto lasSource = open(dir.write("uneven.las", lasBytes));
+    const std::vector<std::byte> expected = readAllRecords(*lasSource, 5000);
+    for (const unsigned threads : {1u, 3u}) {
+        SCOPED_TRACE(::testing::Message() << threads << " threads");
+        const auto laz = open(lazPath, threads);
+        EXPECT_EQ(laz->info().format, lasSource->info().format);
+        EXPECT_EQ(laz->info().format.extraBytesDescriptors.size(), descriptors.size());
+        EXPECT_EQ(laz->info().wkt, "LOCAL_CS[\"site\"]");
+        EXPECT_EQ(laz->info().wkt, lasSource->info().wkt);
+        EXPECT_TRUE(readAllRecords(*laz, 5000) == expected);
+        expectPiecesAgree(*laz);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Merging
 
@@ -758,6 +808,33 @@ TEST(PointRecordSourceTest, InputsThatCannotShareAGridAreOneSentenceNamingBoth) 
     // Far apart: no one grid of 32-bit integers at 0.01 holds 0 and 1e8.
     const auto far = dir.write("far.las", threePointLas(6, glm::dvec3(0.01), {1e8, 0, 0}));
     EXPECT_THAT(mergeError({a, far}), HasSubstr("too far apart"));
+}
+
+TEST(PointRecordSourceTest, AMergeOfManyFilesHoldsOneOpenAtATime) {
+    // 300 inputs under a limit of 64 open files: an input holds its file only while it is read.
+    const test::TempDir dir;
+    std::vector<std::filesystem::path> paths;
+    for (int i = 0; i < 300; ++i) {
+        paths.push_back(dir.write("tile" + std::to_string(i) + ".las",
+                                  threePointLas(7, glm::dvec3(0.01), {10.0 * i, 0.0, 0.0})));
+    }
+    rlimit saved{};
+    ASSERT_EQ(getrlimit(RLIMIT_NOFILE, &saved), 0);
+    rlimit limited = saved;
+    limited.rlim_cur = std::min<rlim_t>(saved.rlim_cur, 64);
+    ASSERT_EQ(setrlimit(RLIMIT_NOFILE, &limited), 0);
+    std::size_t records = 0;
+    try {
+        const auto merged = mergePointRecordSources(openAll(paths));
+        for (int pass = 0; pass < 2; ++pass) {
+            merged->rewind();
+            records = readAllRecords(*merged, 5).size() / merged->info().format.recordLength();
+        }
+    } catch (const Error& error) {
+        ADD_FAILURE() << error.what();
+    }
+    setrlimit(RLIMIT_NOFILE, &saved);
+    EXPECT_EQ(records, 900u);
 }
 
 TEST(PointRecordSourceTest, NearInfraredMissingFromAnInputIsZero) {
