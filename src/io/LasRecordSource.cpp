@@ -35,6 +35,9 @@ constexpr std::uint16_t kGeoKeysRecord = 34735;
 constexpr std::string_view kSpecUser = "LASF_Spec";
 constexpr std::uint16_t kExtraBytesRecord = 4;
 
+/// The header and VLRs are read into memory; real ones take kilobytes (a VLR holds at most 64 KiB),
+/// so a point data offset beyond this is a corrupt header, not a reason to allocate gigabytes.
+constexpr std::uint32_t kLargestHead = 256u << 20;
 /// WKT and extra-bytes descriptors are a few kilobytes; a larger payload is something else.
 constexpr std::uint64_t kLargestEvlrRead = 16u << 20;
 
@@ -270,6 +273,12 @@ class LasRecordSource final : public PointRecordSource {
         }
         const auto pointDataOffset =
             loadLittleEndian<std::uint32_t>(head_.data() + las::header_field::kPointDataOffset);
+        if (pointDataOffset > kLargestHead && pointDataOffset <= fileSize_) {
+            throw Error(fmt::format(
+                "the LAS point data offset {} leaves {} MiB of header and VLRs before the points, "
+                "more than any real file has (header corrupt?)",
+                pointDataOffset, pointDataOffset >> 20));
+        }
         if (pointDataOffset > head_.size() && pointDataOffset <= fileSize_) {
             head_.resize(pointDataOffset);
             file_->read(0, head_);

@@ -456,6 +456,13 @@ TEST(PointRecordSourceTest, BadLasFilesAreOneSentenceNamingTheFile) {
     expectError("none.las", lasWithEveryField(3, 0, 0).bytes(), "no points");
     expectError("empty.las", "", "empty");
     expectError("header.las", lasWithEveryField(3, 0, 3).bytes().substr(0, 100), "LAS header");
+    // A point data offset of 300 MiB in a file that long (sparse: the test writes 300 bytes).
+    std::string farPoints = lasWithEveryField(3, 0, 1).bytes();
+    const std::uint32_t offset = 300u << 20;
+    std::memcpy(farPoints.data() + 96, &offset, sizeof(offset));
+    const auto farPath = dir.write("far.las", farPoints);
+    std::filesystem::resize_file(farPath, offset + 34);
+    EXPECT_THAT(openError(farPath), AllOf(HasSubstr("far.las"), HasSubstr("header corrupt")));
     TestLas unknown = lasWithEveryField(3, 0, 1);
     std::string badFormat = unknown.bytes();
     badFormat[104] = 11;
@@ -662,6 +669,10 @@ TEST(PointRecordSourceTest, BadTextListsAreOneSentenceNamingTheFileAndLine) {
     EXPECT_THAT(openError(dir.write("header.xyz", "x y z\n")),
                 AllOf(HasSubstr("header.xyz"), HasSubstr("no points")));
     EXPECT_THAT(openError(dir.write("counts.pts", "0\n")), HasSubstr("counts.pts"));
+    // A point line, then 100 MiB without a line end (a sparse file of zeros).
+    const auto endless = dir.write("endless.xyz", "1 2 3\n" + std::string(5000, '4'));
+    std::filesystem::resize_file(endless, 100u << 20);
+    EXPECT_THAT(openError(endless), AllOf(HasSubstr("endless.xyz"), HasSubstr("longer than 64")));
     EXPECT_THAT(openError(dir.write("pts.pts", "3\n1 2 3\n4 5 6\n")),
                 AllOf(HasSubstr("pts.pts"), HasSubstr("says 3 points, but 2 follow")));
 }
@@ -722,6 +733,39 @@ TEST(PointRecordSourceTest, LazOfUnevenChunksGivesTheRecordsOfTheSameLasFile) {
         EXPECT_TRUE(readAllRecords(*laz, 5000) == expected);
         expectPiecesAgree(*laz);
     }
+}
+
+TEST(PointRecordSourceTest, BadLazFilesAreOneSentenceNamingTheFile) {
+    const TestLas las = lasWithEveryField(7, 0, 100);
+    const std::string lasBytes = las.bytes();
+    std::string records;
+    for (const std::string& record : las.records) {
+        records += record;
+    }
+    LazFileContents contents;
+    contents.header = bytesOf(std::string_view(lasBytes).substr(0, 375));
+    contents.records = std::as_bytes(std::span(records));
+    contents.chunkPointCounts = {60, 40};
+    const std::vector<std::byte> encoded = encodeLazFile(contents);
+    const std::string laz(reinterpret_cast<const char*>(encoded.data()), encoded.size());
+    const test::TempDir dir;
+    const auto expectError = [&](const std::string& name, const std::string& bytes,
+                                 const std::string& what) {
+        const auto path = dir.write(name, bytes);
+        EXPECT_THAT(openError(path), AllOf(HasSubstr(path.string()), HasSubstr(what))) << name;
+    };
+    // The header's 64-bit count (R15 table 3, byte 247) one more than the chunks hold.
+    std::string counted = laz;
+    const std::uint64_t more = 101;
+    std::memcpy(counted.data() + 247, &more, sizeof(more));
+    expectError("count.laz", counted, "chunks hold 100 points, but the LAS header declares 101");
+    // The laszip VLR (the only VLR, right after the 375-byte header) names compressor 1, the
+    // unchunked one of LASzip 1.x.
+    std::string compressor = laz;
+    ASSERT_EQ(compressor.substr(375 + 2, 14), "laszip encoded");
+    compressor[375 + 54] = 1;
+    expectError("compressor.laz", compressor, "compressor 1");
+    expectError("cut.laz", laz.substr(0, laz.size() - 20), "chunk table");
 }
 
 // ---------------------------------------------------------------------------------------------
