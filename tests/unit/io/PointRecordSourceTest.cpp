@@ -693,6 +693,28 @@ std::vector<std::byte> bytesOf(std::string_view text) {
     return {data, data + text.size()};
 }
 
+/// The LAZ file of a LAS 1.4 file (its header, VLRs, records and EVLRs) in chunks of these
+/// sizes, as subscan's LAZ writer encodes it.
+std::string lazOf(const TestLas& las, std::vector<std::uint64_t> chunkPointCounts) {
+    const std::string lasBytes = las.bytes();
+    std::string records;
+    for (const std::string& record : las.records) {
+        records += record;
+    }
+    LazFileContents contents;
+    contents.header = bytesOf(std::string_view(lasBytes).substr(0, 375));
+    for (const Vlr& vlr : las.vlrs) {
+        contents.vlrs.push_back({vlr.user, vlr.recordId, "", bytesOf(vlr.payload)});
+    }
+    for (const Vlr& evlr : las.evlrs) {
+        contents.extendedVlrs.push_back({evlr.user, evlr.recordId, "", bytesOf(evlr.payload)});
+    }
+    contents.records = std::as_bytes(std::span(records));
+    contents.chunkPointCounts = std::move(chunkPointCounts);
+    const std::vector<std::byte> encoded = encodeLazFile(contents);
+    return {reinterpret_cast<const char*>(encoded.data()), encoded.size()};
+}
+
 TEST(PointRecordSourceTest, LazOfUnevenChunksGivesTheRecordsOfTheSameLasFile) {
     // Format 8 with 3 extra bytes described as three uchar fields, and the WKT as an extended
     // VLR after the chunk table: the LAZ file is the LAS file's header and records encoded by
@@ -707,21 +729,9 @@ TEST(PointRecordSourceTest, LazOfUnevenChunksGivesTheRecordsOfTheSameLasFile) {
     TestLas las = lasWithEveryField(8, 3, 2000);
     las.vlrs.push_back({"LASF_Spec", 4, descriptors});
     las.evlrs.push_back({"LASF_Projection", 2112, "LOCAL_CS[\"site\"]"});
-    const std::string lasBytes = las.bytes();
-    std::string records;
-    for (const std::string& record : las.records) {
-        records += record;
-    }
-    LazFileContents contents;
-    contents.header = bytesOf(std::string_view(lasBytes).substr(0, 375));
-    contents.vlrs.push_back({"LASF_Spec", 4, "", bytesOf(descriptors)});
-    contents.records = std::as_bytes(std::span(records));
-    contents.chunkPointCounts = {1, 7, 992, 1000};
-    contents.extendedVlrs.push_back({"LASF_Projection", 2112, "", bytesOf("LOCAL_CS[\"site\"]")});
     const test::TempDir dir;
-    const auto lazPath = dir / "uneven.laz";
-    writeLaz(lazPath, contents);
-    const auto lasSource = open(dir.write("uneven.las", lasBytes));
+    const auto lazPath = dir.write("uneven.laz", lazOf(las, {1, 7, 992, 1000}));
+    const auto lasSource = open(dir.write("uneven.las", las.bytes()));
     const std::vector<std::byte> expected = readAllRecords(*lasSource, 5000);
     for (const unsigned threads : {1u, 3u}) {
         SCOPED_TRACE(::testing::Message() << threads << " threads");
@@ -736,18 +746,7 @@ TEST(PointRecordSourceTest, LazOfUnevenChunksGivesTheRecordsOfTheSameLasFile) {
 }
 
 TEST(PointRecordSourceTest, BadLazFilesAreOneSentenceNamingTheFile) {
-    const TestLas las = lasWithEveryField(7, 0, 100);
-    const std::string lasBytes = las.bytes();
-    std::string records;
-    for (const std::string& record : las.records) {
-        records += record;
-    }
-    LazFileContents contents;
-    contents.header = bytesOf(std::string_view(lasBytes).substr(0, 375));
-    contents.records = std::as_bytes(std::span(records));
-    contents.chunkPointCounts = {60, 40};
-    const std::vector<std::byte> encoded = encodeLazFile(contents);
-    const std::string laz(reinterpret_cast<const char*>(encoded.data()), encoded.size());
+    const std::string laz = lazOf(lasWithEveryField(7, 0, 100), {60, 40});
     const test::TempDir dir;
     const auto expectError = [&](const std::string& name, const std::string& bytes,
                                  const std::string& what) {
