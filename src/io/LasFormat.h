@@ -11,8 +11,13 @@ namespace subscan::las {
 
 /// Byte offsets of the public header block fields, all little-endian.
 namespace header_field {
+inline constexpr std::size_t kGlobalEncoding = 6;
 inline constexpr std::size_t kVersionMajor = 24;
 inline constexpr std::size_t kVersionMinor = 25;
+inline constexpr std::size_t kSystemIdentifier = 26;    // 32 characters
+inline constexpr std::size_t kGeneratingSoftware = 58;  // 32 characters
+inline constexpr std::size_t kCreationDay = 90;         // day of the year, 1-366
+inline constexpr std::size_t kCreationYear = 92;
 inline constexpr std::size_t kHeaderSize = 94;
 inline constexpr std::size_t kPointDataOffset = 96;
 inline constexpr std::size_t kVlrCount = 100;
@@ -26,6 +31,7 @@ inline constexpr std::size_t kBounds = 179;  // max x, min x, max y, min y, max 
 inline constexpr std::size_t kFirstEvlrOffset = 235;  // LAS 1.4 only, from here on
 inline constexpr std::size_t kEvlrCount = 243;
 inline constexpr std::size_t kPointCount64 = 247;
+inline constexpr std::size_t kReturnCounts64 = 255;  // fifteen uint64
 }  // namespace header_field
 
 inline constexpr std::size_t kHeaderSizeUpTo12 = 227;

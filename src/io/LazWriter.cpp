@@ -38,7 +38,9 @@ void appendPaddedText(std::vector<std::byte>& out, std::string_view text, std::s
     out.resize(out.size() + size - text.size(), std::byte{0});
 }
 
-void appendVlr(std::vector<std::byte>& out, const LasVlr& vlr, bool extended) {
+}  // namespace
+
+void appendLasVlr(std::vector<std::byte>& out, const LasVlr& vlr, bool extended) {
     appendLittleEndian(out, std::uint16_t{0});  // reserved
     appendPaddedText(out, vlr.userId, las::kVlrUserIdSize, "VLR user id");
     appendLittleEndian(out, vlr.recordId);
@@ -55,6 +57,8 @@ void appendVlr(std::vector<std::byte>& out, const LasVlr& vlr, bool extended) {
     appendPaddedText(out, vlr.description, las::kVlrDescriptionSize, "VLR description");
     out.insert(out.end(), vlr.payload.begin(), vlr.payload.end());
 }
+
+namespace {
 
 /// Checks that the header describes `contents`' records and returns their layout.
 laz::LazLayout checkedLayout(const LazFileContents& contents) {
@@ -101,22 +105,48 @@ laz::LazLayout checkedLayout(const LazFileContents& contents) {
 
 }  // namespace
 
-std::vector<std::byte> encodeLazFile(const LazFileContents& contents, LazFileLayout* layout) {
-    const laz::LazLayout lazLayout = checkedLayout(contents);
-
-    std::vector<std::byte> file = contents.header;
-    for (const LasVlr& vlr : contents.vlrs) {
-        appendVlr(file, vlr, false);
+std::vector<std::byte> encodeLazPrefix(std::span<const std::byte> header,
+                                       std::span<const LasVlr> vlrs, const laz::LazLayout& layout,
+                                       std::uint64_t chunkTableOffset,
+                                       std::uint64_t firstExtendedVlrOffset,
+                                       std::uint32_t extendedVlrCount) {
+    std::vector<std::byte> file(header.begin(), header.end());
+    for (const LasVlr& vlr : vlrs) {
+        appendLasVlr(file, vlr, false);
     }
-    appendVlr(file,
-              {std::string(las::kLaszipUserId), las::kLaszipRecordId,
-               std::string(kLaszipDescription), laz::laszipRecordPayload(lazLayout)},
-              false);
+    appendLasVlr(file,
+                 {std::string(las::kLaszipUserId), las::kLaszipRecordId,
+                  std::string(kLaszipDescription), laz::laszipRecordPayload(layout)},
+                 false);
     const std::size_t pointDataOffset = file.size();
     if (pointDataOffset > std::numeric_limits<std::uint32_t>::max()) {
         throw Error("the VLRs end beyond 4 GiB, where the header's point data offset cannot point");
     }
-    appendLittleEndian(file, std::int64_t{0});  // the chunk table's offset, set below
+    appendLittleEndian(file, static_cast<std::int64_t>(chunkTableOffset));
+
+    setField(file, las::header_field::kHeaderSize, static_cast<std::uint16_t>(las::kHeaderSize14));
+    setField(file, las::header_field::kPointDataOffset,
+             static_cast<std::uint32_t>(pointDataOffset));
+    setField(file, las::header_field::kVlrCount, static_cast<std::uint32_t>(vlrs.size() + 1));
+    // The format with bit 7 set and bit 6 (which some writers also set) clear.
+    file[las::header_field::kPointFormat] =
+        (file[las::header_field::kPointFormat] & std::byte{0x3F}) | kCompressedBit;
+    // Formats 6-10 count points in the 64-bit fields only.
+    setField(file, las::header_field::kLegacyPointCount, std::uint32_t{0});
+    std::fill_n(file.begin() + las::header_field::kLegacyReturnCounts, 5 * 4, std::byte{0});
+    setField(file, las::header_field::kFirstEvlrOffset,
+             extendedVlrCount > 0 ? firstExtendedVlrOffset : std::uint64_t{0});
+    setField(file, las::header_field::kEvlrCount, extendedVlrCount);
+    return file;
+}
+
+std::vector<std::byte> encodeLazFile(const LazFileContents& contents, LazFileLayout* layout) {
+    const laz::LazLayout lazLayout = checkedLayout(contents);
+    // The prefix's size does not depend on the offsets it records: made once to learn where
+    // the chunks start, and again at the end with the offsets.
+    const std::size_t prefixSize =
+        encodeLazPrefix(contents.header, contents.vlrs, lazLayout, 0, 0, 0).size();
+    std::vector<std::byte> file(prefixSize);
 
     LazFileLayout placed;
     laz::ChunkEncoder encoder(lazLayout);
@@ -134,24 +164,12 @@ std::vector<std::byte> encodeLazFile(const LazFileContents& contents, LazFileLay
     file.insert(file.end(), table.begin(), table.end());
     placed.firstExtendedVlrOffset = file.size();
     for (const LasVlr& vlr : contents.extendedVlrs) {
-        appendVlr(file, vlr, true);
+        appendLasVlr(file, vlr, true);
     }
-
-    setField(file, pointDataOffset, static_cast<std::int64_t>(placed.chunkTableOffset));
-    setField(file, las::header_field::kHeaderSize, static_cast<std::uint16_t>(las::kHeaderSize14));
-    setField(file, las::header_field::kPointDataOffset,
-             static_cast<std::uint32_t>(pointDataOffset));
-    setField(file, las::header_field::kVlrCount,
-             static_cast<std::uint32_t>(contents.vlrs.size() + 1));
-    file[las::header_field::kPointFormat] |= kCompressedBit;
-    // Formats 6-10 count points in the 64-bit fields only.
-    setField(file, las::header_field::kLegacyPointCount, std::uint32_t{0});
-    std::fill_n(file.begin() + las::header_field::kLegacyReturnCounts, 5 * 4, std::byte{0});
-    const bool extended = !contents.extendedVlrs.empty();
-    setField(file, las::header_field::kFirstEvlrOffset,
-             extended ? placed.firstExtendedVlrOffset : std::uint64_t{0});
-    setField(file, las::header_field::kEvlrCount,
-             static_cast<std::uint32_t>(contents.extendedVlrs.size()));
+    const std::vector<std::byte> prefix = encodeLazPrefix(
+        contents.header, contents.vlrs, lazLayout, placed.chunkTableOffset,
+        placed.firstExtendedVlrOffset, static_cast<std::uint32_t>(contents.extendedVlrs.size()));
+    std::copy(prefix.begin(), prefix.end(), file.begin());
     if (layout) {
         *layout = std::move(placed);
     }

@@ -51,6 +51,22 @@ struct LazFileLayout {
 std::vector<std::byte> encodeLazFile(const LazFileContents& contents,
                                      LazFileLayout* layout = nullptr);
 
+/// The bytes before a LAZ 1.4 file's first chunk: `header` (as LazFileContents::header) with
+/// the fields the layout decides set, `vlrs`, the laszip VLR of `layout`, then the chunk table's
+/// offset (the point data's first 8 bytes). A writer that appends chunks as they come makes it
+/// once to learn its size (it does not depend on the offsets) and again when the chunk table and
+/// EVLRs are placed.
+std::vector<std::byte> encodeLazPrefix(std::span<const std::byte> header,
+                                       std::span<const LasVlr> vlrs, const laz::LazLayout& layout,
+                                       std::uint64_t chunkTableOffset,
+                                       std::uint64_t firstExtendedVlrOffset,
+                                       std::uint32_t extendedVlrCount);
+
+/// Appends `vlr` as LAS stores it: a VLR's 54-byte header (16-bit length) or an EVLR's 60-byte
+/// one (64-bit length), then the payload. Throws subscan::Error for a user id or description
+/// too long or, for a VLR, a payload beyond 65,535 bytes.
+void appendLasVlr(std::vector<std::byte>& out, const LasVlr& vlr, bool extended);
+
 /// Writes encodeLazFile's bytes to `path` atomically (see writeFileAtomically); errors name it.
 LazFileLayout writeLaz(const std::filesystem::path& path, const LazFileContents& contents);
 

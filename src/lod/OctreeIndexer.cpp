@@ -458,6 +458,84 @@ Chunking cutIntoChunks(std::vector<std::uint32_t> counts, int gridLevel, std::si
     return chunking;
 }
 
+/// Where the chunks' records wait to be indexed, and the chunks' top nodes wait for the levels
+/// above: in memory when the whole cloud fits the budget, else in temporary files.
+class ChunkStore {
+  public:
+    ChunkStore(std::size_t chunks, std::size_t length, const std::filesystem::path* folder)
+        : length_(length), memory_(chunks), folder_(folder != nullptr ? *folder : "") {
+        if (!folder_.empty()) {
+            writeBytes(folder_ / "roots.bin", {}, false);
+        }
+    }
+    bool inMemory() const { return folder_.empty(); }
+
+    /// Room for a chunk's records in memory (a hint; files need none).
+    void reserve(std::size_t id, std::size_t bytes) {
+        if (inMemory()) {
+            memory_[id].reserve(bytes);
+        }
+    }
+    /// Appends records to a chunk (one thread at a time).
+    void append(std::size_t id, std::span<const std::byte> records) {
+        if (inMemory()) {
+            memory_[id].insert(memory_[id].end(), records.begin(), records.end());
+        } else {
+            writeBytes(chunkFile(id), records, true);
+        }
+    }
+    /// A chunk's records, once (any thread, each chunk from one).
+    std::vector<std::byte> take(std::size_t id) {
+        if (inMemory()) {
+            return std::move(memory_[id]);
+        }
+        const std::filesystem::path file = chunkFile(id);
+        std::error_code missing;
+        const auto size = std::filesystem::file_size(file, missing);
+        if (missing) {
+            return {};
+        }
+        std::vector<std::byte> records = readBytes(file, 0, static_cast<std::size_t>(size));
+        std::filesystem::remove(file);
+        return records;
+    }
+
+    /// Keeps a chunk's top node (any thread).
+    void putRoot(const VoxelKey& key, std::vector<std::byte> records) {
+        std::lock_guard lock(mutex_);
+        const std::size_t points = records.size() / length_;
+        if (inMemory()) {
+            roots_[key] = {0, points};
+            rootRecords_[key] = std::move(records);
+        } else {
+            writeBytes(folder_ / "roots.bin", records, true);
+            roots_[key] = {rootsSize_, points};
+            rootsSize_ += records.size();
+        }
+    }
+    bool hasRoot(const VoxelKey& key) const { return roots_.contains(key); }
+    std::vector<std::byte> takeRoot(const VoxelKey& key) {
+        const auto& [offset, points] = roots_.at(key);
+        if (inMemory()) {
+            return std::move(rootRecords_.at(key));
+        }
+        return readBytes(folder_ / "roots.bin", offset, points * length_);
+    }
+
+  private:
+    std::filesystem::path chunkFile(std::size_t id) const {
+        return folder_ / fmt::format("chunk-{}.bin", id);
+    }
+
+    std::size_t length_;
+    std::vector<std::vector<std::byte>> memory_;
+    std::filesystem::path folder_;
+    std::mutex mutex_;
+    KeyMap<std::pair<std::uint64_t, std::size_t>> roots_;  // offset in roots.bin, points
+    KeyMap<std::vector<std::byte>> rootRecords_;
+    std::uint64_t rootsSize_ = 0;
+};
+
 class Indexer {
   public:
     Indexer(PointRecordSource& source, NodeSink& sink, const IndexSettings& settings)
@@ -469,22 +547,56 @@ class Indexer {
           threads_(settings.threads != 0 ? settings.threads
                                          : std::max(1u, std::thread::hardware_concurrency())) {
         summary_.cube = octreeCubeFor(info_.min, info_.max);
-        // Each thread indexes one chunk at a time; a quarter of the budget stays for the
-        // distribution's buffers and the sink's encoding.
+        // The whole cloud stays in memory when it fits a third of the budget twice over (read,
+        // then sorted into chunks). Otherwise each thread indexes one chunk at a time in three
+        // quarters of the budget; the rest is for the distribution's buffers and the encoding.
         const std::size_t perPoint = length_ + kChunkBytesPerPoint;
-        maxChunkPoints_ = std::max<std::size_t>(settings.maxNodePoints * 8,
-                                                settings.memoryBytes * 3 / 4 / threads_ / perPoint);
-        maxChunkPoints_ = std::min<std::size_t>(maxChunkPoints_, 0xFFFFFFFFu);
+        inMemory_ = info_.pointCount * length_ * 3 <= settings.memoryBytes;
+        maxChunkPoints_ = settings.memoryBytes * 3 / 4 / threads_ / perPoint;
+        if (inMemory_) {
+            // Enough chunks to keep every thread busy, none so small that its top node would
+            // hold most of its points.
+            maxChunkPoints_ = std::min<std::size_t>(
+                maxChunkPoints_, info_.pointCount / (4 * static_cast<std::size_t>(threads_)) + 1);
+        }
+        maxChunkPoints_ =
+            std::clamp<std::size_t>(maxChunkPoints_, settings.maxNodePoints * 8, 0xFFFFFFFFu);
     }
 
     IndexSummary run() {
         if (info_.pointCount == 0) {
             throw Error(fmt::format("{}: holds no points; there is nothing to index", info_.name));
         }
-        if (info_.pointCount <= maxChunkPoints_) {
-            indexInMemory();
+        // 128 cells per axis hold any cloud up to 2^27 points in chunks of millions; finer
+        // grids for more (256^3 counters: 64 MB).
+        const int gridLevel = info_.pointCount <= (std::uint64_t{1} << 27) ? 7 : 8;
+        if (inMemory_) {
+            std::vector<std::byte> records;
+            records.reserve(info_.pointCount * length_);
+            readAll(0.0, 0.3, "reading", [&](const std::vector<std::byte>& piece, std::size_t) {
+                records.insert(records.end(), piece.begin(), piece.end());
+            });
+            const Chunking chunking =
+                cutIntoChunks(countCells(records, gridLevel), gridLevel, maxChunkPoints_);
+            ChunkStore store(chunking.chunks.size(), length_, nullptr);
+            distribute(records, chunking, store);
+            std::vector<std::byte>().swap(records);
+            indexChunks(chunking, store, 0.35);
+            buildTop(chunking, store);
         } else {
-            indexOutOfCore();
+            TemporaryFolder folder(settings_.temporaryDirectory);
+            std::vector<std::uint32_t> counts(std::size_t{1} << (3 * gridLevel), 0);
+            readAll(0.0, 0.15, "counting", [&](const std::vector<std::byte>& piece, std::size_t) {
+                const std::vector<std::uint32_t> counted = countCells(piece, gridLevel);
+                for (std::size_t i = 0; i < counts.size(); ++i) {
+                    counts[i] += counted[i];
+                }
+            });
+            const Chunking chunking = cutIntoChunks(std::move(counts), gridLevel, maxChunkPoints_);
+            ChunkStore store(chunking.chunks.size(), length_, &folder.path());
+            distributeFromSource(chunking, store);
+            indexChunks(chunking, store, 0.35);
+            buildTop(chunking, store);
         }
         report(settings_, 1.0, "done");
         return summary_;
@@ -538,69 +650,85 @@ class Indexer {
         }
     }
 
-    void indexInMemory() {
-        std::vector<std::byte> records;
-        records.reserve(info_.pointCount * length_);
-        readAll(0.0, 0.3, "reading", [&](const std::vector<std::byte>& piece, std::size_t) {
-            records.insert(records.end(), piece.begin(), piece.end());
+    /// Each record's cell of the 2^gridLevel grid.
+    void cellsOf(std::span<const std::byte> records, int gridLevel,
+                 std::vector<std::uint32_t>& cells) const {
+        const std::size_t n = records.size() / length_;
+        cells.resize(n);
+        inParallelOn(n, [&](std::size_t i) {
+            const glm::dvec3 p = recordPosition(records.data() + i * length_, info_.quantization);
+            cells[i] = static_cast<std::uint32_t>(
+                gridIndex(nodeKeyAt(summary_.cube, p, gridLevel), gridLevel));
         });
-        summary_.chunks = 1;
-        ChunkIndexer indexer(summary_.cube, info_.quantization, length_, settings_.maxNodePoints,
-                             sink_);
-        report(settings_, 0.3, "indexing");
-        const ChunkIndexer::Result result = indexer.index({0, 0, 0, 0}, std::move(records));
-        countWritten(result);
-        writeNode({0, 0, 0, 0}, result.rootRecords, result.rootPoints);
     }
 
-    void indexOutOfCore() {
-        TemporaryFolder folder(settings_.temporaryDirectory);
-        // 128 cells per axis hold any cloud up to 2^27 points in chunks of millions; finer
-        // grids for more (256^3 counters: 64 MB).
-        const int gridLevel = info_.pointCount <= (std::uint64_t{1} << 27) ? 7 : 8;
-        const std::size_t cells = std::size_t{1} << (3 * gridLevel);
-        std::vector<std::uint32_t> counts(cells, 0);
-        readAll(0.0, 0.15, "counting", [&](const std::vector<std::byte>& piece, std::size_t n) {
-            for (std::size_t i = 0; i < n; ++i) {
-                const glm::dvec3 p = recordPosition(piece.data() + i * length_, info_.quantization);
-                ++counts[gridIndex(nodeKeyAt(summary_.cube, p, gridLevel), gridLevel)];
+    std::vector<std::uint32_t> countCells(std::span<const std::byte> records, int gridLevel) const {
+        std::vector<std::uint32_t> cells;
+        cellsOf(records, gridLevel, cells);
+        std::vector<std::uint32_t> counts(std::size_t{1} << (3 * gridLevel), 0);
+        for (const std::uint32_t cell : cells) {
+            ++counts[cell];
+        }
+        return counts;
+    }
+
+    /// Runs work(i) for i < count on the indexer's threads, in contiguous ranges.
+    template <class Work>
+    void inParallelOn(std::size_t count, const Work& work) const {
+        const auto range = [&](std::size_t thread) {
+            const std::size_t last = (thread + 1) * count / threads_;
+            for (std::size_t i = thread * count / threads_; i < last; ++i) {
+                work(i);
             }
-        });
-        const Chunking chunking = cutIntoChunks(std::move(counts), gridLevel, maxChunkPoints_);
-        summary_.chunks = chunking.chunks.size();
-
-        distribute(chunking, folder.path());
-        indexChunks(chunking, folder.path());
-        buildTop(chunking, folder.path());
+        };
+        std::vector<std::jthread> workers;
+        for (std::size_t thread = 1; thread < threads_; ++thread) {
+            workers.emplace_back(range, thread);
+        }
+        range(0);
     }
 
-    std::filesystem::path chunkFile(const std::filesystem::path& folder, std::size_t id) const {
-        return folder / fmt::format("chunk-{}.bin", id);
+    /// Sorts `records` into their chunks, each chunk's memory taken once at its final size.
+    void distribute(std::span<const std::byte> records, const Chunking& chunking,
+                    ChunkStore& store) {
+        std::vector<std::uint32_t> cells;
+        cellsOf(records, chunking.gridLevel, cells);
+        std::vector<std::size_t> sizes(chunking.chunks.size(), 0);
+        for (std::uint32_t& cell : cells) {
+            cell = chunking.chunkOfCell[cell];
+            sizes[cell] += length_;
+        }
+        for (std::size_t id = 0; id < sizes.size(); ++id) {
+            store.reserve(id, sizes[id]);
+        }
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+            store.append(cells[i], records.subspan(i * length_, length_));
+        }
     }
 
-    /// Appends every record to its chunk's file, buffering up to a quarter of the budget.
-    void distribute(const Chunking& chunking, const std::filesystem::path& folder) {
+    /// Reads the source again and appends every record to its chunk's file, buffering up to a
+    /// quarter of the budget.
+    void distributeFromSource(const Chunking& chunking, ChunkStore& store) {
         std::vector<std::vector<std::byte>> buffers(chunking.chunks.size());
         std::size_t buffered = 0;
         const std::size_t budget = std::max<std::size_t>(settings_.memoryBytes / 4, 1 << 20);
         const auto flush = [&] {
             for (std::size_t id = 0; id < buffers.size(); ++id) {
                 if (!buffers[id].empty()) {
-                    writeBytes(chunkFile(folder, id), buffers[id], true);
-                    std::vector<std::byte>().swap(buffers[id]);
+                    store.append(id, buffers[id]);
+                    buffers[id].clear();  // keeps its memory for the next round
                 }
             }
             buffered = 0;
         };
+        std::vector<std::uint32_t> cells;
         readAll(0.15, 0.35, "distributing",
                 [&](const std::vector<std::byte>& piece, std::size_t n) {
+                    cellsOf(piece, chunking.gridLevel, cells);
                     for (std::size_t i = 0; i < n; ++i) {
                         const std::byte* record = piece.data() + i * length_;
-                        const glm::dvec3 p = recordPosition(record, info_.quantization);
-                        const VoxelKey cell = nodeKeyAt(summary_.cube, p, chunking.gridLevel);
-                        const std::uint32_t id =
-                            chunking.chunkOfCell[gridIndex(cell, chunking.gridLevel)];
-                        buffers[id].insert(buffers[id].end(), record, record + length_);
+                        std::vector<std::byte>& buffer = buffers[chunking.chunkOfCell[cells[i]]];
+                        buffer.insert(buffer.end(), record, record + length_);
                     }
                     buffered += n * length_;
                     if (buffered > budget) {
@@ -610,15 +738,13 @@ class Indexer {
         flush();
     }
 
-    /// Indexes the chunks on `threads_` threads; each chunk's top node goes to roots.bin.
-    void indexChunks(const Chunking& chunking, const std::filesystem::path& folder) {
+    /// Indexes the chunks on `threads_` threads; each chunk's top node goes to the store.
+    void indexChunks(const Chunking& chunking, ChunkStore& store, double from) {
         std::mutex mutex;
         std::size_t nextChunk = 0;
         std::uint64_t pointsDone = 0;
         std::exception_ptr failure;
-        const std::filesystem::path roots = folder / "roots.bin";
-        writeBytes(roots, {}, false);
-        std::uint64_t rootsSize = 0;
+        summary_.chunks = chunking.chunks.size();
 
         const auto work = [&] {
             for (;;) {
@@ -632,23 +758,18 @@ class Indexer {
                 }
                 try {
                     checkCancelled(settings_);
-                    const std::filesystem::path file = chunkFile(folder, id);
-                    const auto size = static_cast<std::size_t>(std::filesystem::file_size(file));
-                    std::vector<std::byte> records = readBytes(file, 0, size);
-                    std::filesystem::remove(file);
-                    const std::size_t points = size / length_;
+                    std::vector<std::byte> records = store.take(id);
+                    const std::size_t points = records.size() / length_;
                     ChunkIndexer indexer(summary_.cube, info_.quantization, length_,
                                          settings_.maxNodePoints, sink_);
-                    const ChunkIndexer::Result result =
+                    ChunkIndexer::Result result =
                         indexer.index(chunking.chunks[id], std::move(records));
+                    store.putRoot(chunking.chunks[id], std::move(result.rootRecords));
                     std::lock_guard lock(mutex);
                     countWritten(result);
-                    writeBytes(roots, result.rootRecords, true);
-                    rootPlaces_[chunking.chunks[id]] = {rootsSize, result.rootPoints};
-                    rootsSize += result.rootRecords.size();
                     pointsDone += points;
                     report(settings_,
-                           0.35 + 0.6 * static_cast<double>(pointsDone) /
+                           from + (0.95 - from) * static_cast<double>(pointsDone) /
                                       static_cast<double>(info_.pointCount),
                            "indexing");
                 } catch (...) {
@@ -664,7 +785,6 @@ class Indexer {
             for (unsigned thread = 1; thread < threads_; ++thread) {
                 workers.emplace_back(work);
             }
-            // The calling thread works too and reports progress between its chunks.
             work();
         }
         if (failure) {
@@ -674,7 +794,7 @@ class Indexer {
 
     /// The levels above the chunks: each node samples its children's points, depth first, so
     /// only the nodes along one path and their children are in memory at once.
-    void buildTop(const Chunking& chunking, const std::filesystem::path& folder) {
+    void buildTop(const Chunking& chunking, ChunkStore& store) {
         KeyMap<bool> above;  // every strict ancestor of a chunk
         for (const VoxelKey& chunk : chunking.chunks) {
             for (VoxelKey key = chunk; key.level > 0;) {
@@ -682,19 +802,15 @@ class Indexer {
                 above[key] = true;
             }
         }
-        const std::filesystem::path roots = folder / "roots.bin";
-        if (above.empty()) {  // the root is the only chunk
-            const auto& [offset, points] = rootPlaces_.at(VoxelKey{0, 0, 0, 0});
-            writeNode({0, 0, 0, 0}, readBytes(roots, offset, points * length_), points);
-            return;
-        }
-        std::vector<std::byte> rootRecords = buildAbove({0, 0, 0, 0}, above, roots);
-        writeNode({0, 0, 0, 0}, rootRecords, rootRecords.size() / length_);
+        const VoxelKey root{0, 0, 0, 0};
+        const std::vector<std::byte> rootRecords =
+            above.empty() ? store.takeRoot(root) : buildAbove(root, above, store);
+        writeNode(root, rootRecords, rootRecords.size() / length_);
     }
 
     /// Returns the records `key` holds after sampling its children, whose rest it writes.
     std::vector<std::byte> buildAbove(const VoxelKey& key, const KeyMap<bool>& above,
-                                      const std::filesystem::path& roots) {
+                                      ChunkStore& store) {
         checkCancelled(settings_);
         std::vector<VoxelKey> childKeys;
         std::vector<std::byte> records;  // the children's points, child after child
@@ -702,10 +818,10 @@ class Indexer {
         for (int octant = 0; octant < 8; ++octant) {
             const VoxelKey child = childKey(key, octant);
             std::vector<std::byte> held;
-            if (const auto place = rootPlaces_.find(child); place != rootPlaces_.end()) {
-                held = readBytes(roots, place->second.first, place->second.second * length_);
+            if (store.hasRoot(child)) {
+                held = store.takeRoot(child);
             } else if (above.contains(child)) {
-                held = buildAbove(child, above, roots);
+                held = buildAbove(child, above, store);
             } else {
                 continue;
             }
@@ -729,7 +845,7 @@ class Indexer {
             children.push_back(&lists[c]);
         }
         PointList mine;
-        EvenSampler().sample(positions, summary_.cube, key, children, mine);
+        sampler_.sample(positions, summary_.cube, key, children, mine);
         for (std::size_t c = 0; c < childKeys.size(); ++c) {
             if (!lists[c].empty()) {
                 writeNode(childKeys[c], gatherRecords(records, length_, lists[c]), lists[c].size());
@@ -744,9 +860,10 @@ class Indexer {
     PointRecordSourceInfo info_;
     std::size_t length_;
     unsigned threads_;
+    bool inMemory_ = false;
     std::size_t maxChunkPoints_ = 0;
     IndexSummary summary_;
-    KeyMap<std::pair<std::uint64_t, std::size_t>> rootPlaces_;  // in roots.bin: offset, points
+    EvenSampler sampler_;
 };
 
 }  // namespace

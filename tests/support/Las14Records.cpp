@@ -55,7 +55,9 @@ void storePoint(const Las14Point& point, int pointFormat, std::byte* p) {
     for (std::size_t c = 0; c < colours; ++c, at += 2) {
         put(p + at, point.rgbNir[c]);
     }
-    std::memcpy(p + at, point.extra.data(), point.extra.size());
+    if (!point.extra.empty()) {
+        std::memcpy(p + at, point.extra.data(), point.extra.size());
+    }
 }
 
 enum class RunKind { Quiet, Busy, Pulses, Extremes, FlightLines, OneField };
@@ -263,6 +265,15 @@ class Generator {
 };
 
 }  // namespace
+
+void PrintTo(const Las14Format& format, std::ostream* out) {
+    *out << "format " << format.pointFormat << " with " << format.extraBytes << " extra bytes";
+}
+
+std::string las14FormatName(const Las14Format& format) {
+    return "Format" + std::to_string(format.pointFormat) + "With" +
+           std::to_string(format.extraBytes) + "ExtraBytes";
+}
 
 std::size_t las14RecordLength(int pointFormat, std::size_t extraBytes) {
     switch (pointFormat) {

@@ -2,11 +2,24 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <ostream>
+#include <string>
 #include <vector>
 
 // LAS 1.4 point records of formats 6, 7 and 8 for the LAZ encoder's tests: random, but shaped
 // like scans so that every coder path runs (see randomLas14Records), and a header for them.
 namespace subscan::test {
+
+/// A point format (6, 7 or 8) and a number of extra bytes: what the LAZ tests run over.
+struct Las14Format {
+    int pointFormat = 6;
+    std::size_t extraBytes = 0;
+};
+
+/// How GoogleTest prints a Las14Format: "format 7 with 2 extra bytes".
+void PrintTo(const Las14Format& format, std::ostream* out);
+/// A test name: "Format7With2ExtraBytes".
+std::string las14FormatName(const Las14Format& format);
 
 /// The bytes of a record of `pointFormat` (6, 7 or 8) with `extraBytes` extra bytes.
 std::size_t las14RecordLength(int pointFormat, std::size_t extraBytes);

@@ -125,11 +125,23 @@ void expectUnwritablePathIsAnErrorNamingIt(
 
 CommandResult runSubscan(const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment) {
+    // GL errors fail the command in the Release builds tests run, unless a test says otherwise.
+    std::vector<std::string> variables = environment;
+    if (std::none_of(environment.begin(), environment.end(), [](const std::string& added) {
+            return added.starts_with("SUBSCAN_GL_DEBUG=");
+        })) {
+        variables.emplace_back("SUBSCAN_GL_DEBUG=1");
+    }
+    return runProgram(SUBSCAN_EXECUTABLE, arguments, variables);
+}
+
+CommandResult runProgram(const std::string& executable, const std::vector<std::string>& arguments,
+                         const std::vector<std::string>& environment) {
     const TempDir capture;
     const std::string outPath = (capture / "stdout").string();
     const std::string errPath = (capture / "stderr").string();
 
-    std::vector<std::string> argv{SUBSCAN_EXECUTABLE};
+    std::vector<std::string> argv{executable};
     argv.insert(argv.end(), arguments.begin(), arguments.end());
     std::vector<char*> argvPointers;
     for (std::string& argument : argv) {
@@ -143,13 +155,7 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
     posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, errPath.c_str(),
                                      O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    // GL errors fail the command in the Release builds tests run, unless a test says otherwise.
     std::vector<std::string> variables = environment;
-    if (std::none_of(environment.begin(), environment.end(), [](const std::string& added) {
-            return added.starts_with("SUBSCAN_GL_DEBUG=");
-        })) {
-        variables.emplace_back("SUBSCAN_GL_DEBUG=1");
-    }
     const std::size_t given = variables.size();
     for (char** entry = environ; *entry != nullptr; ++entry) {
         const std::string_view existing(*entry);
@@ -172,7 +178,7 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
                                        argvPointers.data(), environmentPointers.data());
     posix_spawn_file_actions_destroy(&actions);
     if (spawnError != 0) {
-        throw std::runtime_error(std::string("cannot start ") + SUBSCAN_EXECUTABLE);
+        throw std::runtime_error("cannot start " + executable);
     }
     int status = 0;
     waitpid(pid, &status, 0);

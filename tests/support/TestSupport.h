@@ -72,6 +72,10 @@ struct CommandResult {
 CommandResult runSubscan(const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment = {});
 
+/// Runs `executable` (a path) with `arguments` as runSubscan does, without its GL settings.
+CommandResult runProgram(const std::string& executable, const std::vector<std::string>& arguments,
+                         const std::vector<std::string>& environment = {});
+
 /// The shared real-scan folder ($SUBSCAN_TEST_DATA, else ../shared/data beside the checkout),
 /// or nullopt when it is absent (tests then GTEST_SKIP with a visible message).
 std::optional<std::filesystem::path> testDataDirectory();

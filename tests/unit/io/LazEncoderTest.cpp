@@ -112,17 +112,7 @@ TEST(LazEncoderTest, IntegersAtTheEdgesOfTheirRangesRoundTrip) {
     EXPECT_EQ(ks[1], 0u);
 }
 
-struct FormatCase {
-    int pointFormat;
-    std::size_t extraBytes;
-};
-
-void PrintTo(const FormatCase& formatCase, std::ostream* out) {
-    *out << "format " << formatCase.pointFormat << " with " << formatCase.extraBytes
-         << " extra bytes";
-}
-
-class LazEncoderFormatTest : public ::testing::TestWithParam<FormatCase> {};
+class LazEncoderFormatTest : public ::testing::TestWithParam<test::Las14Format> {};
 
 TEST_P(LazEncoderFormatTest, RandomRecordsDecodeToTheSameBytesInChunksOfAnySize) {
     const auto [format, extra] = GetParam();
@@ -148,12 +138,11 @@ TEST_P(LazEncoderFormatTest, RandomRecordsDecodeToTheSameBytesInChunksOfAnySize)
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, LazEncoderFormatTest,
-                         ::testing::Values(FormatCase{6, 0}, FormatCase{6, 3}, FormatCase{7, 0},
-                                           FormatCase{7, 1}, FormatCase{8, 0}, FormatCase{8, 5}),
-                         [](const ::testing::TestParamInfo<FormatCase>& formatCase) {
-                             return fmt::format("Format{}With{}ExtraBytes",
-                                                formatCase.param.pointFormat,
-                                                formatCase.param.extraBytes);
+                         ::testing::Values(test::Las14Format{6, 0}, test::Las14Format{6, 3},
+                                           test::Las14Format{7, 0}, test::Las14Format{7, 1},
+                                           test::Las14Format{8, 0}, test::Las14Format{8, 5}),
+                         [](const ::testing::TestParamInfo<test::Las14Format>& format) {
+                             return test::las14FormatName(format.param);
                          });
 
 void storeColour(std::byte* p, const std::array<std::uint16_t, 4>& rgbNir) {

@@ -10,6 +10,7 @@
 
 #include "core/Error.h"
 #include "io/ByteOrder.h"
+#include "io/LasFormat.h"
 #include "io/LasReader.h"
 #include "io/LazWriter.h"
 #include "io/ReadContext.h"
@@ -62,6 +63,10 @@ TEST(LazWriterTest, TheReaderReadsBackTheRecordsAndTheLayout) {
     // VLRs (ours, then laszip's) between header and points; legacy counts zero for format 7;
     // the EVLR after the chunk table.
     EXPECT_EQ(field<std::uint8_t>(file, 104), 0x87);
+    // A format byte that comes with compression bits already (LASzip's 0xC0) gets 0x80 alone.
+    Format7File marked;
+    marked.contents.header[104] = std::byte{0xC7};
+    EXPECT_EQ(field<std::uint8_t>(encodeLazFile(marked.contents), 104), 0x87);
     EXPECT_EQ(field<std::uint32_t>(file, 100), 2u);
     EXPECT_EQ(field<std::uint32_t>(file, 107), 0u);
     EXPECT_EQ(field<std::uint64_t>(file, 247), 44u);
@@ -82,7 +87,7 @@ TEST(LazWriterTest, TheReaderReadsBackTheRecordsAndTheLayout) {
     EXPECT_EQ(field<std::uint16_t>(file, evlr + 18), 8);
     EXPECT_EQ(field<std::uint64_t>(file, evlr + 20), 5u);
     EXPECT_EQ(std::string(reinterpret_cast<const char*>(file.data()) + evlr + 60, 5), "after");
-    EXPECT_EQ(evlr + 60 + 5, file.size());
+    EXPECT_EQ(evlr + las::kEvlrHeaderSize + 5, file.size());
 
     // The chunk table lists the chunks where the layout says they are.
     const laz::LazLayout lazLayout =
