@@ -35,6 +35,9 @@ constexpr std::uint16_t kGeoKeysRecord = 34735;
 constexpr std::string_view kSpecUser = "LASF_Spec";
 constexpr std::uint16_t kExtraBytesRecord = 4;
 
+/// The header and VLRs are read into memory; real ones take kilobytes (a VLR holds at most 64 KiB),
+/// so a point data offset beyond this is a corrupt header, not a reason to allocate gigabytes.
+constexpr std::uint32_t kLargestHead = 256u << 20;
 /// WKT and extra-bytes descriptors are a few kilobytes; a larger payload is something else.
 constexpr std::uint64_t kLargestEvlrRead = 16u << 20;
 
@@ -187,10 +190,10 @@ class RecordConverter {
 class LasRecordSource final : public PointRecordSource {
   public:
     LasRecordSource(const std::filesystem::path& path, unsigned threads)
-        : file_(path), threads_(threads) {
+        : path_(path), file_(std::in_place, path), fileSize_(file_->size()), threads_(threads) {
         readHead();
         ReadContext context;
-        header_ = parseLasHeader(head_, file_.size(), context);
+        header_ = parseLasHeader(head_, fileSize_, context);
         info_.name = path.string();
         for (const std::string& warning : context.warnings) {
             info_.warnings.push_back(fmt::format("{}: {}", info_.name, warning));
@@ -202,19 +205,30 @@ class LasRecordSource final : public PointRecordSource {
         if (header_.laszipRecord) {
             layout_ = laz::parseLaszipRecord(*header_.laszipRecord, header_.pointFormat,
                                              header_.recordLength);
-            chunks_ = readLazChunkTable(file_, header_, *layout_);
+            chunks_ = readLazChunkTable(*file_, header_, *layout_);
         } else {
             checkPointData();
         }
         describe();
-        rewind();
+        // Closed until the first read: a merge of thousands of tiles must not hold thousands of
+        // files (or decoding threads) open at once.
+        file_.reset();
     }
 
     const PointRecordSourceInfo& info() const override { return info_; }
 
     std::size_t read(std::vector<std::byte>& records, std::size_t maxPoints) override {
         try {
-            return layout_ ? readCompressed(records, maxPoints) : readPlain(records, maxPoints);
+            if (nextPoint_ == header_.pointCount) {
+                return 0;
+            }
+            reopen();
+            const std::size_t got =
+                layout_ ? readCompressed(records, maxPoints) : readPlain(records, maxPoints);
+            if (nextPoint_ == header_.pointCount) {
+                close();
+            }
+            return got;
         } catch (const Error& error) {
             throwNamed(info_.name, error);
         }
@@ -224,36 +238,60 @@ class LasRecordSource final : public PointRecordSource {
         nextPoint_ = 0;
         chunk_.clear();
         chunkPoint_ = 0;
-        if (layout_) {
-            stream_.reset();  // its workers stop before the new ones start
-            stream_ = std::make_unique<LazChunkStream>(file_, *layout_, chunks_, threads_);
-        }
+        stream_.reset();  // its workers stop; the next read starts a new stream at chunk 0
     }
 
   private:
+    void reopen() {
+        if (!file_) {
+            file_.emplace(path_);
+            if (file_->size() != fileSize_) {
+                throw Error(fmt::format(
+                    "the file has {} bytes now, but had {} when it was opened: another program "
+                    "changed it; open it again once it is complete",
+                    file_->size(), fileSize_));
+            }
+        }
+        if (layout_ && !stream_) {
+            stream_ = std::make_unique<LazChunkStream>(*file_, *layout_, chunks_, threads_);
+        }
+    }
+
+    void close() {
+        stream_.reset();
+        file_.reset();
+        chunk_ = {};
+    }
+
     /// The header and the VLRs, up to the point data.
     void readHead() {
         head_.resize(
-            static_cast<std::size_t>(std::min<std::uint64_t>(file_.size(), las::kHeaderSize14)));
-        file_.read(0, head_);
+            static_cast<std::size_t>(std::min<std::uint64_t>(fileSize_, las::kHeaderSize14)));
+        file_->read(0, head_);
         if (head_.size() < las::header_field::kPointDataOffset + 4) {
             return;  // parseLasHeader says what is wrong with so short a file
         }
         const auto pointDataOffset =
             loadLittleEndian<std::uint32_t>(head_.data() + las::header_field::kPointDataOffset);
-        if (pointDataOffset > head_.size() && pointDataOffset <= file_.size()) {
+        if (pointDataOffset > kLargestHead && pointDataOffset <= fileSize_) {
+            throw Error(fmt::format(
+                "the LAS point data offset {} leaves {} MiB of header and VLRs before the points, "
+                "more than any real file has (header corrupt?)",
+                pointDataOffset, pointDataOffset >> 20));
+        }
+        if (pointDataOffset > head_.size() && pointDataOffset <= fileSize_) {
             head_.resize(pointDataOffset);
-            file_.read(0, head_);
+            file_->read(0, head_);
         }
     }
 
     /// Where the point data ends: at the extended VLRs of a LAS 1.4 file when they follow it.
     std::uint64_t pointDataEnd() const {
         if (header_.evlrCount > 0 && header_.evlrOffset >= header_.pointDataOffset &&
-            header_.evlrOffset <= file_.size()) {
+            header_.evlrOffset <= fileSize_) {
             return header_.evlrOffset;
         }
-        return file_.size();
+        return fileSize_;
     }
 
     void checkPointData() const {
@@ -283,7 +321,7 @@ class LasRecordSource final : public PointRecordSource {
                 info_.name, format));
         }
         describeExtraBytes();
-        if (const auto wkt = findRecord(file_, head_, header_, kProjectionUser, kWktRecord)) {
+        if (const auto wkt = findRecord(*file_, head_, header_, kProjectionUser, kWktRecord)) {
             info_.wkt = wktText(*wkt);
         }
         if (info_.wkt.empty() && findLasVlr(head_, header_, kProjectionUser, kGeoKeysRecord)) {
@@ -299,7 +337,7 @@ class LasRecordSource final : public PointRecordSource {
         if (extra == 0) {
             return;
         }
-        const auto descriptors = findRecord(file_, head_, header_, kSpecUser, kExtraBytesRecord);
+        const auto descriptors = findRecord(*file_, head_, header_, kSpecUser, kExtraBytesRecord);
         if (descriptors && describedBytes(*descriptors) == extra) {
             info_.format.extraBytesDescriptors = *descriptors;
             return;
@@ -322,8 +360,8 @@ class LasRecordSource final : public PointRecordSource {
         for (std::size_t done = 0; done < count;) {
             const std::size_t block = std::min(kRecordsPerBlock, count - done);
             chunk_.resize(block * header_.recordLength);
-            file_.read(header_.pointDataOffset + (nextPoint_ + done) * header_.recordLength,
-                       chunk_);
+            file_->read(header_.pointDataOffset + (nextPoint_ + done) * header_.recordLength,
+                        chunk_);
             converter_->convert(chunk_.data(), block, records.data() + start + done * outputLength);
             done += block;
         }
@@ -355,7 +393,9 @@ class LasRecordSource final : public PointRecordSource {
         return done;
     }
 
-    InputFile file_;
+    std::filesystem::path path_;
+    std::optional<InputFile> file_;  // open while reading (see the constructor)
+    std::uint64_t fileSize_;
     unsigned threads_;
     std::vector<std::byte> head_;
     LasHeader header_;

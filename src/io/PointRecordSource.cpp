@@ -271,15 +271,19 @@ std::unique_ptr<PointRecordSource> mergePointRecordSources(
     for (auto& source : sources) {
         const PointRecordSourceInfo& input = source->info();
         // Colour or NIR that an input lacks is 0 in the merged records: LAS has no "absent"
-        // value, and 0 is what a format without the field would be read as (PDAL fills missing
-        // dimensions likewise). Said, because black is a colour.
+        // value, 0 is what PDAL gives a dimension no input set, and any other constant would
+        // be as made up. It is said, because RGB 0 is black: those points show black among
+        // coloured ones.
         const int format = input.format.pointFormat;
-        if (format < info.format.pointFormat) {
+        if (format == 6 && info.format.pointFormat > 6) {
             info.warnings.push_back(fmt::format(
-                "{}: it has no {}; its points get {} 0 beside the other inputs' ({} read as "
-                "black)",
-                input.name, format == 6 ? "colour" : "near infrared", format == 6 ? "RGB" : "NIR",
-                format == 6 ? "so they are" : "their colour is kept; NIR 0 is"));
+                "{}: it has no colour; its points get RGB 0 (black) in the merged records",
+                input.name));
+        }
+        if (format < 8 && info.format.pointFormat == 8) {
+            info.warnings.push_back(fmt::format(
+                "{}: it has no near infrared; its points get NIR 0 in the merged records",
+                input.name));
         }
         inputs.push_back({std::move(source), {}, format == info.format.pointFormat});
     }

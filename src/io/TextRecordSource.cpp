@@ -26,6 +26,9 @@ namespace {
 constexpr std::size_t kTextHeadBytes = 4u << 20;
 /// Text parsed at once; a line longer than this is read whole all the same.
 constexpr std::size_t kTextPieceBytes = 1u << 20;
+/// A point line is at most a few hundred bytes: text without a line end for this long is not a
+/// list of points, and must not be held whole.
+constexpr std::size_t kLongestTextLine = 64u << 20;
 
 /// A text file from an offset on, in pieces that end at a line end (or the file's end).
 class LinePieces {
@@ -34,18 +37,25 @@ class LinePieces {
 
     /// The next piece, or false at the end of the file.
     bool next(std::string_view& piece) {
+        // What is left of the last piece has no line end: only new bytes need a search.
         buffer_.erase(0, used_);
         used_ = 0;
+        std::size_t lineEnd = std::string::npos;
         for (;;) {
-            const std::size_t lineEnd = buffer_.rfind('\n');
-            if (lineEnd != std::string::npos &&
-                (buffer_.size() >= kTextPieceBytes || position_ == file_.size())) {
+            const bool atEnd = position_ == file_.size();
+            if (lineEnd != std::string::npos && (buffer_.size() >= kTextPieceBytes || atEnd)) {
                 used_ = lineEnd + 1;
                 break;
             }
-            if (position_ == file_.size()) {
+            if (atEnd) {
                 used_ = buffer_.size();  // the last line, without its line end
                 break;
+            }
+            if (buffer_.size() > kLongestTextLine) {
+                throw Error(fmt::format(
+                    "it has a line longer than {} MiB (from byte {} on): it is not a text list of "
+                    "points",
+                    kLongestTextLine >> 20, position_ - buffer_.size()));
             }
             const std::size_t start = buffer_.size();
             const auto size = static_cast<std::size_t>(
@@ -53,6 +63,10 @@ class LinePieces {
             buffer_.resize(start + size);
             file_.read(position_, std::as_writable_bytes(std::span(buffer_)).subspan(start));
             position_ += size;
+            const std::size_t found = std::string_view(buffer_).substr(start).rfind('\n');
+            if (found != std::string_view::npos) {
+                lineEnd = start + found;
+            }
         }
         piece = std::string_view(buffer_).substr(0, used_);
         return !piece.empty();

@@ -13,11 +13,14 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "core/Error.h"
+#include "io/LazWriter.h"
 #include "io/PointRecordSource.h"
 #include "support/PointRecordTestSupport.h"
 #include "support/TestSupport.h"
@@ -453,6 +456,13 @@ TEST(PointRecordSourceTest, BadLasFilesAreOneSentenceNamingTheFile) {
     expectError("none.las", lasWithEveryField(3, 0, 0).bytes(), "no points");
     expectError("empty.las", "", "empty");
     expectError("header.las", lasWithEveryField(3, 0, 3).bytes().substr(0, 100), "LAS header");
+    // A point data offset of 300 MiB in a file that long (sparse: the test writes 300 bytes).
+    std::string farPoints = lasWithEveryField(3, 0, 1).bytes();
+    const std::uint32_t offset = 300u << 20;
+    std::memcpy(farPoints.data() + 96, &offset, sizeof(offset));
+    const auto farPath = dir.write("far.las", farPoints);
+    std::filesystem::resize_file(farPath, offset + 34);
+    EXPECT_THAT(openError(farPath), AllOf(HasSubstr("far.las"), HasSubstr("header corrupt")));
     TestLas unknown = lasWithEveryField(3, 0, 1);
     std::string badFormat = unknown.bytes();
     badFormat[104] = 11;
@@ -659,6 +669,10 @@ TEST(PointRecordSourceTest, BadTextListsAreOneSentenceNamingTheFileAndLine) {
     EXPECT_THAT(openError(dir.write("header.xyz", "x y z\n")),
                 AllOf(HasSubstr("header.xyz"), HasSubstr("no points")));
     EXPECT_THAT(openError(dir.write("counts.pts", "0\n")), HasSubstr("counts.pts"));
+    // A point line, then 100 MiB without a line end (a sparse file of zeros).
+    const auto endless = dir.write("endless.xyz", "1 2 3\n" + std::string(5000, '4'));
+    std::filesystem::resize_file(endless, 100u << 20);
+    EXPECT_THAT(openError(endless), AllOf(HasSubstr("endless.xyz"), HasSubstr("longer than 64")));
     EXPECT_THAT(openError(dir.write("pts.pts", "3\n1 2 3\n4 5 6\n")),
                 AllOf(HasSubstr("pts.pts"), HasSubstr("says 3 points, but 2 follow")));
 }
@@ -672,6 +686,85 @@ TEST(PointRecordSourceTest, ScansLoadedWholeBecomeRecordsToo) {
     EXPECT_THAT(test::errorMessage([] { open("synthetic:teapot"); }), HasSubstr("teapot"));
     EXPECT_THAT(test::errorMessage([] { open("/nonexistent/scan.las"); }),
                 HasSubstr("/nonexistent/scan.las"));
+}
+
+std::vector<std::byte> bytesOf(std::string_view text) {
+    const auto* data = reinterpret_cast<const std::byte*>(text.data());
+    return {data, data + text.size()};
+}
+
+/// The LAZ file of a LAS 1.4 file (its header, VLRs, records and EVLRs) in chunks of these
+/// sizes, as subscan's LAZ writer encodes it.
+std::string lazOf(const TestLas& las, std::vector<std::uint64_t> chunkPointCounts) {
+    const std::string lasBytes = las.bytes();
+    std::string records;
+    for (const std::string& record : las.records) {
+        records += record;
+    }
+    LazFileContents contents;
+    contents.header = bytesOf(std::string_view(lasBytes).substr(0, 375));
+    for (const Vlr& vlr : las.vlrs) {
+        contents.vlrs.push_back({vlr.user, vlr.recordId, "", bytesOf(vlr.payload)});
+    }
+    for (const Vlr& evlr : las.evlrs) {
+        contents.extendedVlrs.push_back({evlr.user, evlr.recordId, "", bytesOf(evlr.payload)});
+    }
+    contents.records = std::as_bytes(std::span(records));
+    contents.chunkPointCounts = std::move(chunkPointCounts);
+    const std::vector<std::byte> encoded = encodeLazFile(contents);
+    return {reinterpret_cast<const char*>(encoded.data()), encoded.size()};
+}
+
+TEST(PointRecordSourceTest, LazOfUnevenChunksGivesTheRecordsOfTheSameLasFile) {
+    // Format 8 with 3 extra bytes described as three uchar fields, and the WKT as an extended
+    // VLR after the chunk table: the LAZ file is the LAS file's header and records encoded by
+    // subscan's LAZ writer, in chunks of 1, 7, 992 and 1000 points.
+    std::string descriptors;
+    for (const char* name : {"a", "b", "c"}) {
+        std::string d(kDescriptorSize, '\0');
+        d[2] = 1;  // unsigned char
+        std::memcpy(d.data() + 4, name, 1);
+        descriptors += d;
+    }
+    TestLas las = lasWithEveryField(8, 3, 2000);
+    las.vlrs.push_back({"LASF_Spec", 4, descriptors});
+    las.evlrs.push_back({"LASF_Projection", 2112, "LOCAL_CS[\"site\"]"});
+    const test::TempDir dir;
+    const auto lazPath = dir.write("uneven.laz", lazOf(las, {1, 7, 992, 1000}));
+    const auto lasSource = open(dir.write("uneven.las", las.bytes()));
+    const std::vector<std::byte> expected = readAllRecords(*lasSource, 5000);
+    for (const unsigned threads : {1u, 3u}) {
+        SCOPED_TRACE(::testing::Message() << threads << " threads");
+        const auto laz = open(lazPath, threads);
+        EXPECT_EQ(laz->info().format, lasSource->info().format);
+        EXPECT_EQ(laz->info().format.extraBytesDescriptors.size(), descriptors.size());
+        EXPECT_EQ(laz->info().wkt, "LOCAL_CS[\"site\"]");
+        EXPECT_EQ(laz->info().wkt, lasSource->info().wkt);
+        EXPECT_TRUE(readAllRecords(*laz, 5000) == expected);
+        expectPiecesAgree(*laz);
+    }
+}
+
+TEST(PointRecordSourceTest, BadLazFilesAreOneSentenceNamingTheFile) {
+    const std::string laz = lazOf(lasWithEveryField(7, 0, 100), {60, 40});
+    const test::TempDir dir;
+    const auto expectError = [&](const std::string& name, const std::string& bytes,
+                                 const std::string& what) {
+        const auto path = dir.write(name, bytes);
+        EXPECT_THAT(openError(path), AllOf(HasSubstr(path.string()), HasSubstr(what))) << name;
+    };
+    // The header's 64-bit count (R15 table 3, byte 247) one more than the chunks hold.
+    std::string counted = laz;
+    const std::uint64_t more = 101;
+    std::memcpy(counted.data() + 247, &more, sizeof(more));
+    expectError("count.laz", counted, "chunks hold 100 points, but the LAS header declares 101");
+    // The laszip VLR (the only VLR, right after the 375-byte header) names compressor 1, the
+    // unchunked one of LASzip 1.x.
+    std::string compressor = laz;
+    ASSERT_EQ(compressor.substr(375 + 2, 14), "laszip encoded");
+    compressor[375 + 54] = 1;
+    expectError("compressor.laz", compressor, "compressor 1");
+    expectError("cut.laz", laz.substr(0, laz.size() - 20), "chunk table");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -758,6 +851,33 @@ TEST(PointRecordSourceTest, InputsThatCannotShareAGridAreOneSentenceNamingBoth) 
     // Far apart: no one grid of 32-bit integers at 0.01 holds 0 and 1e8.
     const auto far = dir.write("far.las", threePointLas(6, glm::dvec3(0.01), {1e8, 0, 0}));
     EXPECT_THAT(mergeError({a, far}), HasSubstr("too far apart"));
+}
+
+TEST(PointRecordSourceTest, AMergeOfManyFilesHoldsOneOpenAtATime) {
+    // 300 inputs under a limit of 64 open files: an input holds its file only while it is read.
+    const test::TempDir dir;
+    std::vector<std::filesystem::path> paths;
+    for (int i = 0; i < 300; ++i) {
+        paths.push_back(dir.write("tile" + std::to_string(i) + ".las",
+                                  threePointLas(7, glm::dvec3(0.01), {10.0 * i, 0.0, 0.0})));
+    }
+    rlimit saved{};
+    ASSERT_EQ(getrlimit(RLIMIT_NOFILE, &saved), 0);
+    rlimit limited = saved;
+    limited.rlim_cur = std::min<rlim_t>(saved.rlim_cur, 64);
+    ASSERT_EQ(setrlimit(RLIMIT_NOFILE, &limited), 0);
+    std::size_t records = 0;
+    try {
+        const auto merged = mergePointRecordSources(openAll(paths));
+        for (int pass = 0; pass < 2; ++pass) {
+            merged->rewind();
+            records = readAllRecords(*merged, 5).size() / merged->info().format.recordLength();
+        }
+    } catch (const Error& error) {
+        ADD_FAILURE() << error.what();
+    }
+    setrlimit(RLIMIT_NOFILE, &saved);
+    EXPECT_EQ(records, 900u);
 }
 
 TEST(PointRecordSourceTest, NearInfraredMissingFromAnInputIsZero) {
