@@ -4,11 +4,8 @@
 // to thousands of points. The package comes from tests/npm's lock file, installed into the build
 // folder by the npm_packages test (install-packages.sh); without node, npm or the registry these
 // tests are skipped and say why.
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "io/LazWriter.h"
+#include "npm/NpmPackages.h"
 #include "support/Las14Records.h"
 #include "support/TestSupport.h"
 
@@ -25,41 +23,10 @@ namespace {
 
 using ::testing::HasSubstr;
 
-/// Where install-packages.sh put laz-perf and the reading script, and the node to run them with;
-/// or why there are none.
-struct NpmPackages {
-    std::filesystem::path directory;
-    std::string node;
-    std::string unavailable;  // empty when ready
-};
-
-NpmPackages npmPackages() {
-    NpmPackages packages;
-    const char* directory = std::getenv("SUBSCAN_NPM_DIR");
-    if (directory == nullptr || *directory == '\0') {
-        packages.unavailable = "SUBSCAN_NPM_DIR is not set (run the tests through ctest)";
-        return packages;
-    }
-    packages.directory = directory;
-    std::ifstream status(packages.directory / "status.txt");
-    std::string state;
-    std::string detail;
-    if (!std::getline(status, state) || !std::getline(status, detail)) {
-        packages.unavailable =
-            "the npm packages were not installed (ctest runs the npm_packages "
-            "test first: run the npm label, or this test through ctest)";
-    } else if (state != "ready") {
-        packages.unavailable = detail;
-    } else {
-        packages.node = detail;
-    }
-    return packages;
-}
-
 class LazPerfReadsOurLazTest : public ::testing::TestWithParam<test::Las14Format> {};
 
 TEST_P(LazPerfReadsOurLazTest, ToTheRecordsWeEncoded) {
-    const NpmPackages packages = npmPackages();
+    const test::NpmPackages packages = test::npmPackages();
     if (!packages.unavailable.empty()) {
         GTEST_SKIP() << "laz-perf is not available: " << packages.unavailable;
     }
