@@ -586,10 +586,11 @@ class Indexer {
         } else {
             TemporaryFolder folder(settings_.temporaryDirectory);
             std::vector<std::uint32_t> counts(std::size_t{1} << (3 * gridLevel), 0);
+            std::vector<std::uint32_t> cells;
             readAll(0.0, 0.15, "counting", [&](const std::vector<std::byte>& piece, std::size_t) {
-                const std::vector<std::uint32_t> counted = countCells(piece, gridLevel);
-                for (std::size_t i = 0; i < counts.size(); ++i) {
-                    counts[i] += counted[i];
+                cellsOf(piece, gridLevel, cells);
+                for (const std::uint32_t cell : cells) {
+                    ++counts[cell];
                 }
             });
             const Chunking chunking = cutIntoChunks(std::move(counts), gridLevel, maxChunkPoints_);
@@ -716,7 +717,10 @@ class Indexer {
             for (std::size_t id = 0; id < buffers.size(); ++id) {
                 if (!buffers[id].empty()) {
                     store.append(id, buffers[id]);
-                    buffers[id].clear();  // keeps its memory for the next round
+                    // Freed, not cleared: a survey's pieces come region by region, so each
+                    // round fills other chunks' buffers, and kept capacities would add up to
+                    // the whole cloud.
+                    std::vector<std::byte>().swap(buffers[id]);
                 }
             }
             buffered = 0;

@@ -77,8 +77,8 @@ INSTANTIATE_TEST_SUITE_P(SharedScans, IndexDataTest,
                          testing::Values("autzen_trim.las", "autzen_trim.laz", "lone_star.laz",
                                          "lone_star.copc.laz", "autzen_trim_las14_pf7.las",
                                          "bun_zipper.ply", "bunnyDouble.e57"),
-                         [](const testing::TestParamInfo<std::string>& info) {
-                             std::string name = info.param;
+                         [](const testing::TestParamInfo<std::string>& param) {
+                             std::string name = param.param;
                              std::replace_if(
                                  name.begin(), name.end(), [](char c) { return !std::isalnum(c); },
                                  '_');
