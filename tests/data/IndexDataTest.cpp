@@ -85,6 +85,60 @@ INSTANTIATE_TEST_SUITE_P(SharedScans, IndexDataTest,
                              return name;
                          });
 
+/// The records of any scan as the sources read them, with the quantization they are on.
+struct ReadBack {
+    std::vector<std::string> records;  // sorted
+    Quantization quantization;
+};
+
+ReadBack readBack(const std::filesystem::path& path) {
+    const std::unique_ptr<PointRecordSource> source = openPointRecordSource(path);
+    const std::vector<std::byte> bytes = test::readAllRecords(*source, 1 << 16);
+    return {sortedRecords(bytes, source->info().format.recordLength()),
+            source->info().quantization};
+}
+
+class LasFamilyConvertDataTest : public testing::TestWithParam<std::string> {};
+
+// Between LAS, LAZ and COPC, convert keeps the integer coordinates on the input's grid and every
+// attribute, both ways: the input to each, and each of those back to LAS.
+TEST_P(LasFamilyConvertDataTest, EveryRecordUnchangedBothWays) {
+    const std::optional<std::filesystem::path> data = test::testDataDirectory();
+    if (!data) {
+        GTEST_SKIP() << "../shared/data (or $SUBSCAN_TEST_DATA) is absent on this machine";
+    }
+    const std::filesystem::path input = *data / GetParam();
+    const ReadBack original = readBack(input);
+    const test::TempDir folder;
+    for (const std::string name : {"out.las", "out.laz", "out.copc.laz"}) {
+        const std::filesystem::path output = folder / name;
+        const test::CommandResult there =
+            test::runSubscan({"convert", input.string(), "-o", output.string()});
+        ASSERT_EQ(there.exitCode, 0) << there.err;
+        const ReadBack converted = readBack(output);
+        EXPECT_EQ(converted.quantization, original.quantization) << name;
+        EXPECT_TRUE(converted.records == original.records) << input << " -> " << name;
+
+        const std::filesystem::path back = folder / ("back-" + std::string(name) + ".las");
+        const test::CommandResult again =
+            test::runSubscan({"convert", output.string(), "-o", back.string()});
+        ASSERT_EQ(again.exitCode, 0) << again.err;
+        EXPECT_TRUE(readBack(back).records == original.records) << name << " -> LAS";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedScans, LasFamilyConvertDataTest,
+                         testing::Values("autzen_trim.las", "autzen_trim.laz", "simple.las",
+                                         "autzen_trim_las14_pf7.las", "lone_star.laz",
+                                         "lone_star.copc.laz"),
+                         [](const testing::TestParamInfo<std::string>& param) {
+                             std::string name = param.param;
+                             std::replace_if(
+                                 name.begin(), name.end(), [](char c) { return !std::isalnum(c); },
+                                 '_');
+                             return name;
+                         });
+
 TEST(IndexDataTest, XyzTextEveryPointOnce) {
     const std::optional<std::filesystem::path> data = test::testDataDirectory();
     if (!data) {

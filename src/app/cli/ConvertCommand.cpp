@@ -2,6 +2,7 @@
 #include <array>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -11,11 +12,14 @@
 #include "app/cli/CommandSupport.h"
 #include "app/cli/Commands.h"
 #include "core/Error.h"
+#include "io/Las14Writer.h"
 #include "io/LasWriter.h"
 #include "io/PcdWriter.h"
 #include "io/PlyWriter.h"
 #include "io/WriterSupport.h"
 #include "io/XyzWriter.h"
+#include "lod/CopcWriter.h"
+#include "lod/OctreeIndexer.h"
 
 namespace subscan::cli {
 
@@ -45,11 +49,68 @@ constexpr std::array<OutputFormat, 4> kOutputFormats{{
     {".xyz", "XYZ text", writeXyz, true, false, false},
 }};
 
+std::string lowercase(std::string text) {
+    std::transform(text.begin(), text.end(), text.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return text;
+}
+
+/// Outputs written from LAS 1.4 point records (io/PointRecordSource.h) rather than from a
+/// loaded cloud: LAZ and COPC always, LAS when the input is LAS, LAZ or COPC, so that its
+/// integer coordinates and every attribute pass unchanged.
+enum class RecordOutput { None, Las, Laz, Copc };
+
+bool isLasFamily(const std::string& source) {
+    std::ifstream file(source, std::ios::binary);
+    char signature[4] = {};
+    return file.read(signature, 4) && std::string_view(signature, 4) == "LASF";
+}
+
+RecordOutput recordOutput(const std::filesystem::path& output, const std::string& source) {
+    const std::string name = lowercase(output.filename().string());
+    if (name.ends_with(".copc.laz")) {
+        return RecordOutput::Copc;
+    }
+    if (name.ends_with(".laz")) {
+        return RecordOutput::Laz;
+    }
+    if (name.ends_with(".las") && isLasFamily(source)) {
+        return RecordOutput::Las;
+    }
+    return RecordOutput::None;
+}
+
+/// Writes `source` as LAS 1.4, LAZ or COPC from its records; returns the point count.
+std::uint64_t convertRecords(const std::string& source, const std::filesystem::path& output,
+                             RecordOutput kind) {
+    const std::unique_ptr<PointRecordSource> records = openPointRecordSource(source);
+    const PointRecordSourceInfo& info = records->info();
+    for (const std::string& warning : info.warnings) {
+        fmt::print(stderr, "subscan: warning: {}\n", warning);
+    }
+    if (kind == RecordOutput::Copc) {
+        lod::IndexSettings settings;
+        settings.temporaryDirectory = std::filesystem::absolute(output).parent_path();
+        lod::CopcWriter writer(output, info, lod::octreeCubeFor(info.min, info.max));
+        lod::buildOctree(*records, writer, settings);
+        writer.finish();
+        return info.pointCount;
+    }
+    std::vector<std::byte> all;
+    all.reserve(info.pointCount * info.format.recordLength());
+    while (records->read(all, std::size_t{1} << 20) > 0) {
+    }
+    if (kind == RecordOutput::Laz) {
+        writeLaz14(output, info, all);
+    } else {
+        writeLas14(output, info, all);
+    }
+    return info.pointCount;
+}
+
 /// The format named by the output's extension (any case), or nullptr.
 const OutputFormat* outputFormat(const std::filesystem::path& output) {
-    std::string extension = output.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string extension = lowercase(output.extension().string());
     const auto* format = std::find_if(
         kOutputFormats.begin(), kOutputFormats.end(),
         [&](const OutputFormat& candidate) { return candidate.extension == extension; });
@@ -98,12 +159,23 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
 
 int runConvert(const ConvertOptions& options) {
     const std::filesystem::path output = options.output;
-    const OutputFormat& format = *outputFormat(output);  // the option's check accepted it
     if (!options.source.starts_with("synthetic:") && sameFile(output, options.source)) {
         throw Error(fmt::format(
             "{}: refusing to write the converted scan over its input; choose another output path",
             options.output));
     }
+    if (const RecordOutput kind = recordOutput(output, options.source);
+        kind != RecordOutput::None) {
+        const std::uint64_t points = convertRecords(options.source, output, kind);
+        fmt::print("{}: {} points written as {} (from {}), every attribute as LAS 1.4 holds it\n",
+                   options.output, points,
+                   kind == RecordOutput::Copc  ? "COPC"
+                   : kind == RecordOutput::Laz ? "LAZ 1.4"
+                                               : "LAS 1.4",
+                   options.source);
+        return 0;
+    }
+    const OutputFormat& format = *outputFormat(output);  // the option's check accepted it
     const LoadedScan scan = loadScanForCommand(options.source);
     format.write(output, scan.cloud);
     warnAboutWhatIsNotWritten(options.output, format, scan.cloud);
@@ -118,16 +190,19 @@ Command addConvertCommand(CLI::App& parent) {
     auto options = std::make_shared<ConvertOptions>();
     CLI::App* convert = parent.add_subcommand(
         "convert",
-        "Write a scan as PLY, LAS, PCD or XYZ text, with its colour, intensity and normals");
+        "Write a scan as PLY, LAS, LAZ, COPC, PCD or XYZ text, with its colour, intensity and "
+        "normals");
     convert->add_option("scan", options->source, "Scan file, or synthetic:NAME")->required();
     convert
         ->add_option("-o,--output", options->output,
-                     fmt::format("File to write; its extension picks the format ({})",
+                     fmt::format("File to write; its extension picks the format ({}, .laz, "
+                                 ".copc.laz; LAS, LAZ and COPC inputs keep their coordinates "
+                                 "and attributes exactly)",
                                  supportedExtensions()))
         ->required()
         ->check(
             [](const std::string& path) -> std::string {
-                return outputFormat(path) != nullptr
+                return outputFormat(path) != nullptr || lowercase(path).ends_with(".laz")
                            ? std::string()
                            : fmt::format("'{}' has no extension of a format convert writes ({})",
                                          path, supportedExtensions());
