@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -346,10 +347,15 @@ std::vector<std::byte> decompressLaz(std::span<const std::byte> file, const LasH
                 "the COPC hierarchy's nodes hold {} points, but the LAS header declares {}", points,
                 header.pointCount));
         }
-        // Points per level: what a level-of-detail loader would read down to that level.
-        std::vector<std::uint64_t> perLevel(static_cast<std::size_t>(laz::copcLevels(nodes)), 0);
+        // Points per level: what a level-of-detail loader would read down to that level. A map,
+        // not a vector by level: a damaged key's level may be any 32-bit number.
+        std::map<std::int32_t, std::uint64_t> levelPoints;
         for (const laz::CopcNode& node : nodes) {
-            perLevel[static_cast<std::size_t>(node.key.level)] += node.chunk.pointCount;
+            levelPoints[node.key.level] += node.chunk.pointCount;
+        }
+        std::vector<std::uint64_t> perLevel;
+        for (const auto& [level, levelCount] : levelPoints) {
+            perLevel.push_back(levelCount);
         }
         context.formatDetail = fmt::format(
             "COPC 1.0 (LAZ, LAS 1.{}, point format {}): octree of {} levels, {} nodes, root "
