@@ -304,13 +304,15 @@ std::vector<std::byte> gatherRecords(std::span<const std::byte> records, std::si
 /// draw from them).
 class ChunkIndexer {
   public:
+    /// `sampler`: the calling thread's (its 8 MB grid is made once per thread, not per chunk).
     ChunkIndexer(const OctreeCube& cube, const Quantization& quantization, std::size_t length,
-                 std::size_t maxNodePoints, NodeSink& sink)
+                 std::size_t maxNodePoints, NodeSink& sink, EvenSampler& sampler)
         : cube_(cube),
           quantization_(quantization),
           length_(length),
           maxNodePoints_(maxNodePoints),
-          sink_(sink) {}
+          sink_(sink),
+          sampler_(sampler) {}
 
     struct Result {
         std::vector<std::byte> rootRecords;
@@ -391,7 +393,7 @@ class ChunkIndexer {
     NodeSink& sink_;
     std::vector<std::byte> records_;
     std::vector<glm::dvec3> positions_;
-    EvenSampler sampler_;
+    EvenSampler& sampler_;
 };
 
 /// Cells of a count grid at `level` (2^level per axis), flattened x fastest.
@@ -576,10 +578,17 @@ class Indexer {
             readAll(0.0, 0.3, "reading", [&](const std::vector<std::byte>& piece, std::size_t) {
                 records.insert(records.end(), piece.begin(), piece.end());
             });
+            // A cloud of one chunk's size is that chunk: no grid to count and cut.
             const Chunking chunking =
-                cutIntoChunks(countCells(records, gridLevel), gridLevel, maxChunkPoints_);
+                info_.pointCount <= maxChunkPoints_
+                    ? Chunking{0, {VoxelKey{0, 0, 0, 0}}, {}}
+                    : cutIntoChunks(countCells(records, gridLevel), gridLevel, maxChunkPoints_);
             ChunkStore store(chunking.chunks.size(), length_, nullptr);
-            distribute(records, chunking, store);
+            if (chunking.chunks.size() == 1) {
+                store.append(0, records);
+            } else {
+                distribute(records, chunking, store);
+            }
             std::vector<std::byte>().swap(records);
             indexChunks(chunking, store, 0.35);
             buildTop(chunking, store);
@@ -751,6 +760,7 @@ class Indexer {
         summary_.chunks = chunking.chunks.size();
 
         const auto work = [&] {
+            EvenSampler sampler;
             for (;;) {
                 std::size_t id = 0;
                 {
@@ -765,7 +775,7 @@ class Indexer {
                     std::vector<std::byte> records = store.take(id);
                     const std::size_t points = records.size() / length_;
                     ChunkIndexer indexer(summary_.cube, info_.quantization, length_,
-                                         settings_.maxNodePoints, sink_);
+                                         settings_.maxNodePoints, sink_, sampler);
                     ChunkIndexer::Result result =
                         indexer.index(chunking.chunks[id], std::move(records));
                     store.putRoot(chunking.chunks[id], std::move(result.rootRecords));

@@ -19,10 +19,12 @@
 // exactly once, in the shallowest node that accepts it. A node of level L accepts points at
 // least rootSpacing / 2^L apart from each other (Poisson-disk-like acceptance, drawn from its
 // children's points), so the union of levels 0..L is an even sample of spacing rootSpacing / 2^L
-// and a renderer can take its local spacing from the level. Out of core: the cloud is cut into
-// chunks that fit the memory budget (a counting pass, then a distribution pass into temporary
-// files), each chunk is indexed on its own thread, and the levels above the chunks are built
-// last from the chunks' top nodes.
+// and a renderer can take its local spacing from the level (leaves keep what no level took, at
+// the scan's own density). The cloud is cut into chunks, each indexed on a thread of its own;
+// the levels above the chunks are built last from the chunks' top nodes. A cloud that fits a
+// third of the memory budget is read once and sorted into chunks in memory; a larger one is
+// read twice, out of core: a counting pass cuts chunks that fit the budget, and a distribution
+// pass writes them to temporary files.
 namespace subscan::lod {
 
 /// The root cube and spacing, as the COPC info VLR records them.
@@ -78,7 +80,7 @@ struct IndexSummary {
     OctreeCube cube;
     std::vector<LevelCount> levels;  // by level
     std::uint64_t points = 0;
-    std::size_t chunks = 0;       // pieces indexed one by one (1: in memory, no temporary files)
+    std::size_t chunks = 0;       // pieces indexed one per thread at a time
     std::size_t largestNode = 0;  // points
 };
 

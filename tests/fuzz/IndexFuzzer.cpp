@@ -1,6 +1,6 @@
 // libFuzzer target for subscan index's writer: any bytes become LAS 1.4 point records (the
 // first byte picks format 6, 7 or 8, the second the extra bytes, the third how many points a
-// node may hold), which are indexed into a COPC file and read back through the COPC reader.
+// node may hold, 16 to 271), which are indexed into a COPC file and read back through the COPC reader.
 // Every record must come back once and unchanged; anything else aborts, as a crash does.
 #include <algorithm>
 #include <cstdint>
@@ -38,7 +38,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         return 0;
     }
     const PointRecordFormat format{6 + data[0] % 3, static_cast<std::size_t>(data[1] % 8), {}};
-    const std::size_t maxNodePoints = 1 + data[2] % 64;
+    // Nodes of 16 to 271 points: several levels from a few hundred points, without so many tiny
+    // LAZ chunks (each resets every model) that an execution takes a second.
+    const std::size_t maxNodePoints = 16 + data[2];
     const std::size_t length = format.recordLength();
     const std::size_t count = (size - 3) / length;
     if (count == 0) {
