@@ -314,10 +314,6 @@ void warnIfBoundsDisagree(const LasHeader& header, const Bounds& decoded, ReadCo
     }
 }
 
-/// LASzip compresses hardly below two bytes a point; a header that claims more than this many
-/// points per compressed byte is corrupt, and must not make us allocate its records.
-constexpr std::uint64_t kMaxLazPointsPerByte = 64;
-
 /// The point records of a LAZ or COPC file, decompressed: the same bytes an uncompressed LAS
 /// file of the same points holds. COPC files are read node by node through their hierarchy.
 std::vector<std::byte> decompressLaz(std::span<const std::byte> file, const LasHeader& header,
@@ -325,7 +321,7 @@ std::vector<std::byte> decompressLaz(std::span<const std::byte> file, const LasH
     const laz::LazLayout layout =
         laz::parseLaszipRecord(*header.laszipRecord, header.pointFormat, header.recordLength);
     const std::uint64_t compressedBytes = file.size() - header.pointDataOffset;
-    if (header.pointCount > kMaxLazPointsPerByte * compressedBytes) {
+    if (header.pointCount > laz::kMostLazPointsPerByte * compressedBytes) {
         throw Error(fmt::format(
             "the LAS header declares {} points, far more than {} bytes of LAZ data can hold "
             "(file truncated, or the count is wrong)",

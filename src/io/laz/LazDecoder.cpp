@@ -158,11 +158,11 @@ class ChunkDecoder {
     std::vector<std::span<const std::byte>> layers_;
 };
 
+}  // namespace
+
 std::string chunkName(std::size_t index, std::size_t count, const Chunk& chunk) {
     return fmt::format("the LAZ chunk {} of {} (at byte {})", index + 1, count, chunk.offset);
 }
-
-}  // namespace
 
 std::vector<ItemSpec> pointFormatItems(int pointFormat) {
     const ItemSpec point10{ItemType::Point10, 20, 2};
@@ -280,27 +280,26 @@ LazLayout parseLaszipRecord(std::span<const std::byte> payload, int pointFormat,
     return layout;
 }
 
-std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t pointDataOffset,
-                                  const LazLayout& layout, std::uint64_t pointCount) {
-    if (file.size() - pointDataOffset < 8) {
-        throw Error("the LAZ point data is shorter than its 8-byte chunk table offset");
-    }
-    const std::uint64_t chunksStart = pointDataOffset + 8;
-    auto tableOffset = loadLittleEndian<std::int64_t>(file.data() + pointDataOffset);
-    if (tableOffset == -1) {
-        // Written by a streaming compressor: the offset was appended at the end of the file.
-        tableOffset = loadLittleEndian<std::int64_t>(file.data() + file.size() - 8);
-    }
-    if (tableOffset < static_cast<std::int64_t>(chunksStart) ||
-        static_cast<std::uint64_t>(tableOffset) > file.size() - 8) {
+std::uint64_t checkedChunkTableOffset(std::int64_t offset, std::uint64_t chunksStart,
+                                      std::uint64_t fileSize) {
+    if (offset < static_cast<std::int64_t>(chunksStart) ||
+        static_cast<std::uint64_t>(offset) + kChunkTableHeaderSize > fileSize) {
         throw Error(fmt::format(
             "the LAZ chunk table offset {} lies outside the point data (bytes {} to {}; file "
             "truncated?)",
-            tableOffset, chunksStart, file.size()));
+            offset, chunksStart, fileSize));
     }
-    const std::byte* table = file.data() + tableOffset;
-    const auto version = loadLittleEndian<std::uint32_t>(table);
-    const auto chunkCount = loadLittleEndian<std::uint32_t>(table + 4);
+    return static_cast<std::uint64_t>(offset);
+}
+
+std::vector<Chunk> decodeChunkTable(std::span<const std::byte> table, std::uint64_t chunksStart,
+                                    std::uint64_t tableOffset, std::uint64_t fileSize,
+                                    const LazLayout& layout, std::uint64_t pointCount) {
+    if (table.size() < kChunkTableHeaderSize) {
+        throw Error("the LAZ chunk table is cut off before its chunk count");
+    }
+    const auto version = loadLittleEndian<std::uint32_t>(table.data());
+    const auto chunkCount = loadLittleEndian<std::uint32_t>(table.data() + 4);
     if (version != 0) {
         throw Error(fmt::format("the LAZ chunk table has version {}; only 0 exists", version));
     }
@@ -309,7 +308,7 @@ std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t p
         variable ? chunkCount : (pointCount + layout.chunkSize - 1) / layout.chunkSize;
     // Every chunk takes at least a byte, so a count above the file size is corrupt (and must not
     // allocate).
-    if (chunkCount != expectedChunks || chunkCount > file.size()) {
+    if (chunkCount != expectedChunks || chunkCount > fileSize) {
         throw Error(fmt::format(
             "the LAZ chunk table lists {} chunks, but {} points in chunks of {} make {}",
             chunkCount, pointCount, layout.chunkSize, expectedChunks));
@@ -317,7 +316,7 @@ std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t p
 
     std::vector<Chunk> chunks(chunkCount);
     if (chunkCount > 0) {
-        ArithmeticDecoder decoder(file.subspan(static_cast<std::size_t>(tableOffset) + 8));
+        ArithmeticDecoder decoder(table.subspan(kChunkTableHeaderSize));
         IntegerDecompressor integers(32, 2);
         integers.reset();
         std::int32_t lastCount = 0;
@@ -339,11 +338,16 @@ std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t p
         if (!variable) {
             chunk.pointCount = std::min<std::uint64_t>(layout.chunkSize, pointCount - points);
         }
-        if (chunk.byteSize > static_cast<std::uint64_t>(tableOffset) - offset) {
+        if (chunk.byteSize > tableOffset - offset) {
             throw Error(fmt::format(
                 "the LAZ chunk table says chunk {} of {} has {} bytes, which reach past the "
                 "chunk table",
                 i + 1, chunks.size(), chunk.byteSize));
+        }
+        if (chunk.pointCount > kMostLazPointsPerByte * chunk.byteSize) {
+            throw Error(fmt::format("{} claims {} points in {} bytes, far more than LAZ can hold",
+                                    chunkName(i, chunks.size(), chunk), chunk.pointCount,
+                                    chunk.byteSize));
         }
         offset += chunk.byteSize;
         points += chunk.pointCount;
@@ -354,6 +358,22 @@ std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t p
             pointCount));
     }
     return chunks;
+}
+
+std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t pointDataOffset,
+                                  const LazLayout& layout, std::uint64_t pointCount) {
+    if (file.size() - pointDataOffset < 8) {
+        throw Error("the LAZ point data is shorter than its 8-byte chunk table offset");
+    }
+    const std::uint64_t chunksStart = pointDataOffset + 8;
+    auto stored = loadLittleEndian<std::int64_t>(file.data() + pointDataOffset);
+    if (stored == -1) {
+        // Written by a streaming compressor: the offset was appended at the end of the file.
+        stored = loadLittleEndian<std::int64_t>(file.data() + file.size() - 8);
+    }
+    const std::uint64_t tableOffset = checkedChunkTableOffset(stored, chunksStart, file.size());
+    return decodeChunkTable(file.subspan(static_cast<std::size_t>(tableOffset)), chunksStart,
+                            tableOffset, file.size(), layout, pointCount);
 }
 
 void decodeChunk(std::span<const std::byte> chunk, std::uint64_t pointCount,

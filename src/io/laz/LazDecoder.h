@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "io/laz/LazItems.h"
@@ -49,9 +50,41 @@ std::vector<ItemSpec> pointFormatItems(int pointFormat);
 LazLayout parseLaszipRecord(std::span<const std::byte> payload, int pointFormat,
                             std::size_t recordLength);
 
-/// Reads the chunk table. `pointDataOffset` is where the header says the point data starts: the
-/// table's offset is stored there, the first chunk follows it. Checks that every chunk lies in
-/// the file and that the chunks hold `pointCount` points in all.
+/// "the LAZ chunk 3 of 11 (at byte 123456)", for error sentences.
+std::string chunkName(std::size_t index, std::size_t count, const Chunk& chunk);
+
+/// LASzip compresses hardly below two bytes a point: a header or chunk that claims more than
+/// this many points per compressed byte is corrupt, and must not make a reader allocate its
+/// records.
+inline constexpr std::uint64_t kMostLazPointsPerByte = 64;
+
+/// The chunk table starts with its version (0) and chunk count; each chunk's byte size (and, for
+/// variable chunks, point count) follows, coded as 32-bit integers predicted from the previous
+/// chunk's.
+inline constexpr std::size_t kChunkTableHeaderSize = 8;
+/// The most bytes of a chunk table of `chunkCount` chunks the decoder may read, header included
+/// (a coded 32-bit value takes at most 5 bytes; twice that per value bounds it).
+inline std::uint64_t mostChunkTableBytes(std::uint32_t chunkCount) {
+    return std::uint64_t{chunkCount} * 2 * 10 + kChunkTableHeaderSize;
+}
+
+/// Checks the chunk table's offset, as stored at the point data's start (or, for -1, at the
+/// file's end), against the point data (`chunksStart`, just after that offset) and the file.
+std::uint64_t checkedChunkTableOffset(std::int64_t offset, std::uint64_t chunksStart,
+                                      std::uint64_t fileSize);
+
+/// Decodes the chunk table from `table`, its bytes from the table's start on (they may run on
+/// past it: the decoder reads no further than the entries need). The chunks lie from
+/// `chunksStart` up to the table at `tableOffset` in a file of `fileSize` bytes. Checks the
+/// version, the chunk count against `pointCount`, that every chunk ends before the table and
+/// holds no more points than LAZ can fit in its bytes, and that the chunks hold `pointCount`
+/// points in all.
+std::vector<Chunk> decodeChunkTable(std::span<const std::byte> table, std::uint64_t chunksStart,
+                                    std::uint64_t tableOffset, std::uint64_t fileSize,
+                                    const LazLayout& layout, std::uint64_t pointCount);
+
+/// Reads the chunk table of a file in memory. `pointDataOffset` is where the header says the
+/// point data starts: the table's offset is stored there, the first chunk follows it.
 std::vector<Chunk> readChunkTable(std::span<const std::byte> file, std::size_t pointDataOffset,
                                   const LazLayout& layout, std::uint64_t pointCount);
 
