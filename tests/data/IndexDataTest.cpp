@@ -22,16 +22,9 @@
 namespace subscan {
 namespace {
 
-using ::testing::HasSubstr;
+using test::sortedRecords;
 
-std::vector<std::string> sortedRecords(std::span<const std::byte> bytes, std::size_t length) {
-    std::vector<std::string> records;
-    for (std::size_t at = 0; at + length <= bytes.size(); at += length) {
-        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), length);
-    }
-    std::sort(records.begin(), records.end());
-    return records;
-}
+using ::testing::HasSubstr;
 
 /// Indexes `input` and checks the COPC file against the input's records.
 void expectIndexGivesBackEveryRecord(const std::filesystem::path& input) {

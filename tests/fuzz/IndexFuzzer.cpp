@@ -1,11 +1,12 @@
 // libFuzzer target for subscan index's writer: any bytes become LAS 1.4 point records (the
 // first byte picks format 6, 7 or 8, the second the extra bytes, the third how many points a
-// node may hold, 16 to 271), which are indexed into a COPC file and read back through the COPC reader.
-// Every record must come back once and unchanged; anything else aborts, as a crash does.
+// node may hold, 16 to 271), which are indexed into a COPC file and read back through the COPC
+// reader. Every record must come back once and unchanged; anything else aborts, as a crash does.
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -18,19 +19,7 @@
 #include "lod/CopcWriter.h"
 #include "lod/OctreeIndexer.h"
 #include "support/MemoryRecordSource.h"
-
-namespace {
-
-std::vector<std::string> sortedRecords(std::span<const std::byte> bytes, std::size_t length) {
-    std::vector<std::string> records;
-    for (std::size_t at = 0; at + length <= bytes.size(); at += length) {
-        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), length);
-    }
-    std::sort(records.begin(), records.end());
-    return records;
-}
-
-}  // namespace
+#include "support/PointRecordTestSupport.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace subscan;
@@ -71,7 +60,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const MappedFile file(output);
     ReadContext context;
     const LasRecords back = readLasRecords(file.bytes(), context);
-    if (sortedRecords(back.bytes, length) != sortedRecords(records, length)) {
+    if (test::sortedRecords(back.bytes, length) != test::sortedRecords(records, length)) {
         std::fprintf(stderr, "index fuzzer: the COPC file does not give back the records\n");
         std::abort();
     }

@@ -1,10 +1,12 @@
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "io/PointRecordSource.h"
@@ -19,6 +21,18 @@ inline std::vector<std::byte> readAllRecords(PointRecordSource& source, std::siz
     std::vector<std::byte> records;
     while (source.read(records, piece) > 0) {
     }
+    return records;
+}
+
+/// The records of `bytes` (`length` bytes each), sorted: two sets of records compare as
+/// multisets, whatever order a writer put them in.
+inline std::vector<std::string> sortedRecords(std::span<const std::byte> bytes,
+                                              std::size_t length) {
+    std::vector<std::string> records;
+    for (std::size_t at = 0; at + length <= bytes.size(); at += length) {
+        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), length);
+    }
+    std::sort(records.begin(), records.end());
     return records;
 }
 

@@ -18,18 +18,11 @@
 namespace subscan {
 namespace {
 
+using test::sortedRecords;
+
 using test::runSubscan;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
-
-std::vector<std::string> sortedRecords(std::span<const std::byte> bytes, std::size_t length) {
-    std::vector<std::string> records;
-    for (std::size_t at = 0; at + length <= bytes.size(); at += length) {
-        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), length);
-    }
-    std::sort(records.begin(), records.end());
-    return records;
-}
 
 /// The folder's entries, for "nothing but the input is left".
 std::vector<std::string> entries(const std::filesystem::path& folder) {

@@ -19,10 +19,13 @@
 #include "io/laz/LazEncoder.h"
 #include "support/Las14Records.h"
 #include "support/MemoryRecordSource.h"
+#include "support/PointRecordTestSupport.h"
 #include "support/TestSupport.h"
 
 namespace subscan::lod {
 namespace {
+
+using test::sortedRecords;
 
 /// Records of `format` whose positions lie on a 40 x 40 m waving terrain (at millimetres) and
 /// whose other fields are the LAZ tests' random ones (every field changing, runs of constant
@@ -45,15 +48,6 @@ std::vector<std::byte> terrainWithAttributes(const PointRecordFormat& format, st
             static_cast<std::int32_t>(std::lround(2000 * std::sin(x / 5) * std::cos(y / 7)))};
         std::memcpy(records.data() + i * length, stored, sizeof stored);
     }
-    return records;
-}
-
-std::vector<std::string> sortedRecords(std::span<const std::byte> bytes, std::size_t length) {
-    std::vector<std::string> records;
-    for (std::size_t at = 0; at + length <= bytes.size(); at += length) {
-        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), length);
-    }
-    std::sort(records.begin(), records.end());
     return records;
 }
 
@@ -108,8 +102,7 @@ TEST_P(CopcWriterFormats, TheFileHoldsEveryRecordInItsNodeAndReadsBack) {
 
     // The header: 64-bit count, scale, offset and the bounds of the stored coordinates.
     const std::byte* header = file.bytes().data();
-    EXPECT_EQ(loadLittleEndian<std::uint64_t>(header + las::header_field::kPointCount64),
-              20'000u);
+    EXPECT_EQ(loadLittleEndian<std::uint64_t>(header + las::header_field::kPointCount64), 20'000u);
     EXPECT_EQ(loadLittleEndian<double>(header + las::header_field::kOffset), 500000.0);
     EXPECT_EQ(loadLittleEndian<double>(header + las::header_field::kBounds + 8),
               source.info().min.x);
@@ -119,10 +112,10 @@ TEST_P(CopcWriterFormats, TheFileHoldsEveryRecordInItsNodeAndReadsBack) {
     // The info VLR sits right after the header (COPC's rule) and gives the indexer's cube; every
     // node of the hierarchy holds the points of its voxel.
     EXPECT_EQ(std::string(reinterpret_cast<const char*>(header + las::kHeaderSize14 +
-                                                         las::kVlrUserIdOffset)),
+                                                        las::kVlrUserIdOffset)),
               "copc");
-    const laz::CopcInfo info = laz::parseCopcInfo(
-        file.bytes().subspan(las::kHeaderSize14 + las::kVlrHeaderSize, 160));
+    const laz::CopcInfo info =
+        laz::parseCopcInfo(file.bytes().subspan(las::kHeaderSize14 + las::kVlrHeaderSize, 160));
     EXPECT_EQ(info.center, written.summary.cube.center);
     EXPECT_EQ(info.halfSize, written.summary.cube.halfSize);
     EXPECT_EQ(info.rootSpacing, written.summary.cube.rootSpacing);
@@ -137,9 +130,8 @@ TEST_P(CopcWriterFormats, TheFileHoldsEveryRecordInItsNodeAndReadsBack) {
         for (std::size_t i = 0; i < node.chunk.pointCount; ++i) {
             std::int32_t stored[3];
             std::memcpy(stored, decoded.data() + i * format.recordLength(), sizeof stored);
-            const glm::dvec3 p =
-                glm::dvec3(stored[0], stored[1], stored[2]) * kMillimetres.scale +
-                kMillimetres.offset;
+            const glm::dvec3 p = glm::dvec3(stored[0], stored[1], stored[2]) * kMillimetres.scale +
+                                 kMillimetres.offset;
             const laz::VoxelKey at = nodeKeyAt(written.summary.cube, p, node.key.level);
             ASSERT_EQ(std::tie(at.x, at.y, at.z), std::tie(node.key.x, node.key.y, node.key.z));
         }

@@ -16,10 +16,13 @@
 
 #include "core/Error.h"
 #include "support/MemoryRecordSource.h"
+#include "support/PointRecordTestSupport.h"
 #include "support/TestSupport.h"
 
 namespace subscan::lod {
 namespace {
+
+using test::sortedRecords;
 
 using laz::VoxelKey;
 
@@ -75,15 +78,6 @@ std::vector<std::byte> terrainRecords(std::size_t count, double scale, unsigned 
             record[b] = static_cast<std::byte>(byte(random));
         }
     }
-    return records;
-}
-
-std::vector<std::string> sortedRecords(std::span<const std::byte> bytes) {
-    std::vector<std::string> records;
-    for (std::size_t at = 0; at < bytes.size(); at += kFormat6Length) {
-        records.emplace_back(reinterpret_cast<const char*>(bytes.data() + at), kFormat6Length);
-    }
-    std::sort(records.begin(), records.end());
     return records;
 }
 
@@ -191,7 +185,8 @@ TEST(OctreeIndexerTest, CubeAndKeys) {
 void expectAnEvenOctree(const MemorySource& source, const std::vector<std::byte>& input,
                         const Indexed& indexed, std::size_t maxNodePoints) {
     const CollectingSink& sink = indexed.sink;
-    EXPECT_EQ(sortedRecords(allWritten(sink)), sortedRecords(input));
+    EXPECT_EQ(sortedRecords(allWritten(sink), kFormat6Length),
+              sortedRecords(input, kFormat6Length));
     EXPECT_EQ(indexed.summary.points, source.info().pointCount);
 
     const OctreeCube& cube = indexed.summary.cube;
@@ -294,7 +289,8 @@ TEST(OctreeIndexerTest, PointsAtOnePositionEndInOneLeaf) {
     MemorySource source(input, kMillimetres);
     CollectingSink sink;
     const IndexSummary summary = buildOctree(source, sink, settingsIn(folder, 100, 1 << 30));
-    EXPECT_EQ(sortedRecords(allWritten(sink)), sortedRecords(input));
+    EXPECT_EQ(sortedRecords(allWritten(sink), kFormat6Length),
+              sortedRecords(input, kFormat6Length));
     // The root accepts one of them (the rest are closer than any spacing); splitting stops at
     // the depth where a node is finer than the coordinates' grid.
     EXPECT_EQ(summary.largestNode, 4'999u);
