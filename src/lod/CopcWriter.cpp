@@ -190,4 +190,17 @@ std::uint64_t CopcWriter::finish() {
     return end_;
 }
 
+CopcFile writeCopc(PointRecordSource& source, const std::filesystem::path& output,
+                   const IndexSettings& settings) {
+    const PointRecordSourceInfo& info = source.info();
+    CopcWriter writer(output, info, octreeCubeFor(info.min, info.max));
+    CopcFile file;
+    file.summary = buildOctree(source, writer, settings);
+    if (settings.cancelled != nullptr && settings.cancelled->load()) {
+        throw Error("interrupted; no output was written");
+    }
+    file.bytes = writer.finish();
+    return file;
+}
+
 }  // namespace subscan::lod

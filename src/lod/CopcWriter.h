@@ -70,4 +70,16 @@ class CopcWriter final : public NodeSink {
     bool finished_ = false;
 };
 
+/// What writeCopc made.
+struct CopcFile {
+    IndexSummary summary;
+    std::uint64_t bytes = 0;
+};
+
+/// Indexes `source` into a COPC file at `output`: buildOctree into a CopcWriter of the source's
+/// cube, then finish() — unless `settings.cancelled` turned true, which is then an error and
+/// leaves no file.
+CopcFile writeCopc(PointRecordSource& source, const std::filesystem::path& output,
+                   const IndexSettings& settings);
+
 }  // namespace subscan::lod

@@ -77,6 +77,14 @@ struct LevelCount {
 };
 
 struct IndexSummary {
+    std::uint64_t nodes() const {
+        std::uint64_t count = 0;
+        for (const LevelCount& level : levels) {
+            count += level.nodes;
+        }
+        return count;
+    }
+
     OctreeCube cube;
     std::vector<LevelCount> levels;  // by level
     std::uint64_t points = 0;

@@ -132,6 +132,22 @@ INSTANTIATE_TEST_SUITE_P(SharedScans, LasFamilyConvertDataTest,
                              return name;
                          });
 
+TEST(IndexDataTest, TheSourcesWarningsReachTheUser) {
+    const std::optional<std::filesystem::path> data = test::testDataDirectory();
+    if (!data) {
+        GTEST_SKIP() << "../shared/data (or $SUBSCAN_TEST_DATA) is absent on this machine";
+    }
+    // lone_star.laz gives its coordinate system as GeoTIFF keys only: the output has no WKT,
+    // and index says so.
+    const test::TempDir folder;
+    const std::filesystem::path input = *data / "lone_star.laz";
+    const test::CommandResult result =
+        test::runSubscan({"index", input.string(), "-o", (folder / "out.copc.laz").string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("subscan: warning: " + input.string() +
+                                      ": its coordinate system is given only as GeoTIFF keys"));
+}
+
 TEST(IndexDataTest, XyzTextEveryPointOnce) {
     const std::optional<std::filesystem::path> data = test::testDataDirectory();
     if (!data) {

@@ -51,12 +51,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     settings.temporaryDirectory = folder;
     settings.maxNodePoints = maxNodePoints;
     settings.threads = 1;
-    {
-        lod::CopcWriter writer(output, source.info(),
-                               lod::octreeCubeFor(source.info().min, source.info().max));
-        lod::buildOctree(source, writer, settings);
-        writer.finish();
-    }
+    lod::writeCopc(source, output, settings);
     const MappedFile file(output);
     ReadContext context;
     const LasRecords back = readLasRecords(file.bytes(), context);

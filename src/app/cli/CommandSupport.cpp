@@ -28,6 +28,12 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
+void printSourceWarnings(const PointRecordSourceInfo& info) {
+    for (const std::string& warning : info.warnings) {
+        fmt::print(stderr, "subscan: warning: {}\n", warning);  // each names its input
+    }
+}
+
 bool sameFile(const std::filesystem::path& a, const std::filesystem::path& b) {
     std::error_code ignored;  // a path that does not exist is no other file
     return std::filesystem::equivalent(a, b, ignored);

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <glm/vec3.hpp>
 
+#include "io/PointRecordSource.h"
 #include "io/ScanLoader.h"
 #include "render/ScatteringSettings.h"
 
@@ -16,6 +17,10 @@ namespace subscan::cli {
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".
 LoadedScan loadScanForCommand(std::string_view source);
+
+/// A record source's warnings (io/PointRecordSource.h) as "subscan: warning: ..." lines, as
+/// loadScanForCommand prints a reader's.
+void printSourceWarnings(const PointRecordSourceInfo& info);
 
 /// Whether `a` and `b` are the same existing file, also through another spelling of the path or
 /// a link: the guard that keeps commands from writing over their inputs.

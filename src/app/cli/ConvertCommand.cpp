@@ -85,15 +85,11 @@ std::uint64_t convertRecords(const std::string& source, const std::filesystem::p
                              RecordOutput kind) {
     const std::unique_ptr<PointRecordSource> records = openPointRecordSource(source);
     const PointRecordSourceInfo& info = records->info();
-    for (const std::string& warning : info.warnings) {
-        fmt::print(stderr, "subscan: warning: {}\n", warning);
-    }
+    printSourceWarnings(info);
     if (kind == RecordOutput::Copc) {
         lod::IndexSettings settings;
         settings.temporaryDirectory = std::filesystem::absolute(output).parent_path();
-        lod::CopcWriter writer(output, info, lod::octreeCubeFor(info.min, info.max));
-        lod::buildOctree(*records, writer, settings);
-        writer.finish();
+        lod::writeCopc(*records, output, settings);
         return info.pointCount;
     }
     std::vector<std::byte> all;

@@ -98,6 +98,7 @@ int runIndex(const IndexOptions& options) {
                                                     ? std::move(sources.front())
                                                     : mergePointRecordSources(std::move(sources));
     const PointRecordSourceInfo& info = source->info();
+    printSourceWarnings(info);
 
     lod::IndexSettings settings;
     settings.threads = options.threads;
@@ -113,27 +114,16 @@ int runIndex(const IndexOptions& options) {
                                          static_cast<double>(info.pointCount) * 1e-6));
     };
 
-    lod::CopcWriter writer(output, info, lod::octreeCubeFor(info.min, info.max));
-    const lod::IndexSummary summary = lod::buildOctree(*source, writer, settings);
-    if (interrupts.interrupted()) {
-        throw Error("interrupted; no output was written");
-    }
-    const std::uint64_t bytes = writer.finish();
+    const lod::CopcFile written = lod::writeCopc(*source, output, settings);
+    const lod::IndexSummary& summary = written.summary;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
     fmt::print(
         "{}: {} points in {} levels, {} nodes, root spacing {:g}; {:.1f} MB in {:.1f} s "
         "({:.2f} M points/s)\n",
-        options.output, summary.points, summary.levels.size(),
-        [&] {
-            std::uint64_t nodes = 0;
-            for (const lod::LevelCount& level : summary.levels) {
-                nodes += level.nodes;
-            }
-            return nodes;
-        }(),
-        summary.cube.rootSpacing, static_cast<double>(bytes) * 1e-6, seconds,
+        options.output, summary.points, summary.levels.size(), summary.nodes(),
+        summary.cube.rootSpacing, static_cast<double>(written.bytes) * 1e-6, seconds,
         static_cast<double>(summary.points) * 1e-6 / seconds);
     return 0;
 }

@@ -112,7 +112,8 @@ Command addViewCommand(CLI::App& parent) {
                      "JSON list of timed camera actions (docs/cli.md#subscan-view)")
         ->check(CLI::ExistingFile);
     view->add_option("--screenshot", options->screenshot,
-                     "PNG of the window (panel included) to write at exit, with its .camera.json and .settings.json");
+                     "PNG of the window (panel included) to write at exit, with its .camera.json "
+                     "and .settings.json");
     view->add_option("--exit-after-frames", options->exitAfterFrames,
                      "Quit after this many frames showing the scan")
         ->check(CLI::PositiveNumber);

@@ -67,10 +67,9 @@ Written indexToCopc(const test::TempDir& folder, test::MemoryRecordSource& sourc
     settings.temporaryDirectory = folder.path();
     settings.maxNodePoints = maxNodePoints;
     settings.threads = 2;
-    CopcWriter writer(written.path, source.info(),
-                      octreeCubeFor(source.info().min, source.info().max));
-    written.summary = buildOctree(source, writer, settings);
-    written.bytes = writer.finish();
+    const CopcFile file = writeCopc(source, written.path, settings);
+    written.summary = file.summary;
+    written.bytes = file.bytes;
     return written;
 }
 
@@ -137,13 +136,7 @@ TEST_P(CopcWriterFormats, TheFileHoldsEveryRecordInItsNodeAndReadsBack) {
         }
     }
     EXPECT_EQ(points, 20'000u);
-    EXPECT_EQ(nodes.size(), [&] {
-        std::uint64_t count = 0;
-        for (const LevelCount& level : written.summary.levels) {
-            count += level.nodes;
-        }
-        return count;
-    }());
+    EXPECT_EQ(nodes.size(), written.summary.nodes());
 }
 
 INSTANTIATE_TEST_SUITE_P(PointFormats, CopcWriterFormats,
