@@ -128,12 +128,6 @@ std::uint8_t lasClassification(std::uint8_t code) {
     return code <= kLargestLegacyClass ? code : kUnclassified;
 }
 
-std::size_t countUnwritableClasses(const PointCloud& cloud) {
-    return static_cast<std::size_t>(
-        std::count_if(cloud.classifications.begin(), cloud.classifications.end(),
-                      [](std::uint8_t code) { return code > kLargestLegacyClass; }));
-}
-
 LasScaling chooseLasScaling(const Bounds& bounds) {
     LasScaling scaling;
     if (bounds.empty()) {

@@ -18,8 +18,6 @@ inline constexpr std::uint8_t kUnclassified = 1;
 /// The classification byte writeLas stores for `code`: the code itself up to 31 (flags clear),
 /// else kUnclassified.
 std::uint8_t lasClassification(std::uint8_t code);
-/// How many of the cloud's class codes LAS 1.2 cannot hold (above 31, from LAS 1.4 formats 6-10).
-std::size_t countUnwritableClasses(const PointCloud& cloud);
 
 /// How a LAS file stores coordinates, per axis: file coordinate = int32 * scale + offset.
 struct LasScaling {

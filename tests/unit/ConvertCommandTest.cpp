@@ -87,7 +87,8 @@ TEST(ConvertCommandTest, RealLasToEveryFormatKeepsPointsAndColours) {
 
 TEST(ConvertCommandTest, ClassificationSurvivesLasToLasAndIsNamedWhereItCannot) {
     SUBSCAN_REQUIRE_TEST_DATA(data);
-    // LAS 1.4 point format 7 (8-bit codes) to LAS 1.2 (5-bit codes): autzen's codes are 1 and 2.
+    // LAS 1.4 point format 7 to LAS (through its records, format 7 again): autzen's codes are 1
+    // and 2, unchanged; to PLY, which has no classification, with a warning.
     const auto source = data / "autzen_trim_las14_pf7.las";
     const LoadedScan original = loadScan(source.string());
     ASSERT_TRUE(original.cloud.hasClassifications());

@@ -135,14 +135,6 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
     if (cloud.hasClassifications() && !format.classification) {
         warn("classification codes");
     }
-    if (format.classification) {
-        if (const std::size_t unwritable = countUnwritableClasses(cloud); unwritable > 0) {
-            fmt::print(stderr,
-                       "subscan: warning: {}: {} cannot hold class codes above {}; {} points "
-                       "are written as class {} (unclassified)\n",
-                       output, format.name, kLargestLegacyClass, unwritable, kUnclassified);
-        }
-    }
     if (!format.alphaAndFaces) {
         if (hasTranslucentColors(cloud)) {
             warn("colour alpha values");
