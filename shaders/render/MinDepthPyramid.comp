@@ -1,6 +1,10 @@
 #version 450
 // Min-depth pyramid (paper Fig. 3): level 0 is the rasterized depth, a texel of level R the
 // minimum of its 2x2 children on level R-1 (children past an odd edge simply do not exist).
+// Levels from 1 on also record where in a texel its points lie ("pointCentroids": the mean of
+// the children's that hold points; on level 1 the pixels' centres), for fill removal's
+// outline (FillRemoval.glsl's enclosesTowards). Children count alike, not by their points:
+// any such mean lies inside the points' convex hull, which is all the outline needs.
 //   STAGE_FIRST   levels 0 (a copy of the "depth" image) and 1 at once, one invocation per
 //                 level-1 texel: a quarter of the invocations of a separate copy
 //   STAGE_REDUCE  level `level` from level `level` - 1
@@ -15,6 +19,10 @@ layout(std430, binding = SUBSCAN_SSBO_PYRAMID) writeonly buffer Pyramid {
     float minDepth[];
 };
 layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
+layout(std430, binding = SUBSCAN_SSBO_POINT_CENTROIDS) writeonly buffer PointCentroids {
+    uint pointCentroid[];
+};
+layout(binding = SUBSCAN_TEXELS_POINT_CENTROIDS) uniform usamplerBuffer pointCentroidTexels;
 #if STAGE_FIRST
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 #endif
@@ -45,23 +53,38 @@ void main() {
     }
 #else
     float nearest = kInfinity;
+    vec2 centroidSum = vec2(0.0);  // in units of a texel of `level - 1`
+    float occupiedChildren = 0.0;
     for (int dy = 0; dy < 2; ++dy) {
         for (int dx = 0; dx < 2; ++dx) {
             ivec2 child = 2 * texel + ivec2(dx, dy);
             if (insideLevel(level - 1u, child)) {
+                uint childIndex = texelIndex(level - 1u, child);
 #if STAGE_FIRST
                 float depth = imageLoad(inDepth, child).r;
-                minDepth[texelIndex(0u, child)] = depth;
-                nearest = min(nearest, depth);
+                minDepth[childIndex] = depth;
+                vec2 inChild = vec2(0.5);
 #else
-                nearest =
-                    min(nearest, texelFetch(minDepthTexels, int(texelIndex(level - 1u, child))).r);
+                float depth = texelFetch(minDepthTexels, int(childIndex)).r;
+                vec2 inChild = isinf(depth)
+                                   ? vec2(0.0)
+                                   : unpackUnorm2x16(texelFetch(pointCentroidTexels,
+                                                                int(childIndex)).r);
 #endif
+                nearest = min(nearest, depth);
+                if (!isinf(depth)) {
+                    centroidSum += vec2(child - 2 * texel) + inChild;
+                    occupiedChildren += 1.0;
+                }
             }
         }
     }
     if (level < levelCount()) {
-        minDepth[texelIndex(level, texel)] = nearest;
+        uint index = texelIndex(level, texel);
+        minDepth[index] = nearest;
+        if (occupiedChildren > 0.0) {
+            pointCentroid[index] = packUnorm2x16(centroidSum / (2.0 * occupiedChildren));
+        }
     }
 #endif
 }

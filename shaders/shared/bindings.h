@@ -44,6 +44,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_COLOR_SUMS 12    // uvec4 per pixel: fixed-point linear RGB sums, point count
 #define SUBSCAN_SSBO_CLEAR 13         // uint words GpuClear fills (its own binding: no pass's)
 #define SUBSCAN_SSBO_OCCUPANCY 14     // uint per pixel: which of its 4x4 sub-cells hold points
+#define SUBSCAN_SSBO_POINT_CENTROIDS 15  // uint per texel, levels >= 1: where in the texel its
+                                         // points lie on average (unorm16x2 of the texel)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
@@ -56,6 +58,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
 #define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
 #define SUBSCAN_TEXELS_LOCAL_SPACING 9  // rgba16f per point, one chunk (estimateLocalSpacing)
+#define SUBSCAN_TEXELS_POINT_CENTROIDS 14  // r32ui view of SUBSCAN_SSBO_POINT_CENTROIDS (after
+                                           // the light maps: 16 units are all GL promises)
 
 // ---- textures read with texelFetch ----
 // sampler2D per directional light (units 10 .. 10 + SUBSCAN_MAX_LIGHTS - 1): its light map
@@ -199,6 +203,8 @@ static_assert(sizeof(ShadeParams) == 3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 +
 static_assert(sizeof(FrameParams) == 2 * 64 + 4 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);
+static_assert(SUBSCAN_TEXELS_POINT_CENTROIDS >= SUBSCAN_TEXTURES_LIGHT_MAPS + SUBSCAN_MAX_LIGHTS &&
+              SUBSCAN_TEXELS_POINT_CENTROIDS < 16);
 }  // namespace subscan::gpu
 #endif
 

@@ -7,11 +7,17 @@
 
 namespace subscan {
 
+void bindFillRemovalInputs(FrameResources& resources) {
+    resources.buffer("pyramid").bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
+    resources.buffer("pointCentroids")
+        .bindTexels(SUBSCAN_TEXELS_POINT_CENTROIDS, TextureFormat::R32UI);
+}
+
 FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
     : stages_(sources, "render/FillRemoval.comp", {"REACH", "MASK", "SURFACE_DEPTH"}) {}
 
 std::vector<std::string_view> FillRemovalPass::inputs(const RenderSettings& settings) const {
-    std::vector<std::string_view> names{"pullWeights", "pyramid"};
+    std::vector<std::string_view> names{"pullWeights", "pyramid", "pointCentroids"};
     if (levelZero_ == LevelZero::Fused) {
         if (!followsNormalsToOutline(settings)) {
             return names;
@@ -39,7 +45,7 @@ std::vector<std::string_view> FillRemovalPass::outputs(const RenderSettings& set
 void FillRemovalPass::execute(FrameContext& frame) {
     FrameResources& resources = frame.resources;
     resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
-    resources.buffer("pyramid").bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
+    bindFillRemovalInputs(resources);
     Buffer& fillReach =
         resources.ensureBuffer("fillReach", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t));
     fillReach.bindStorage(SUBSCAN_SSBO_FILL_REACH);

@@ -9,7 +9,9 @@ namespace subscan {
 /// sub-pixel outline of SurfaceSettings::subpixelOutline): "mask" is 1 where points surround
 /// the pixel up to the level of the expected point gap (visible ones beside it, hidden ones too
 /// from level 1 on; looked up in the per-direction "fillReach" pyramid), and "surfaceDepth"
-/// holds the filled depth there (+inf elsewhere). With LevelZero::Fused only "fillReach" above
+/// holds the filled depth there (+inf elsewhere). A direction counts only where the texel's
+/// points lie in it as seen from the pixel (their mean, "pointCentroids"), so the fill stays
+/// within the points' convex hull. With LevelZero::Fused only "fillReach" above
 /// level 0, and "surfaceDepth" when the normals follow the surface to the outline
 /// (FinishSurface then reads it).
 class FillRemovalPass final : public RenderPass {
@@ -27,5 +29,9 @@ class FillRemovalPass final : public RenderPass {
     ComputeStages stages_;
     LevelZero levelZero_ = LevelZero::PerPass;
 };
+
+/// Binds what FillRemoval.glsl's gap test reads besides the pull weights and the reach: the
+/// min-depth pyramid and where its texels' points lie (MinDepthPyramidPass's).
+void bindFillRemovalInputs(FrameResources& resources);
 
 }  // namespace subscan

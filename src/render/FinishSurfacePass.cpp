@@ -6,6 +6,7 @@
 
 #include "core/Error.h"
 #include "render/ComputeStages.h"
+#include "render/FillRemovalPass.h"
 #include "render/PresentPass.h"
 #include "render/ShadePass.h"
 #include "render/TemporalPass.h"
@@ -35,7 +36,7 @@ std::vector<std::string_view> FinishSurfacePass::inputs(const RenderSettings& se
         names.push_back("surfaceDepth");  // the mask, FillRemovalPass's
         return names;
     }
-    names.push_back("fillReach");
+    names.insert(names.end(), {"fillReach", "pyramid", "pointCentroids"});
     if (placesOutlineBySubpixels(settings)) {
         names.push_back("occupancy");
     }
@@ -91,6 +92,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
         resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     } else {
         resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
+        bindFillRemovalInputs(resources);
         if (placesOutlineBySubpixels(frame.settings)) {
             resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
         }

@@ -23,6 +23,11 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
         frame.resources.ensureBuffer("pyramid", pyramidTexels(frame.pyramid) * sizeof(float));
     pyramid.bindStorage(SUBSCAN_SSBO_PYRAMID);
     pyramid.bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
+    // Read only where the pyramid holds a depth, and written wherever it does: no clear.
+    Buffer& centroids = frame.resources.ensureBuffer(
+        "pointCentroids", pyramidTexels(frame.pyramid) * sizeof(std::uint32_t));
+    centroids.bindStorage(SUBSCAN_SSBO_POINT_CENTROIDS);
+    centroids.bindTexels(SUBSCAN_TEXELS_POINT_CENTROIDS, TextureFormat::R32UI);
     frame.resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     // Levels 0 and 1 are copied only where the cloud's bounding box projects: elsewhere the
     // depth is +inf, as the fill leaves it.

@@ -6,8 +6,9 @@
 namespace subscan {
 
 /// The min-depth pyramid of the rasterized depth (paper Fig. 3), every level in the buffer
-/// "pyramid" (see PyramidLayout). Where surfaceBoundsAllowed(), it also measures the bounds of
-/// the rasterized points into FrameContext::pointBounds for the passes after it.
+/// "pyramid" (see PyramidLayout), and where each texel's points lie ("pointCentroids", for
+/// fill removal). Where surfaceBoundsAllowed(), it also measures the bounds of the rasterized
+/// points into FrameContext::pointBounds for the passes after it.
 class MinDepthPyramidPass final : public RenderPass {
   public:
     explicit MinDepthPyramidPass(const ShaderSources& sources);
@@ -15,7 +16,7 @@ class MinDepthPyramidPass final : public RenderPass {
     std::string_view name() const override { return "MinDepthPyramid"; }
     std::vector<std::string_view> inputs(const RenderSettings&) const override { return {"depth"}; }
     std::vector<std::string_view> outputs(const RenderSettings&) const override {
-        return {"pyramid"};
+        return {"pyramid", "pointCentroids"};
     }
     void execute(FrameContext& frame) override;
 

@@ -5,7 +5,7 @@
 // canopy point. With the local spacing the canopy's gaps fill. Since the fill counts texels of
 // hidden points as enclosing from pyramid level 1 on, and the sub-pixel outline's cells keep
 // the pixels of hidden points as surface (both FillRemoval.glsl), the global h leaves far
-// fewer holes, and none when that outline is on (the default).
+// fewer holes, and since the fill looks one level beyond the expected gap's, none.
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -105,12 +105,12 @@ TEST(LocalSpacingGLTest, ASparseCanopyOverDenseGroundLeavesNoHoles) {
         "background pixels under the canopy: %d of %d with h, %d with the local spacing, "
         "%d with h and the sub-pixel outline\n",
         withGlobal.background, withGlobal.pixels, withLocal.background, byCells.background);
-    // The global h leaves holes (measured 132 of 2309 pixels, where the hidden ground's
-    // texels do not reach; 1854 before they enclosed gaps); the local spacing fills all but
-    // single pixels where ground and canopy meet (measured 0 to 3), and so do the hidden ground
-    // points' cells (measured 0). The local spacing must leave at least 1 % fewer holes than
-    // the global h, so that this scene still shows what it does.
-    EXPECT_GT(withGlobal.background, withLocal.background + withGlobal.pixels / 100);
+    // Each leaves at most single pixels where ground and canopy meet (measured 2026-12-05: 0,
+    // 0 and 0). The global h left 132 holes until the fill looked one pyramid level beyond the
+    // expected gap's (FillRemoval.glsl's fillsGap), whose texels here hold the hidden ground's
+    // points; where the local spacing still counts is the station's far field
+    // (LidarEvaluationGLTest.LocalSpacingFillsTheStationsSparseFarField).
+    EXPECT_LT(withGlobal.background, withGlobal.pixels / 100);
     EXPECT_LT(withLocal.background, withLocal.pixels / 100);
     EXPECT_LT(byCells.background, byCells.pixels / 100);
 }
