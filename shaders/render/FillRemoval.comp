@@ -13,7 +13,8 @@
 //                is weighted (FillRemoval.glsl; 15: none). A texel takes its own
 //                neighbour's level or else its parent's answer, so the mask stage reads 9
 //                values per pixel instead of walking up to 8 x (L(x) + 1) texels: on
-//                close-ups, where L(x) is large, that walk dominated the frame.
+//                close-ups, where L(x) is large, that walk dominated the frame. On level 1
+//                also "fillSparse" (FillRemoval.glsl's sparseEnclosure).
 //   STAGE_MASK   writes "mask" (1 = surface) and "surfaceDepth" (the filled depth there, +inf
 //                elsewhere), unless FinishSurface.comp tests level 0 itself.
 //   STAGE_SURFACE_DEPTH  "surfaceDepth" alone, from the push's level 0 (which FinishSurface.comp
@@ -28,6 +29,11 @@ layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
 layout(std430, binding = SUBSCAN_SSBO_FILL_REACH) writeonly buffer FillReach {
     uint fillReach[];
 };
+#if STAGE_REACH
+layout(std430, binding = SUBSCAN_SSBO_FILL_SPARSE) writeonly buffer FillSparse {
+    uint fillSparse[];
+};
+#endif
 #if STAGE_MASK
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inFilledDepth;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outMask;
@@ -40,7 +46,11 @@ void main() {
 #if STAGE_REACH
     ivec2 texel = dispatchTexel();
     if (insideLevel(level, texel) && insideRegion(texel)) {
-        fillReach[texelIndex(level, texel)] = reachOf(level, texel);
+        uint reach = reachOf(level, texel);
+        fillReach[texelIndex(level, texel)] = reach;
+        if (level == 1u) {
+            fillSparse[texel.y * int(levelSize(1u).x) + texel.x] = sparseEnclosure(texel, reach);
+        }
     }
 #else
     ivec2 pixel = dispatchTexel();
@@ -52,7 +62,7 @@ void main() {
 #else
     float depth = pushedValue(0u, pixel).x;
 #endif
-    bool surfacePixel = onSurface(pixel, depth, spacingRatioAt(pixel));
+    bool surfacePixel = onSurface(pixel, depth);
 #if STAGE_MASK
     imageStore(outMask, pixel, vec4(surfacePixel ? 1.0 : 0.0));
 #endif

@@ -6,6 +6,7 @@
 layout(binding = SUBSCAN_TEXELS_FILL_REACH) uniform usamplerBuffer fillReachTexels;
 layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 layout(binding = SUBSCAN_TEXELS_POINT_CENTROIDS) uniform usamplerBuffer pointCentroidTexels;
+layout(binding = SUBSCAN_TEXELS_FILL_SPARSE) uniform usamplerBuffer fillSparseTexels;
 
 const uint kNoReach = 15u;
 
@@ -68,44 +69,44 @@ vec2 meanPointPosition(uint onLevel, ivec2 texel, uint index) {
 /// finds no points in that direction; any narrower cone would turn away more true gaps.
 const float kEnclosingConeCos = 0.38268343;
 
-/// Whether the points of the texel beside `pixel`'s own on `onLevel`, in direction k (a
-/// weighted texel), lie in that direction as seen from the pixel's centre: within the cone
-/// above around it, judged by their mean position (MinDepthPyramid.comp). A coarse texel
-/// beside the pixel's reaches up to 90 degrees to either side of the direction, so without
-/// this a pixel beyond a sparse cloud's outline found points "around" it in texels that
-/// hold them only on the cloud's side, and the fill ran past the outline in the coarse
-/// texels' blocks. On level 0 the neighbour lies exactly in the direction. Beyond the image
-/// the surface goes on, but counts only where the border lies within `borderReach` pixels:
-/// a coarse level's texel beside the border reaches far into the picture (once the fill
-/// looked a level beyond the gap's, the corners between a sphere's silhouette and the border
-/// filled).
-bool enclosesTowards(ivec2 pixel, int k, uint onLevel, float borderReach) {
-    ivec2 texel = (pixel >> onLevel) + kDirections[k];
-    if (onLevel == 0u) {
-        return true;
-    }
-    vec2 centre = vec2(pixel) + 0.5;
+/// Whether the points of the texel beside `own` on `onLevel` (>= 2, laid out as `place`), in
+/// direction k, lie in that direction as seen from `centre` (window coordinates, inside
+/// `own`): within the cone above around it, judged by their mean position
+/// (MinDepthPyramid.comp). A coarse texel beside the viewpoint's reaches up to 90 degrees to
+/// either side of the direction, so without this a pixel beyond a sparse cloud's outline
+/// found points "around" it in texels that hold them only on the cloud's side, and the fill
+/// ran past the outline in the coarse texels' blocks. Beyond the image the surface goes on,
+/// but counts only where the border lies within `borderReach` pixels: a coarse level's texel
+/// beside the border reaches far into the picture (once the fill looked a level beyond the
+/// gap's, the corners between a sphere's silhouette and the border filled).
+bool enclosesTowards(vec2 centre, ivec2 own, int k, uint onLevel, LevelLayout place,
+                     float borderReach) {
+    ivec2 texel = own + kDirections[k];
     vec2 direction = vec2(kDirections[k]);
-    if (!insideLevel(onLevel, texel)) {
+    if (!insideLevel(place, texel)) {
         // How far along the direction the image ends.
-        vec2 size = vec2(levelSize(0u));
+        vec2 size = vec2(pyramid.levels[0].yz);
         vec2 toBorder = mix(centre, size - centre, greaterThan(direction, vec2(0.0)));
         float distance = min(direction.x != 0.0 ? toBorder.x : kInfinity,
                              direction.y != 0.0 ? toBorder.y : kInfinity);
         return distance * length(direction) <= borderReach;
     }
-    vec2 offset = meanPointPosition(onLevel, texel, texelIndex(onLevel, texel)) - centre;
+    uint index = texelIndex(place, texel);
+    // A texel of the walk above the finest weighted one may hold no points.
+    if (isinf(texelFetch(minDepthTexels, int(index)).r)) {
+        return false;
+    }
+    vec2 offset = meanPointPosition(onLevel, texel, index) - centre;
     return dot(offset, direction) > kEnclosingConeCos * length(offset) * length(direction);
 }
 
-/// Whether the 3x3 texels of `onLevel` around `pixel`'s hold a point within `radius` pixels of
-/// its centre, judged by each texel's mean point position.
-bool pointWithinOn(uint onLevel, ivec2 pixel, float radius) {
-    LevelLayout place = levelLayout(onLevel);
-    ivec2 centre = pixel >> onLevel;
+/// Whether the 3x3 texels of `onLevel` (>= 1, laid out as `place`) around the one holding
+/// `centre` hold a point within `radius` pixels of it, judged by each texel's mean position.
+bool pointWithinOn(uint onLevel, LevelLayout place, vec2 centre, float radius) {
+    ivec2 middle = ivec2(centre) >> onLevel;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
-            ivec2 texel = centre + ivec2(dx, dy);
+            ivec2 texel = middle + ivec2(dx, dy);
             if (!insideLevel(place, texel)) {
                 continue;
             }
@@ -113,9 +114,7 @@ bool pointWithinOn(uint onLevel, ivec2 pixel, float radius) {
             if (isinf(texelFetch(minDepthTexels, int(index)).r)) {
                 continue;
             }
-            vec2 position =
-                onLevel == 0u ? vec2(texel) + 0.5 : meanPointPosition(onLevel, texel, index);
-            vec2 offset = position - (vec2(pixel) + 0.5);
+            vec2 offset = meanPointPosition(onLevel, texel, index) - centre;
             if (dot(offset, offset) <= radius * radius) {
                 return true;
             }
@@ -124,15 +123,18 @@ bool pointWithinOn(uint onLevel, ivec2 pixel, float radius) {
     return false;
 }
 
-/// Whether a point lies within `radius` (>= 1) pixels of `pixel`'s centre. The texels of the
-/// level that spans the radius reach it from anywhere in the pixel's own texel, but their mean
+/// Whether a point lies within `radius` (>= 1) pixels of `centre`. The texels of the level
+/// that spans the radius reach it from anywhere in the centre's own texel, but their mean
 /// positions lie up to a radius apart along a row of points, which leaves scallops between
 /// them; the level below, twice as dense, fills those in where it reaches. A mean lies no
-/// nearer than the nearest of its points, so the test errs towards "no".
-bool pointWithin(ivec2 pixel, float radius) {
-    uint coarse = min(uint(ceil(log2(radius))), levelCount() - 1u);
-    return (coarse > 0u && pointWithinOn(coarse - 1u, pixel, radius)) ||
-           pointWithinOn(coarse, pixel, radius);
+/// nearer than the nearest of its points, so the test errs towards "no". Levels from 1 on:
+/// the radius is measured from a level-1 texel's centre, half a pixel from its pixels'.
+bool pointWithin(vec2 centre, float radius) {
+    uint coarse = clamp(uint(ceil(log2(radius))), 1u, levelCount() - 1u);
+    uint fine = max(coarse - 1u, 1u);
+    LevelLayout finePlace = levelLayout(fine);
+    return pointWithinOn(fine, finePlace, centre, radius) ||
+           (coarse > fine && pointWithinOn(coarse, nextLevel(finePlace), centre, radius));
 }
 
 /// Beyond its outermost points a sparse surface is kept for this share of the expected gap,
@@ -150,73 +152,85 @@ bool pointWithin(ivec2 pixel, float radius) {
 /// share alone, unscaled, fattened the bunny's vertices at 512x512 from leakage 0.005 to 0.037).
 const float kBeyondOutermostPoints = 0.75;
 
-/// Whether the pixel `pixel` without a visible point of its own, at depth `depth`, lies in a
-/// gap the fill closes: enough directions find points within the expected gap, in their
-/// direction (enclosesTowards: the fill stays within the points' convex hull); or a sparse
-/// surface's outermost points lie within kBeyondOutermostPoints of that gap.
-bool fillsGap(ivec2 pixel, float depth, float spacingRatio) {
+/// What the level-1 texel `texel` (whose reach is `reach`) adds to its pixels' gap test
+/// (fillsGap), judged from its centre at its own complete depth and spacing ratio: bit k for
+/// direction k, whose points on some level from 2 up to one beyond the expected gap's lie in
+/// its cone (enclosesTowards: the fill stays within the points' convex hull); bit 8 where a
+/// point lies within kBeyondOutermostPoints of the gap. Once per level-1 texel instead of per
+/// pixel: on llvmpipe, where every lane of a group runs a loop any of them enters, the walk
+/// over levels and the 18 texels near a point per pixel took FillRemoval from 19.7 to 45.8
+/// ms at 1920x1080 (the Happy Buddha). Its pixels lie within 0.71 pixels of the centre.
+uint sparseEnclosure(ivec2 texel, uint reach) {
+    uint index = texelIndex(1u, texel);
+    float depth = pushValueAt(index).x;
+    if (!(depth > 0.0 && !isinf(depth))) {
+        return 0u;
+    }
+    // A pixel in a gap takes the ratio of the finest texel above it that holds visible
+    // points (spacingRatioAt), which is the level-1 texel's (spacingRatioFrom level 1).
+    float spacingRatio = spacingRatioFrom(1u, texel);
     float gapLevel = levelForRadius(surface.fill.x * spacingRatio, depth);
-    // Level 1 at least: its texels bridge one-pixel gaps between dense points. One level more
-    // than the gap's: a texel on the gap's level beside the pixel's own holds a point of the
+    // One level more than the gap's (at least 1: its texels bridge one-pixel gaps between
+    // dense points): a texel on the gap's level beside the pixel's own holds a point of the
     // next row only where the rows fall that way, which the pull weight's spread used to
     // paper over (without it coverage fell to 0.97 on the bunny's vertices at 512x512, 0.95
     // near the station); the cone keeps the coarser level from reaching past the outline.
-    uint levels = uint(ceil(clamp(gapLevel, 1.0, float(levelCount() - 1u)))) + 1u;
     // kNoReach never counts: it could only mean the top level, whose one texel has no
     // neighbours.
-    levels = min(levels, min(kNoReach - 1u, levelCount() - 1u));
+    uint levels = min(uint(ceil(clamp(gapLevel, 1.0, float(levelCount() - 1u)))) + 1u,
+                      min(kNoReach - 1u, levelCount() - 1u));
     // Twice the gap: the points that enclose a pixel lie up to about that far (the level
     // beyond the gap's), and a pixel 1.5 pixels from the border between points 2.2 pixels
     // apart must still count it (SurfaceCloseUpGLTest).
     float borderReach = 2.0 * exp2(gapLevel);
-    uint reach = reachOf(0u, pixel);
-    // Directions with points on some level within reach, and of those the ones found on level
-    // 0, which lie exactly in their direction: the cones are looked at only where these leave
-    // the answer open (on llvmpipe the walk below doubled FillRemoval's time when every pixel
-    // took it).
-    int reachable = 0;
-    int besides = 0;
-    uint nearestLevel = kNoReach;
+    vec2 centre = (vec2(texel) + 0.5) * 2.0;
+    uint enclosure = 0u;
     for (int k = 0; k < 8; ++k) {
+        // From the finest weighted level on (levels 0 and 1 the pixels count themselves):
+        // the finest texel's points may lie beside the direction where a coarser texel's do
+        // not.
         uint finest = (reach >> (4 * k)) & 0xFu;
-        reachable += finest <= levels ? 1 : 0;
-        besides += finest == 0u ? 1 : 0;
-        nearestLevel = min(nearestLevel, finest);
-    }
-    if (float(besides) >= surface.fill.y) {
-        return true;
-    }
-    if (float(reachable) >= surface.fill.y) {
-        int enclosed = 0;
-        for (int k = 0; k < 8; ++k) {
-            // The finest weighted level first (the reach), then coarser ones: the finest
-            // texel's points may lie beside the direction where a coarser texel's do not.
-            uint finest = (reach >> (4 * k)) & 0xFu;
-            bool found = false;
-            for (uint l = finest; l <= levels && !found; ++l) {
-                found = (l == finest || weighted(l, (pixel >> l) + kDirections[k])) &&
-                        enclosesTowards(pixel, k, l, borderReach);
-            }
-            enclosed += found ? 1 : 0;
+        if (finest < 2u || finest > levels) {
+            continue;
         }
-        if (float(enclosed) >= surface.fill.y) {
-            return true;
+        LevelLayout place = levelLayout(finest);
+        for (uint l = finest; l <= levels; ++l, place = nextLevel(place)) {
+            if (enclosesTowards(centre, texel >> (l - 1u), k, l, place, borderReach)) {
+                enclosure |= 1u << k;
+                break;
+            }
         }
     }
     // Under a pixel the sub-pixel outline rule places the outline.
-    float beyond = kBeyondOutermostPoints * (1.0 - 1.0 / max(spacingRatio, 1.0)) * exp2(gapLevel);
-    if (beyond < 1.0) {
+    float beyond = kBeyondOutermostPoints * (1.0 - 1.0 / spacingRatio) * exp2(gapLevel);
+    if (beyond >= 1.0 && pointWithin(centre, beyond)) {
+        enclosure |= 1u << 8;
+    }
+    return enclosure;
+}
+
+/// Whether the pixel `pixel` without a visible point of its own lies in a gap the fill closes:
+/// enough directions find points within the expected gap, on levels 0 and 1 beside it
+/// (a level-0 neighbour lies exactly in its direction, a level-1 texel within 3 pixels, so
+/// it oversteps an outline by a pixel at most) or further on in their cones (its level-1
+/// texel's sparseEnclosure); or a sparse surface's outermost points lie near enough.
+bool fillsGap(ivec2 pixel) {
+    uint reach = reachOf(0u, pixel);
+    uint found = 0u;  // bit k: direction k enclosed
+    for (int k = 0; k < 8; ++k) {
+        found |= ((reach >> (4 * k)) & 0xFu) <= 1u ? 1u << k : 0u;
+    }
+    if (float(bitCount(found)) >= surface.fill.y) {
+        return true;
+    }
+    if (levelCount() < 2u) {
         return false;
     }
-    // No point in the 3x3 texels around the pixel's on the radius's level, nor in that texel
-    // itself, leaves none within the radius (pointWithin looks no further): the background
-    // away from the cloud, most of the pixels that get here, skips the 18 texels.
-    uint radiusLevel = uint(ceil(log2(beyond)));
-    if (radiusLevel >= 1u && radiusLevel < levelCount() && nearestLevel > radiusLevel &&
-        isinf(texelFetch(minDepthTexels, int(texelIndex(radiusLevel, pixel >> radiusLevel))).r)) {
-        return false;
-    }
-    return pointWithin(pixel, beyond);
+    ivec2 texel = pixel >> 1;
+    uint enclosure =
+        texelFetch(fillSparseTexels, texel.y * int(pyramid.levels[1].y) + texel.x).r;
+    return float(bitCount(found | (enclosure & 0xFFu))) >= surface.fill.y ||
+           (enclosure & (1u << 8)) != 0u;
 }
 
 /// How many of the 4x4 sub-cells of `pixel` hold a point (hidden ones too).
@@ -234,7 +248,7 @@ uint occupiedCells(ivec2 pixel) {
 /// or less is half of the count, noise rather than area. Sparse clouds show the area less
 /// exactly (a cell holds one point or several alike), yet the rule still moves their outlines
 /// closer to the truth (docs/eval.md, "Measured quality").
-bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
+bool centreBeyondOutline(ivec2 pixel) {
     // The 4-neighbours without points first: off the outline (nearly every pixel) none is, and
     // the counts and the fill's reach below are skipped (llvmpipe skips a loop only where
     // none of its lanes enters it). Off the image's border the surface goes on.
@@ -259,10 +273,9 @@ bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
     if (densest < 3u || float(own) > 0.625 * float(densest)) {
         return false;
     }
-    // The neighbour's gap is judged at this pixel's depth.
     for (int k = 0; k < 8; k += 2) {
         if ((emptyBeside & (1u << (k / 2))) != 0u &&
-            !fillsGap(pixel + kDirections[k], depth, spacingRatio)) {
+            !fillsGap(pixel + kDirections[k])) {
             return true;
         }
     }
@@ -270,8 +283,7 @@ bool centreBeyondOutline(ivec2 pixel, float depth, float spacingRatio) {
 }
 
 /// Whether `pixel`, filled to `depth` by pull-push, belongs to the surface (the "mask").
-/// `spacingRatio`: spacingRatioAt(pixel), which scales the expected gap.
-bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
+bool onSurface(ivec2 pixel, float depth) {
     if (!(depth > 0.0 && !isinf(depth) && !isnan(depth))) {
         return false;
     }
@@ -282,7 +294,7 @@ bool onSurface(ivec2 pixel, float depth, float spacingRatio) {
     bool holdsPoints = pullWeightAt(texelIndex(0u, pixel)) > 0.0 ||
                        (surface.fill.w != 0.0 && occupiedCells(pixel) > 0u);
     if (holdsPoints) {
-        return surface.fill.w == 0.0 || !centreBeyondOutline(pixel, depth, spacingRatio);
+        return surface.fill.w == 0.0 || !centreBeyondOutline(pixel);
     }
-    return fillsGap(pixel, depth, spacingRatio);
+    return fillsGap(pixel);
 }

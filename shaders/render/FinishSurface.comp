@@ -54,7 +54,7 @@ void main() {
 #if FINISH_SEES_OUTLINE
     bool surfacePixel = !isinf(imageLoad(inSurfaceDepth, pixel).r);
 #else
-    bool surfacePixel = onSurface(pixel, filled.x, spacingRatio);
+    bool surfacePixel = onSurface(pixel, filled.x);
 #endif
     if (surfacePixel) {
         vec3 diffuse;

@@ -19,18 +19,19 @@ float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index))
 /// dense ones (measured on tests/gl/LocalSpacingGLTest.cpp's canopy: 115 pixels of background
 /// left from the finest texel alone, 3 to 7 with its parent). Never below 1: where overlapping
 /// strips or scans interleave, points lie closer than h but leave gaps of h between them
-/// (autzen's meadow showed holes).
-float spacingRatioAt(ivec2 pixel) {
+/// (autzen's meadow showed holes). spacingRatioFrom looks from `texel` on level `first` up.
+float spacingRatioFrom(uint first, ivec2 texel) {
     if (surface.spacing.x < 0.5) {
         return 1.0;
     }
-    for (uint level = 0u; level < levelCount(); ++level) {
-        vec2 pulled = texelFetch(pullWeightTexels, int(texelIndex(level, pixel >> level))).rg;
+    for (uint level = first; level < levelCount(); ++level) {
+        ivec2 above = texel >> (level - first);
+        vec2 pulled = texelFetch(pullWeightTexels, int(texelIndex(level, above))).rg;
         if (pulled.x > 0.0) {
             float ratio = pulled.y / pulled.x;
             if (level > 0u && level + 1u < levelCount()) {
-                vec2 parent = texelFetch(pullWeightTexels,
-                                         int(texelIndex(level + 1u, pixel >> (level + 1u)))).rg;
+                vec2 parent =
+                    texelFetch(pullWeightTexels, int(texelIndex(level + 1u, above >> 1))).rg;
                 ratio = max(ratio, parent.y / parent.x);
             }
             return max(ratio, 1.0);
@@ -38,6 +39,7 @@ float spacingRatioAt(ivec2 pixel) {
     }
     return 1.0;
 }
+float spacingRatioAt(ivec2 pixel) { return spacingRatioFrom(0u, pixel); }
 vec4 pushValueAt(uint index) { return texelFetch(pushValueTexels, int(index)); }
 
 /// The complete (depth, r, g, b) of `texel` on `level` from the complete level above: m is the

@@ -46,6 +46,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_OCCUPANCY 14     // uint per pixel: which of its 4x4 sub-cells hold points
 #define SUBSCAN_SSBO_POINT_CENTROIDS 15  // uint per texel, levels >= 1: where in the texel its
                                          // points lie on average (unorm16x2 of the texel)
+#define SUBSCAN_SSBO_FILL_SPARSE 16  // uint per level-1 texel: what it adds to its pixels' gap
+                                     // test (FillRemoval.glsl's sparseEnclosure)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
@@ -60,6 +62,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_TEXELS_LOCAL_SPACING 9  // rgba16f per point, one chunk (estimateLocalSpacing)
 #define SUBSCAN_TEXELS_POINT_CENTROIDS 14  // r32ui view of SUBSCAN_SSBO_POINT_CENTROIDS (after
                                            // the light maps: 16 units are all GL promises)
+#define SUBSCAN_TEXELS_FILL_SPARSE 15      // r32ui view of SUBSCAN_SSBO_FILL_SPARSE
 
 // ---- textures read with texelFetch ----
 // sampler2D per directional light (units 10 .. 10 + SUBSCAN_MAX_LIGHTS - 1): its light map
@@ -204,7 +207,8 @@ static_assert(sizeof(FrameParams) == 2 * 64 + 4 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);
 static_assert(SUBSCAN_TEXELS_POINT_CENTROIDS >= SUBSCAN_TEXTURES_LIGHT_MAPS + SUBSCAN_MAX_LIGHTS &&
-              SUBSCAN_TEXELS_POINT_CENTROIDS < 16);
+              SUBSCAN_TEXELS_FILL_SPARSE > SUBSCAN_TEXELS_POINT_CENTROIDS &&
+              SUBSCAN_TEXELS_FILL_SPARSE < 16);
 }  // namespace subscan::gpu
 #endif
 

@@ -11,8 +11,9 @@ namespace subscan {
 /// from level 1 on; looked up in the per-direction "fillReach" pyramid), and "surfaceDepth"
 /// holds the filled depth there (+inf elsewhere). A direction counts only where the texel's
 /// points lie in it as seen from the pixel (their mean, "pointCentroids"), so the fill stays
-/// within the points' convex hull. With LevelZero::Fused only "fillReach" above
-/// level 0, and "surfaceDepth" when the normals follow the surface to the outline
+/// within the points' convex hull; that walk, and the reach beyond a sparse surface's
+/// outermost points, run per level-1 texel ("fillSparse"). With LevelZero::Fused only "fillReach"
+/// above level 0, and "surfaceDepth" when the normals follow the surface to the outline
 /// (FinishSurface then reads it).
 class FillRemovalPass final : public RenderPass {
   public:
@@ -29,9 +30,5 @@ class FillRemovalPass final : public RenderPass {
     ComputeStages stages_;
     LevelZero levelZero_ = LevelZero::PerPass;
 };
-
-/// Binds what FillRemoval.glsl's gap test reads besides the pull weights and the reach: the
-/// min-depth pyramid and where its texels' points lie (MinDepthPyramidPass's).
-void bindFillRemovalInputs(FrameResources& resources);
 
 }  // namespace subscan

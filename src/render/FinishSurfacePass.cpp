@@ -6,7 +6,6 @@
 
 #include "core/Error.h"
 #include "render/ComputeStages.h"
-#include "render/FillRemovalPass.h"
 #include "render/PresentPass.h"
 #include "render/ShadePass.h"
 #include "render/TemporalPass.h"
@@ -36,7 +35,7 @@ std::vector<std::string_view> FinishSurfacePass::inputs(const RenderSettings& se
         names.push_back("surfaceDepth");  // the mask, FillRemovalPass's
         return names;
     }
-    names.insert(names.end(), {"fillReach", "pyramid", "pointCentroids"});
+    names.insert(names.end(), {"fillReach", "fillSparse"});
     if (placesOutlineBySubpixels(settings)) {
         names.push_back("occupancy");
     }
@@ -92,7 +91,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
         resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     } else {
         resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
-        bindFillRemovalInputs(resources);
+        resources.buffer("fillSparse").bindTexels(SUBSCAN_TEXELS_FILL_SPARSE, TextureFormat::R32UI);
         if (placesOutlineBySubpixels(frame.settings)) {
             resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
         }
