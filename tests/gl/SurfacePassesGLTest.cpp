@@ -939,6 +939,53 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
 // The outline's sub-pixel cells pass from the raster to the mask in the "occupancy" buffer:
 // declared where a frame's settings use it, so that PassRunner refuses a frame that would read
 // an earlier frame's cells.
+TEST(SurfacePassesGLTest, NothingBeyondTheHullOfSparsePointsIsFilled) {
+    // Points 4 pixels apart within a disc in the middle of a 96x96 picture, at a depth where
+    // the expected gap is about 8 pixels (the gap test reaches up to level 4), as dense as h
+    // (ratio 1: no reach beyond the outermost points). The gap test's cones leave a direction
+    // wholly beyond any straight line, so no pixel more than a pixel outside the points'
+    // convex hull may be surface; without them (a coarse texel beside a pixel reaches 90
+    // degrees to either side of its direction) or with wider ones, the texels beside a pixel
+    // outside the disc found its points around the curve (measured: 2 such pixels at radius 21).
+    constexpr int kSize = 96;
+    RenderSettings settings = makeHarness().settings();
+    for (const double radius : {13.0, 21.0, 30.0}) {
+        PassHarness harness(kSize, kSize, settings, kSpacing, 50.0, false);
+        std::vector<float> depth(kSize * kSize, std::numeric_limits<float>::infinity());
+        std::vector<float> color(4 * kSize * kSize, 1.0f);
+        const glm::dvec2 centre(48.3, 47.6);
+        double outermost = 0.0;  // the largest distance of a point from the centre
+        for (int y = 0; y < kSize; ++y) {
+            for (int x = 0; x < kSize; ++x) {
+                const double distance = glm::length(glm::dvec2(x + 0.5, y + 0.5) - centre);
+                if (x % 4 == 2 && y % 4 == 2 && distance < radius) {
+                    depth[y * kSize + x] = 5.0f;
+                    outermost = std::max(outermost, distance);
+                }
+            }
+        }
+        FrameResources& resources = harness.resources();
+        resources.ensureTexture("depth", TextureFormat::R32F, kSize, kSize).uploadFloats(depth);
+        resources.ensureTexture("color", TextureFormat::RGBA16F, kSize, kSize).uploadFloats(color);
+        FrameContext frame = runPullPushPasses(harness);
+        FillRemovalPass(harness.sources()).execute(frame);
+        const std::vector<float> mask = resources.texture("mask").readFloats();
+        int beyond = 0, filledGaps = 0;
+        for (int y = 0; y < kSize; ++y) {
+            for (int x = 0; x < kSize; ++x) {
+                const double distance = glm::length(glm::dvec2(x + 0.5, y + 0.5) - centre);
+                const bool surface = mask[y * kSize + x] > 0.5f;
+                // The hull lies within the disc through the outermost points.
+                beyond += surface && distance > outermost + 1.0 ? 1 : 0;
+                filledGaps += surface && std::isinf(depth[y * kSize + x]) ? 1 : 0;
+            }
+        }
+        std::printf("radius %.0f: %d pixels beyond, %d gaps filled\n", radius, beyond, filledGaps);
+        EXPECT_EQ(beyond, 0) << "radius " << radius;
+        EXPECT_GT(filledGaps, 200) << "radius " << radius;  // the gaps between them do fill
+    }
+}
+
 TEST(SurfacePassesGLTest, TheOutlinesCellsAreDeclaredWhereTheyAreUsed) {
     PassHarness harness = makeHarness();
     const RasterizePointsPass raster(harness.sources(), test::glTestContext().capabilities());
