@@ -66,17 +66,19 @@ TEST_P(IndexDataTest, EveryPointOnceWithEveryAttribute) {
     expectIndexGivesBackEveryRecord(*data / GetParam());
 }
 
+/// A test's name from its file's: letters and digits, '_' for the rest.
+std::string fileTestName(const testing::TestParamInfo<std::string>& param) {
+    std::string name = param.param;
+    std::replace_if(
+        name.begin(), name.end(), [](char c) { return !std::isalnum(c); }, '_');
+    return name;
+}
+
 INSTANTIATE_TEST_SUITE_P(SharedScans, IndexDataTest,
                          testing::Values("autzen_trim.las", "autzen_trim.laz", "lone_star.laz",
                                          "lone_star.copc.laz", "autzen_trim_las14_pf7.las",
                                          "bun_zipper.ply", "bunnyDouble.e57"),
-                         [](const testing::TestParamInfo<std::string>& param) {
-                             std::string name = param.param;
-                             std::replace_if(
-                                 name.begin(), name.end(), [](char c) { return !std::isalnum(c); },
-                                 '_');
-                             return name;
-                         });
+                         fileTestName);
 
 /// The records of any scan as the sources read them, with the quantization they are on.
 struct ReadBack {
@@ -124,13 +126,7 @@ INSTANTIATE_TEST_SUITE_P(SharedScans, LasFamilyConvertDataTest,
                          testing::Values("autzen_trim.las", "autzen_trim.laz", "simple.las",
                                          "autzen_trim_las14_pf7.las", "lone_star.laz",
                                          "lone_star.copc.laz"),
-                         [](const testing::TestParamInfo<std::string>& param) {
-                             std::string name = param.param;
-                             std::replace_if(
-                                 name.begin(), name.end(), [](char c) { return !std::isalnum(c); },
-                                 '_');
-                             return name;
-                         });
+                         fileTestName);
 
 TEST(IndexDataTest, TheSourcesWarningsReachTheUser) {
     const std::optional<std::filesystem::path> data = test::testDataDirectory();
