@@ -49,7 +49,7 @@ void main() {
         uint reach = reachOf(level, texel);
         fillReach[texelIndex(level, texel)] = reach;
         if (level == 1u) {
-            fillSparse[texel.y * int(levelSize(1u).x) + texel.x] = sparseEnclosure(texel, reach);
+            fillSparse[fillSparseIndex(texel)] = sparseEnclosure(texel, reach);
         }
     }
 #else

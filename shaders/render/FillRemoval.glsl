@@ -209,6 +209,9 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
     return enclosure;
 }
 
+/// Where the level-1 texel `texel`'s word lies in "fillSparse", which holds level 1 alone.
+uint fillSparseIndex(ivec2 texel) { return texelIndex(1u, texel) - levelLayout(1u).first; }
+
 /// Whether the pixel `pixel` without a visible point of its own lies in a gap the fill closes:
 /// enough directions find points within the expected gap, on levels 0 and 1 beside it
 /// (a level-0 neighbour lies exactly in its direction, a level-1 texel within 3 pixels, so
@@ -226,9 +229,7 @@ bool fillsGap(ivec2 pixel) {
     if (levelCount() < 2u) {
         return false;
     }
-    ivec2 texel = pixel >> 1;
-    uint enclosure =
-        texelFetch(fillSparseTexels, texel.y * int(pyramid.levels[1].y) + texel.x).r;
+    uint enclosure = texelFetch(fillSparseTexels, int(fillSparseIndex(pixel >> 1))).r;
     return float(bitCount(found | (enclosure & 0xFFu))) >= surface.fill.y ||
            (enclosure & (1u << 8)) != 0u;
 }
