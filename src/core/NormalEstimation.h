@@ -1,0 +1,38 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/PointCloud.h"
+
+namespace subscan {
+
+/// The neighbourhood sizes (the point included) a normal is fitted to. Small ones follow a
+/// scanner's noise and overlapping scans' offsets, large ones round off curved and thin parts:
+/// each point takes the size its neighbours lie flattest in (the smallest surface variation of
+/// Pauly et al. 2002), which is a large one on a noisy flat part and a small one on a curved
+/// clean part. Measured through `eval` at 1024² (bench/README.md, "Normals that belong to the
+/// points"): a fixed 16 gave 3.7 degrees mean on the bunny's vertices and 5.5 on its range
+/// scans, these sizes 3.4 and 3.5.
+inline constexpr std::array<std::size_t, 6> kNormalNeighbourhoods = {12, 16, 24, 32, 48, 64};
+
+/// Per point, the unit normal of the plane through its nearest points in the least-squares
+/// sense: the eigenvector of their covariance with the smallest eigenvalue (principal component
+/// analysis, Hoppe et al. 1992), over the neighbourhood of kNormalNeighbourhoods they lie
+/// flattest in. Where the neighbours determine no plane (fewer than 3 distinct points, or all
+/// on one line) the normal is 0.
+/// Oriented towards `sensor` (cloud coordinates, i.e. relative to `cloud.origin`) where one is
+/// known; else its sign is arbitrary and the renderer faces it to the eye. Runs on every core.
+std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
+                                       const std::optional<glm::vec3>& sensor = std::nullopt);
+
+/// The normals the renderer draws the cloud with: the file's where it has them, else
+/// estimateNormals() towards `sensor` (file coordinates) where one is known.
+std::vector<glm::vec3> pointNormals(const PointCloud& cloud,
+                                    const std::optional<glm::dvec3>& sensor = std::nullopt);
+
+}  // namespace subscan
