@@ -11,7 +11,6 @@
 #define NORMALS_SEE_OUTLINE 0
 #endif
 
-layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
 #if NORMALS_SEE_OUTLINE
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inSurfaceDepth;
 #endif
@@ -95,11 +94,15 @@ vec3 unitOrFacing(vec3 normal) {
     return length2 > 0.0 ? normal * inversesqrt(length2) : vec3(0.0, 0.0, 1.0);
 }
 
-/// The view-space normal of surface pixel `texel` at `depth`: the normals of the two pyramid
+/// The view-space normal of surface pixel `texel` at `depth`. With the points' own normals: the
+/// push of their pull-push to level 0. Else the paper's: the normals of the two pyramid
 /// levels around its smoothing level, blended, and near the outline followed towards it
 /// (followProfileToOutline) when the settings ask. `spacingRatio`: spacingRatioAt(texel), which
 /// scales the smoothing radius.
 vec3 blendedNormal(ivec2 texel, float depth, float spacingRatio) {
+    if (surface.normals.z > 0.5) {
+        return unitOrFacing(pushedNormal(0u, texel));  // the points' own (PullPush.glsl)
+    }
     // Level 1 at least: where points are denser than pixels, neighbouring pixels are closer
     // than the scanner's noise allows a slope to be measured over.
     float smoothing = clamp(levelForRadius(surface.normals.x * spacingRatio, depth), 1.0,

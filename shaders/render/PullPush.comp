@@ -7,6 +7,9 @@
 //                    h = {1/3, 1, 1, 1/3} per axis; w = min(1, W), a = A * w / W. Beyond
 //                    Kraus: only children on the front-most surface take part (see below).
 //   STAGE_PUSH_TOP   the coarsest level: complete value a / w
+// With the points' own normals (SurfaceParams.normals.z) every stage does the same for them in
+// the normal pyramid, with their own weight (PullPush.glsl's pushedNormal), except that the
+// push stops at level 1: the normals' level 0 is pushed where it is read (Normals.glsl).
 //   STAGE_PUSH       level R from R+1: m = bilinear of the complete coarser level with the
 //                    kernel {1/4, 3/4, 3/4, 1/4}; complete = a + (1 - w) * m. Level 0 goes to
 //                    the "filledDepth" and "filledColor" images instead of the buffer
@@ -26,10 +29,15 @@ layout(std430, binding = SUBSCAN_SSBO_PULL_WEIGHTS) writeonly buffer PullWeights
 layout(std430, binding = SUBSCAN_SSBO_PUSH_VALUES) writeonly buffer PushValues {
     vec4 pushValue[];
 };
+layout(std430, binding = SUBSCAN_SSBO_NORMALS) writeonly buffer NormalPyramid {
+    vec4 normalPyramid[];  // pulled: w_n * normal, w_n; pushed: complete normal sum, 1
+};
+bool carriesNormals() { return surface.normals.z > 0.5; }
 #if STAGE_PULL_INIT
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
 layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inColor;
 layout(binding = SUBSCAN_IMAGE_IN2, r8) readonly uniform image2D inVisibility;
+layout(binding = SUBSCAN_IMAGE_IN3, rgba16f) readonly uniform image2D inPointNormal;
 #endif
 #if STAGE_PUSH
 layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
@@ -50,6 +58,10 @@ void main() {
     vec4 color = imageLoad(inColor, texel);
     pullWeight[index] = visible ? vec2(1.0, color.a) : vec2(0.0);
     pullValue[index] = visible ? vec4(imageLoad(inDepth, texel).r, color.rgb) : vec4(0.0);
+    if (carriesNormals()) {
+        vec3 normal = visible ? imageLoad(inPointNormal, texel).xyz : vec3(0.0);
+        normalPyramid[index] = vec4(normal, dot(normal, normal) > 0.0 ? 1.0 : 0.0);
+    }
 #elif STAGE_PULL
     // Only the front-most surface among the children: a child deeper than the nearest one by
     // more than `slope` texel widths (at that depth) belongs to a surface behind and is left out.
@@ -80,21 +92,36 @@ void main() {
     float weightSum = 0.0;
     float spacingSum = 0.0;
     vec4 valueSum = vec4(0.0);
+    vec4 normalSum = vec4(0.0);
+    bool normals = carriesNormals();
     for (int c = 0; c < 16; ++c) {
         if (weights[c] > 0.0 && depths[c] <= front + tolerance) {
             float h = kPullKernel[c % 4] * kPullKernel[c / 4];
             weightSum += h * weights[c];
             spacingSum += h * spacings[c];
             valueSum += h * values[c];
+            if (normals) {
+                ivec2 child = 2 * texel + ivec2(c % 4 - 1, c / 4 - 1);
+                normalSum += h * texelFetch(normalTexels, int(texelIndex(level - 1u, child)));
+            }
         }
     }
     float clamped = min(1.0, weightSum);
     float scale = weightSum > 0.0 ? clamped / weightSum : 0.0;
     pullWeight[index] = vec2(clamped, spacingSum * scale);
     pullValue[index] = valueSum * scale;
+    if (normals) {
+        float normalWeight = min(1.0, normalSum.w);
+        normalPyramid[index] = normalSum.w > 0.0 ? normalSum * (normalWeight / normalSum.w)
+                                                 : vec4(0.0);
+    }
 #elif STAGE_PUSH_TOP
     float weight = pullWeightAt(index);
     pushValue[index] = weight > 0.0 ? pullValueAt(index) / weight : vec4(kInfinity, 0.0, 0.0, 0.0);
+    if (carriesNormals()) {
+        vec4 pulled = texelFetch(normalTexels, int(index));
+        normalPyramid[index] = vec4(pulled.w > 0.0 ? pulled.xyz / pulled.w : vec3(0.0), 1.0);
+    }
 #else
     vec4 complete = pushedValue(level, texel);
     // Level 0 lives only in the images: nothing reads it from the buffer.
@@ -103,6 +130,9 @@ void main() {
         imageStore(outColor, texel, vec4(complete.yzw, 1.0));
     } else {
         pushValue[index] = complete;
+        if (carriesNormals()) {
+            normalPyramid[index] = vec4(pushedNormal(level, texel), 1.0);
+        }
     }
 #endif
 }

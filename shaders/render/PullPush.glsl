@@ -7,6 +7,7 @@
 layout(binding = SUBSCAN_TEXELS_PULL_VALUES) uniform samplerBuffer pullValueTexels;
 layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
 layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
+layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
 
 vec4 pullValueAt(uint index) { return texelFetch(pullValueTexels, int(index)); }
 float pullWeightAt(uint index) { return texelFetch(pullWeightTexels, int(index)).r; }
@@ -60,4 +61,22 @@ vec4 pushedValue(uint level, ivec2 texel) {
     float weight = pullWeightAt(index);
     vec4 own = pullValueAt(index);
     return weight >= 1.0 ? own : own + (1.0 - weight) * m;
+}
+
+/// With the points' own normals (SurfaceParams.normals.z): the complete view-space normal sum of
+/// `texel` on `level` (levels below the coarsest), pushed as pushedValue pushes the values but
+/// with the normals' own weight: the normal pyramid holds, pulled, (w_n * normal, w_n) per
+/// texel, w_n the share of it that points with a normal cover, and from the coarsest level down
+/// to level 1 the push overwrites each texel with its complete sum (the texel is the only one
+/// that reads its own pulled value). Not unit length: the reader normalises.
+vec3 pushedNormal(uint level, ivec2 texel) {
+    ivec2 coarseSize = levelSize(level + 1u);
+    ivec2 near = texel >> 1;
+    ivec2 far = clamp(near + ((texel & 1) * 2 - 1), ivec2(0), coarseSize - 1);
+    vec3 m = 0.5625 * texelFetch(normalTexels, int(texelIndex(level + 1u, near))).xyz +
+             0.1875 * texelFetch(normalTexels, int(texelIndex(level + 1u, ivec2(far.x, near.y)))).xyz +
+             0.1875 * texelFetch(normalTexels, int(texelIndex(level + 1u, ivec2(near.x, far.y)))).xyz +
+             0.0625 * texelFetch(normalTexels, int(texelIndex(level + 1u, far))).xyz;
+    vec4 own = texelFetch(normalTexels, int(texelIndex(level, texel)));
+    return own.xyz + max(1.0 - own.w, 0.0) * m;
 }

@@ -13,7 +13,9 @@
 //   STAGE_RESOLVE  one thread per pixel of the cloud's projected bounding box: the winner's
 //                  linear colour, or with USE_BLEND the mean of the sums (and with USE_INT64
 //                  the winner's depth) into images cleared before; alpha: the winner's local
-//                  spacing on screen in units of h's (1 without local spacing)
+//                  spacing on screen in units of h's (1 without local spacing); with the
+//                  points' own normals (SurfaceParams.normals.z) the winner's normal in view
+//                  space, facing the eye, into "pointNormals" (0 where it has none)
 // Positive IEEE floats order like their bit patterns, so depth bits compare as uints. Points
 // are read as buffer textures and the 32-bit path keeps its per-pixel words in images rather
 // than storage buffers: on llvmpipe a texel fetch or image load is a vector gather, a storage
@@ -63,7 +65,9 @@ layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GRO
 layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
 #endif
 layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor;
+layout(binding = SUBSCAN_IMAGE_OUT2, rgba16f) writeonly uniform image2D outNormal;
 layout(binding = SUBSCAN_TEXELS_LOCAL_SPACING) uniform samplerBuffer localSpacing;
+layout(binding = SUBSCAN_TEXELS_POINT_NORMALS) uniform usamplerBuffer pointNormals;
 
 /// The local spacing (estimateLocalSpacing) of chunk point `local` on screen, over h's there:
 /// the larger of its spacing w and its vector across scan lines projected. The projection is
@@ -85,6 +89,17 @@ float spacingRatio(uint local) {
                      : across.xy + viewPosition.xy * (across.z / distance);
     // Both lengths in units of h times f / distance; the image holds half floats.
     return min(max(spacing.w, length(moved)), 6.0e4);
+}
+
+/// Chunk point `local`'s normal in view space, turned to face the eye: a normal's sign is
+/// arbitrary where no sensor oriented it, and the side seen is the side shaded.
+vec3 viewNormal(uint local) {
+    vec3 normal = mat3(frame.viewFromCloud) * unpackNormal(texelFetch(pointNormals, int(local)).r);
+    int first = 3 * int(local);
+    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
+                         texelFetch(positions, first + 2).r);
+    vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+    return dot(normal, towardsEye(viewPosition)) < 0.0 ? -normal : normal;
 }
 
 void main() {
@@ -113,6 +128,9 @@ void main() {
     vec3 color = unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r);
 #endif
     imageStore(outColor, pixel, vec4(color, spacingRatio(winner - raster.firstPoint)));
+    if (surface.normals.z > 0.5) {
+        imageStore(outNormal, pixel, vec4(viewNormal(winner - raster.firstPoint), 0.0));
+    }
 }
 
 #else

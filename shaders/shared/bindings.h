@@ -22,7 +22,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UBO_PASS 1
 #define SUBSCAN_UBO_PYRAMID 2
 #define SUBSCAN_UBO_SURFACE 3
-#define SUBSCAN_UBO_LIGHTS 4  // ShadeParams for a pass other than Shade that needs the lights
+#define SUBSCAN_UBO_LIGHTS 4    // ShadeParams for a pass other than Shade that needs the lights
 #define SUBSCAN_UBO_TEMPORAL 5  // TemporalParams (Temporal, and FinishSurface's fused filter)
 
 // ---- plain uniforms ----
@@ -32,37 +32,49 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_END 3      // ivec2: the texel past the region's last (shared/region.glsl)
 
 // ---- shader storage blocks (std430) ----
-#define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
-#define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
-#define SUBSCAN_SSBO_PULL_VALUES 6    // vec4 per texel, all levels: w * (depth, r, g, b)
-#define SUBSCAN_SSBO_PULL_WEIGHTS 7   // vec2 per texel, all levels: clamped weight w and
-                                      // w * the local spacing (in h) of the points pulled
-#define SUBSCAN_SSBO_PUSH_VALUES 8    // vec4 per texel, levels >= 1: complete (depth, r, g, b)
-#define SUBSCAN_SSBO_NORMALS 9        // vec4 per texel, levels >= 1: view-space normal, w unused
+#define SUBSCAN_SSBO_DEPTH_INDEX 4  // uint64 per pixel: depth bits << 32 | point index
+#define SUBSCAN_SSBO_PYRAMID 5      // float per texel, all levels: min depth
+#define SUBSCAN_SSBO_PULL_VALUES 6  // vec4 per texel, all levels: w * (depth, r, g, b)
+#define SUBSCAN_SSBO_PULL_WEIGHTS \
+    7                               // vec2 per texel, all levels: clamped weight w and
+                                    // w * the local spacing (in h) of the points pulled
+#define SUBSCAN_SSBO_PUSH_VALUES 8  // vec4 per texel, levels >= 1: complete (depth, r, g, b)
+#define SUBSCAN_SSBO_NORMALS \
+    9                                 // vec4 per texel: screen-space normals (levels >= 1):
+                                      // view-space normal, w unused; point normals (all levels):
+                                      // pulled w_n * normal, w_n, pushed in place (levels >= 1)
+                                      // to the complete normal, 1
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 #define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
 #define SUBSCAN_SSBO_COLOR_SUMS 12    // uvec4 per pixel: fixed-point linear RGB sums, point count
 #define SUBSCAN_SSBO_CLEAR 13         // uint words GpuClear fills (its own binding: no pass's)
 #define SUBSCAN_SSBO_OCCUPANCY 14     // uint per pixel: which of its 4x4 sub-cells hold points
-#define SUBSCAN_SSBO_POINT_CENTROIDS 15  // uint per texel, levels >= 1: where in the texel its
-                                         // points lie on average (unorm16x2 of the texel)
-#define SUBSCAN_SSBO_FILL_SPARSE 16  // uint per level-1 texel: what it adds to its pixels' gap
-                                     // test (FillRemoval.glsl's sparseEnclosure)
+#define SUBSCAN_SSBO_POINT_CENTROIDS \
+    15  // uint per texel, levels >= 1: where in the texel its
+        // points lie on average (unorm16x2 of the texel)
+#define SUBSCAN_SSBO_FILL_SPARSE \
+    16  // uint per level-1 texel: what it adds to its pixels' gap
+        // test (FillRemoval.glsl's sparseEnclosure)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
-#define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
-#define SUBSCAN_TEXELS_PULL_VALUES 1   // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
-#define SUBSCAN_TEXELS_PULL_WEIGHTS 2  // rg32f view of SUBSCAN_SSBO_PULL_WEIGHTS
-#define SUBSCAN_TEXELS_PUSH_VALUES 3   // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
-#define SUBSCAN_TEXELS_NORMALS 4       // rgba32f view of SUBSCAN_SSBO_NORMALS
-#define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
-#define SUBSCAN_TEXELS_POSITIONS 6     // r32f: x, y, z per point (cloud-relative), one chunk
-#define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
-#define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
+#define SUBSCAN_TEXELS_PYRAMID 0        // r32f view of SUBSCAN_SSBO_PYRAMID
+#define SUBSCAN_TEXELS_PULL_VALUES 1    // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
+#define SUBSCAN_TEXELS_PULL_WEIGHTS 2   // rg32f view of SUBSCAN_SSBO_PULL_WEIGHTS
+#define SUBSCAN_TEXELS_PUSH_VALUES 3    // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
+#define SUBSCAN_TEXELS_NORMALS 4        // rgba32f view of SUBSCAN_SSBO_NORMALS
+#define SUBSCAN_TEXELS_FILL_REACH 5     // r32ui view of SUBSCAN_SSBO_FILL_REACH
+#define SUBSCAN_TEXELS_POSITIONS 6      // r32f: x, y, z per point (cloud-relative), one chunk
+#define SUBSCAN_TEXELS_COLORS 7         // r32ui: RGBA8, sRGB-encoded, per point, one chunk
+#define SUBSCAN_TEXELS_ALBEDO_ROOTS 8   // r32f: sqrt(1 - reduced albedo) by total reflectance
 #define SUBSCAN_TEXELS_LOCAL_SPACING 9  // rgba16f per point, one chunk (estimateLocalSpacing)
-#define SUBSCAN_TEXELS_POINT_CENTROIDS 14  // r32ui view of SUBSCAN_SSBO_POINT_CENTROIDS (after
-                                           // the light maps: 16 units are all GL promises)
-#define SUBSCAN_TEXELS_FILL_SPARSE 15      // r32ui view of SUBSCAN_SSBO_FILL_SPARSE
+#define SUBSCAN_TEXELS_POINT_NORMALS \
+    10  // r32ui per point, one chunk: octahedral snorm16x2 unit
+        // normal, 0 for none (the rasterizer's; it shares its
+        // unit with the first light map, which it never reads)
+#define SUBSCAN_TEXELS_POINT_CENTROIDS \
+    14                                 // r32ui view of SUBSCAN_SSBO_POINT_CENTROIDS (after
+                                       // the light maps: 16 units are all GL promises)
+#define SUBSCAN_TEXELS_FILL_SPARSE 15  // r32ui view of SUBSCAN_SSBO_FILL_SPARSE
 
 // ---- textures read with texelFetch ----
 // sampler2D per directional light (units 10 .. 10 + SUBSCAN_MAX_LIGHTS - 1): its light map
@@ -84,8 +96,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_ATTRIBUTE_COLOR 1
 
 // ---- limits ----
-#define SUBSCAN_MAX_PYRAMID_LEVELS 16  // 1 + ceil(log2(65536)): the largest image side
-#define SUBSCAN_MAX_LIGHTS 4           // directional lights besides the head light
+#define SUBSCAN_MAX_PYRAMID_LEVELS 16     // 1 + ceil(log2(65536)): the largest image side
+#define SUBSCAN_MAX_LIGHTS 4              // directional lights besides the head light
 #define SUBSCAN_MAX_PROFILE_GAUSSIANS 12  // terms of a diffusion profile the shading transmits
 
 // ---- compute work group sizes ----
@@ -139,6 +151,7 @@ struct SurfaceParams {
                       // z: pull depth slope (texel widths), w: 1 to place a dense
                       // cloud's outline by its points' sub-pixel cells (SUBSCAN_SSBO_OCCUPANCY)
     vec4 normals;     // x: smoothing radius, y: 1 to extrapolate them towards the outline
+                      // (screen-space normals), z: 1 for the points' own normals
     vec4 spacing;     // x: 1 when the points carry their local spacing, else 0
 };
 
@@ -187,9 +200,9 @@ struct SingleScatterParams {
 struct TemporalParams {
     mat4 previousFromView;    // this frame's view space -> the previous frame's view space
     mat4 previousProjection;  // the previous frame's projection without its jitter
-    vec4 blend;  // x: least weight of the new frame while the camera moves, y: clip sigma,
-                 // z: most frames a still camera averages, w: unused
-    vec4 depth;  // x: depth difference (scene units) beyond which the history saw another surface
+    vec4 blend;   // x: least weight of the new frame while the camera moves, y: clip sigma,
+                  // z: most frames a still camera averages, w: unused
+    vec4 depth;   // x: depth difference (scene units) beyond which the history saw another surface
     uvec4 flags;  // x: 1 when the history was reprojected last frame (a still camera then
                   // weighs it as one frame)
 };
@@ -201,11 +214,14 @@ static_assert(sizeof(SingleScatterParams) == 96);
 static_assert(sizeof(PyramidLayout) == (SUBSCAN_MAX_PYRAMID_LEVELS + 1) * 16);
 static_assert(sizeof(SurfaceParams) == 64);
 static_assert(sizeof(ShadeParams) == 3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 +
-                                        SUBSCAN_MAX_LIGHTS * 64 + 16 +
-                                        SUBSCAN_MAX_PROFILE_GAUSSIANS * 16 + 16);
+                                         SUBSCAN_MAX_LIGHTS * 64 + 16 +
+                                         SUBSCAN_MAX_PROFILE_GAUSSIANS * 16 + 16);
 static_assert(sizeof(FrameParams) == 2 * 64 + 4 * 16);
 static_assert(sizeof(RasterParams) == 16);
 static_assert(sizeof(DrawParams) == 16);
+static_assert(SUBSCAN_TEXELS_POINT_NORMALS >= SUBSCAN_TEXTURES_LIGHT_MAPS &&
+              SUBSCAN_TEXELS_POINT_NORMALS < SUBSCAN_TEXTURES_LIGHT_MAPS + SUBSCAN_MAX_LIGHTS &&
+              SUBSCAN_TEXELS_POINT_NORMALS > SUBSCAN_TEXELS_LOCAL_SPACING);
 static_assert(SUBSCAN_TEXELS_POINT_CENTROIDS >= SUBSCAN_TEXTURES_LIGHT_MAPS + SUBSCAN_MAX_LIGHTS &&
               SUBSCAN_TEXELS_FILL_SPARSE > SUBSCAN_TEXELS_POINT_CENTROIDS &&
               SUBSCAN_TEXELS_FILL_SPARSE < 16);

@@ -71,3 +71,16 @@ float levelForRadius(float worldRadius, float depth) {
 vec3 towardsEye(vec3 position) {
     return frame.depthRange.w > 0.0 ? vec3(0.0, 0.0, 1.0) : normalize(-position);
 }
+
+/// The unit normal packNormal (GpuPointCloud.h) stored as an octahedral snorm16x2, 0 for none.
+vec3 unpackNormal(uint bits) {
+    if (bits == 0u) {
+        return vec3(0.0);
+    }
+    vec2 folded = unpackSnorm2x16(bits);
+    vec3 normal = vec3(folded, 1.0 - abs(folded.x) - abs(folded.y));
+    // The lower half was folded over the diagonals: unfold by the overshoot below z = 0.
+    float below = max(-normal.z, 0.0);
+    normal.xy += mix(vec2(below), vec2(-below), greaterThanEqual(normal.xy, vec2(0.0)));
+    return normalize(normal);
+}

@@ -36,6 +36,9 @@ class CloudData {
     /// estimatePointSpacing with that h: the local spacing too where the renderer wants it,
     /// computed once for every Renderer of this cloud (call without the GIL).
     const PointSpacing& pointSpacing() const;
+    /// pointNormals(cloud()) for a cloud without normals of its own, computed once for every
+    /// Renderer of this cloud, as the CLI's renderer estimates them (call without the GIL).
+    const std::vector<glm::vec3>& estimatedNormals() const;
 
     /// framingBounds(cloud()), computed on the first call (a pass over a sample of the points:
     /// 10 ms for 10 M, which only a default camera needs).
@@ -53,6 +56,8 @@ class CloudData {
     mutable SpacingSample sample_;  // h, and the distances that decide on the local spacing
     mutable std::once_flag pointSpacingOnce_;
     mutable PointSpacing pointSpacing_;
+    mutable std::once_flag normalsOnce_;
+    mutable std::vector<glm::vec3> estimatedNormals_;
     mutable std::once_flag framedOnce_;
     mutable Bounds framed_;
 };

@@ -15,6 +15,7 @@
 #include <glm/vector_relational.hpp>
 
 #include "core/Error.h"
+#include "core/NormalEstimation.h"
 #include "core/Spacing.h"
 #include "io/ScanLoader.h"
 #include "python/Bindings.h"
@@ -34,6 +35,11 @@ const PointSpacing& CloudData::pointSpacing() const {
         pointSpacing_ = estimatePointSpacing(cloud_, sample_);
     });
     return pointSpacing_;
+}
+
+const std::vector<glm::vec3>& CloudData::estimatedNormals() const {
+    std::call_once(normalsOnce_, [this] { estimatedNormals_ = pointNormals(cloud_); });
+    return estimatedNormals_;
 }
 
 const Bounds& CloudData::framed() const {

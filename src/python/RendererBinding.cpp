@@ -87,6 +87,9 @@ class RendererState {
         // allows (the Cloud is immutable and kept alive here): no 160 MB copy for 10 M points.
         renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing(), 0,
                                                PointMemory::Borrow);
+        if (!cloud->cloud().hasNormals()) {
+            renderer_->setPointNormals(cloud->estimatedNormals());
+        }
         if (!ownColors) {
             renderer_->setColors(colors);
         }

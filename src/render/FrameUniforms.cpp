@@ -36,7 +36,8 @@ const gpu::PyramidLayout& FrameUniforms::update(const Camera& camera,
                          surface.edgeRule ? 1.0f : 0.0f, 0.0f};
     params.fill = {surface.fillRadius * h, static_cast<float>(surface.fillDirections),
                    surface.pullDepthSlope, placesOutlineBySubpixels(settings) ? 1.0f : 0.0f};
-    params.normals = {surface.normalRadius * h, surface.outlineNormals ? 1.0f : 0.0f, 0.0f, 0.0f};
+    params.normals = {surface.normalRadius * h, surface.outlineNormals ? 1.0f : 0.0f,
+                      usesPointNormals(settings) ? 1.0f : 0.0f, 0.0f};
     params.spacing = {surface.localSpacing && cloud.hasLocalSpacing() ? 1.0f : 0.0f, 0.0f, 0.0f,
                       0.0f};
     surface_.set(params);

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <glm/gtc/packing.hpp>
+#include <glm/packing.hpp>
 
 #include "core/Coloring.h"
 #include "core/Error.h"
@@ -22,6 +23,33 @@ std::uint32_t pack(Rgba8 color) {
 }
 
 }  // namespace
+
+std::uint32_t packNormal(const glm::vec3& normal) {
+    const float l1 = std::abs(normal.x) + std::abs(normal.y) + std::abs(normal.z);
+    if (!(l1 > 0.0f) || !std::isfinite(l1)) {
+        return 0u;
+    }
+    glm::vec2 folded = glm::vec2(normal) / l1;
+    if (normal.z < 0.0f) {
+        const glm::vec2 sign(folded.x >= 0.0f ? 1.0f : -1.0f, folded.y >= 0.0f ? 1.0f : -1.0f);
+        folded = (1.0f - glm::abs(glm::vec2(folded.y, folded.x))) * sign;
+    }
+    const std::uint32_t packed = glm::packSnorm2x16(folded);
+    return packed == 0u ? 1u : packed;
+}
+
+glm::vec3 unpackNormal(std::uint32_t packed) {
+    if (packed == 0u) {
+        return glm::vec3(0.0f);
+    }
+    const glm::vec2 folded = glm::unpackSnorm2x16(packed);
+    glm::vec3 normal(folded, 1.0f - std::abs(folded.x) - std::abs(folded.y));
+    // The lower half was folded over the diagonals: unfold by the overshoot below z = 0.
+    const float below = std::max(-normal.z, 0.0f);
+    normal.x += normal.x >= 0.0f ? -below : below;
+    normal.y += normal.y >= 0.0f ? -below : below;
+    return glm::normalize(normal);
+}
 
 std::vector<std::uint32_t> displayColors(const PointCloud& cloud) {
     std::vector<std::uint32_t> packed(cloud.size());
@@ -93,6 +121,9 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
         }
         chunks_.push_back(std::move(chunk));
     }
+    if (cloud.hasNormals()) {
+        setNormals(cloud.normals);
+    }
 }
 
 bool GpuPointCloud::borrowsPositions() const {
@@ -126,6 +157,21 @@ void GpuPointCloud::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
             Buffer::fromSpan(std::span<const glm::u16vec4>(halves), "points.localSpacing");
     }
     hasLocalSpacing_ = true;
+}
+
+void GpuPointCloud::setNormals(const std::vector<glm::vec3>& normals) {
+    if (normals.size() != size_) {
+        throw Error(fmt::format("{} normals given to a cloud of {} points", normals.size(), size_));
+    }
+    std::vector<std::uint32_t> packed;
+    for (Chunk& chunk : chunks_) {
+        packed.resize(chunk.pointCount);
+        for (std::uint32_t i = 0; i < chunk.pointCount; ++i) {
+            packed[i] = packNormal(normals[chunk.firstPoint + i]);
+        }
+        chunk.normals = Buffer::fromSpan(std::span<const std::uint32_t>(packed), "points.normals");
+    }
+    hasNormals_ = true;
 }
 
 }  // namespace subscan

@@ -27,7 +27,7 @@ enum class PointMemory {
 /// dispatch: positions as 3 floats (cloud-relative), colours as packed sRGB RGBA8. The
 /// rasterizer reads both as buffer textures (Buffer::bindTexels), the GL_POINTS baseline as
 /// vertex attributes. A cloud may also carry each point's local spacing (estimateLocalSpacing)
-/// as four half floats.
+/// as four half floats, and its normal (packNormal).
 class GpuPointCloud {
   public:
     struct Chunk {
@@ -36,6 +36,7 @@ class GpuPointCloud {
         Buffer positions;
         Buffer colors;
         Buffer localSpacing;  // empty unless hasLocalSpacing()
+        Buffer normals;       // empty unless hasNormals()
     };
 
     /// `maxChunkPoints` 0 = as large as the driver allows; tests pass small values to exercise
@@ -48,6 +49,10 @@ class GpuPointCloud {
     /// Uploads estimateLocalSpacing's result, one entry per point.
     void setLocalSpacing(const std::vector<glm::vec4>& spacing);
     bool hasLocalSpacing() const { return hasLocalSpacing_; }
+    /// Uploads one normal per point (unit length, or 0 where none is known); the constructor
+    /// uploads the cloud's own.
+    void setNormals(const std::vector<glm::vec3>& normals);
+    bool hasNormals() const { return hasNormals_; }
     /// True when the positions are read from the cloud's own memory (PointMemory::Borrow on a
     /// driver that allows it).
     bool borrowsPositions() const;
@@ -57,7 +62,8 @@ class GpuPointCloud {
     const glm::dvec3& origin() const { return origin_; }
     std::size_t bytes() const {
         return size_ * (3 * sizeof(float) + sizeof(std::uint32_t) +
-                        (hasLocalSpacing_ ? kLocalSpacingBytes : 0));
+                        (hasLocalSpacing_ ? kLocalSpacingBytes : 0) +
+                        (hasNormals_ ? sizeof(std::uint32_t) : 0));
     }
 
   private:
@@ -65,8 +71,16 @@ class GpuPointCloud {
     std::size_t size_ = 0;
     glm::dvec3 origin_{0.0};
     bool hasLocalSpacing_ = false;
+    bool hasNormals_ = false;
     static constexpr std::size_t kLocalSpacingBytes = 4 * sizeof(std::uint16_t);
 };
+
+/// A unit normal as the GPU reads it (SUBSCAN_TEXELS_POINT_NORMALS): its octahedral map
+/// (Cigolle et al. 2014) as two snorm16, about 0.005 degrees apart; 0 stands for "no normal"
+/// (a zero or non-finite vector), so the one normal that maps to 0, +z, is moved by 1/32767.
+std::uint32_t packNormal(const glm::vec3& normal);
+/// The inverse of packNormal (for tests; the shaders have their own): 0 for none.
+glm::vec3 unpackNormal(std::uint32_t packed);
 
 /// The colour each point is drawn with: its own, else its intensity as grey (stretched between
 /// the 1st and 99th percentile), else a neutral light grey. Packed sRGB RGBA8.

@@ -7,18 +7,26 @@ namespace subscan {
 NormalsPass::NormalsPass(const ShaderSources& sources)
     : stages_(sources, "render/Normals.comp", {"LEVEL", "BLEND"}) {}
 
-std::vector<std::string_view> NormalsPass::inputs(const RenderSettings&) const {
-    if (levelZero_ == LevelZero::Fused) {
-        return {"pushValues", "pullWeights"};
+std::vector<std::string_view> NormalsPass::inputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names{"pushValues", "pullWeights"};
+    if (usesPointNormals(settings)) {
+        names.push_back("normalPyramid");  // PullPushPass's
     }
-    return {"pushValues", "pullWeights", "surfaceDepth"};
+    if (levelZero_ == LevelZero::PerPass) {
+        names.push_back("surfaceDepth");
+    }
+    return names;
 }
 
-std::vector<std::string_view> NormalsPass::outputs(const RenderSettings&) const {
-    if (levelZero_ == LevelZero::Fused) {
-        return {"normalPyramid"};
+std::vector<std::string_view> NormalsPass::outputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names;
+    if (!usesPointNormals(settings)) {
+        names.push_back("normalPyramid");
     }
-    return {"normalPyramid", "normals"};
+    if (levelZero_ == LevelZero::PerPass) {
+        names.push_back("normals");
+    }
+    return names;
 }
 
 void NormalsPass::execute(FrameContext& frame) {
@@ -32,11 +40,14 @@ void NormalsPass::execute(FrameContext& frame) {
     // spacing that scales the smoothing radius (PullPush.glsl's spacingRatioAt).
     resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     // From level 1: the blend never reads level 0 (its smoothing level is at least 1), and the
-    // push leaves level 0 in the filled images only.
-    for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
-        stages_.runOverRegion(Level, frame.region(level), level);
+    // push leaves level 0 in the filled images only. The points' own normals are pushed by
+    // PullPushPass instead.
+    if (!usesPointNormals(frame.settings)) {
+        for (unsigned level = 1; level < frame.pyramid.info.x; ++level) {
+            stages_.runOverRegion(Level, frame.region(level), level);
+        }
+        glMemoryBarrier(kPyramidWritesBarrier);
     }
-    glMemoryBarrier(kPyramidWritesBarrier);
     if (levelZero_ == LevelZero::Fused) {
         return;
     }

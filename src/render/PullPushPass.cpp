@@ -7,11 +7,22 @@ namespace subscan {
 PullPushPass::PullPushPass(const ShaderSources& sources)
     : stages_(sources, "render/PullPush.comp", {"PULL_INIT", "PULL", "PUSH_TOP", "PUSH"}) {}
 
-std::vector<std::string_view> PullPushPass::outputs(const RenderSettings&) const {
-    if (levelZero_ == LevelZero::Fused) {
-        return {"pullValues", "pullWeights", "pushValues"};
+std::vector<std::string_view> PullPushPass::inputs(const RenderSettings& settings) const {
+    if (usesPointNormals(settings)) {
+        return {"depth", "color", "visibility", "pointNormals"};
     }
-    return {"pullValues", "pullWeights", "pushValues", "filledDepth", "filledColor"};
+    return {"depth", "color", "visibility"};
+}
+
+std::vector<std::string_view> PullPushPass::outputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names{"pullValues", "pullWeights", "pushValues"};
+    if (levelZero_ == LevelZero::PerPass) {
+        names.insert(names.end(), {"filledDepth", "filledColor"});
+    }
+    if (usesPointNormals(settings)) {
+        names.push_back("normalPyramid");
+    }
+    return names;
 }
 
 void PullPushPass::execute(FrameContext& frame) {
@@ -33,6 +44,13 @@ void PullPushPass::execute(FrameContext& frame) {
     resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     resources.texture("color").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     resources.texture("visibility").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
+    if (usesPointNormals(frame.settings)) {
+        // The points' normals are pulled and pushed beside the values (PullPush.comp).
+        Buffer& normalPyramid = resources.ensureBuffer("normalPyramid", texels * 4 * sizeof(float));
+        normalPyramid.bindStorage(SUBSCAN_SSBO_NORMALS);
+        normalPyramid.bindTexels(SUBSCAN_TEXELS_NORMALS, TextureFormat::RGBA32F);
+        resources.texture("pointNormals").bindImage(SUBSCAN_IMAGE_IN3, GL_READ_ONLY);
+    }
     const bool perPass = levelZero_ == LevelZero::PerPass;
     if (perPass) {
         resources.ensureTexture("filledDepth", TextureFormat::R32F, frame.width(), frame.height())

@@ -14,9 +14,7 @@ class PullPushPass final : public RenderPass {
     explicit PullPushPass(const ShaderSources& sources);
 
     std::string_view name() const override { return "PullPush"; }
-    std::vector<std::string_view> inputs(const RenderSettings&) const override {
-        return {"depth", "color", "visibility"};
-    }
+    std::vector<std::string_view> inputs(const RenderSettings& settings) const override;
     std::vector<std::string_view> outputs(const RenderSettings&) const override;
     void execute(FrameContext& frame) override;
     void setLevelZero(LevelZero levelZero) { levelZero_ = levelZero; }

@@ -90,6 +90,9 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
         if (frame.cloud.hasLocalSpacing()) {
             chunk.localSpacing.bindTexels(SUBSCAN_TEXELS_LOCAL_SPACING, TextureFormat::RGBA16F);
         }
+        if (usesPointNormals(frame.settings)) {
+            chunk.normals.bindTexels(SUBSCAN_TEXELS_POINT_NORMALS, TextureFormat::R32UI);
+        }
         if (perPixel) {
             Program::dispatch2D(region.size.x, region.size.y, SUBSCAN_IMAGE_GROUP_SIZE,
                                 SUBSCAN_IMAGE_GROUP_SIZE);
@@ -112,10 +115,14 @@ std::vector<std::uint32_t> RasterizePointsPass::readWinners(const FrameResources
 }
 
 std::vector<std::string_view> RasterizePointsPass::outputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names{"depth", "color"};
     if (placesOutlineBySubpixels(settings)) {
-        return {"depth", "color", "occupancy"};
+        names.push_back("occupancy");
     }
-    return {"depth", "color"};
+    if (usesPointNormals(settings)) {
+        names.push_back("pointNormals");
+    }
+    return names;
 }
 
 void RasterizePointsPass::execute(FrameContext& frame) {
@@ -131,6 +138,10 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     // bounding box projects to, and writes those that hold a point.
     frame.clear(depth, glm::vec4(std::numeric_limits<float>::infinity()));
     frame.clear(color);
+    const bool pointNormals = usesPointNormals(frame.settings);
+    if (pointNormals && !frame.cloud.hasNormals()) {
+        throw Error("the settings ask for the points' normals, but the cloud has none");
+    }
     if (placesOutlineBySubpixels(frame.settings)) {
         // Which 4x4 sub-cells of each pixel hold points (FillRemoval.glsl's outline).
         Buffer& occupancy = frame.resources.ensureBuffer(
@@ -181,6 +192,11 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         }
     }
     color.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    if (pointNormals) {
+        // Read only where a point won its pixel, which the resolve writes: nothing to clear.
+        frame.resources.ensureTexture("pointNormals", TextureFormat::RGBA16F, width, height)
+            .bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    }
     runPerChunk(blend   ? blendPrograms(int64).resolve
                 : int64 ? resolve64_
                         : resolve32_,

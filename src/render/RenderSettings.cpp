@@ -87,8 +87,14 @@ bool placesOutlineBySubpixels(const RenderSettings& settings) {
     return settings.surface.subpixelOutline && reconstructsSurface(settings.raster.mode);
 }
 
+bool usesPointNormals(const RenderSettings& settings) {
+    return settings.surface.normals == NormalSource::Points &&
+           reconstructsSurface(settings.raster.mode);
+}
+
 bool followsNormalsToOutline(const RenderSettings& settings) {
-    return settings.surface.outlineNormals && reconstructsSurface(settings.raster.mode);
+    return settings.surface.outlineNormals && reconstructsSurface(settings.raster.mode) &&
+           !usesPointNormals(settings);
 }
 
 bool filtersTemporally(const RenderSettings& settings) {

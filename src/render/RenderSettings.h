@@ -121,8 +121,12 @@ bool filtersTemporally(const RenderSettings& settings);
 /// Whether the frame records its points' sub-pixel cells and places the outline by them
 /// (SurfaceSettings::subpixelOutline in a mode that reconstructs the surface).
 bool placesOutlineBySubpixels(const RenderSettings& settings);
-/// Whether the frame's normals follow the surface towards the outline, which they find in
-/// "surfaceDepth" (SurfaceSettings::outlineNormals in a mode that reconstructs the surface).
+/// Whether the frame's normals are the points' own, carried by pull-push (SurfaceSettings::normals
+/// Points, as the renderer resolves Auto, in a mode that reconstructs the surface).
+bool usesPointNormals(const RenderSettings& settings);
+/// Whether the frame's screen-space normals follow the surface towards the outline, which they
+/// find in "surfaceDepth" (SurfaceSettings::outlineNormals in a mode that reconstructs the
+/// surface with screen-space normals).
 bool followsNormalsToOutline(const RenderSettings& settings);
 /// Frames a camera at rest renders through the temporal filter before its picture counts as
 /// finished (the viewer then idles; `render` with the filter on averages this many): 32 jitter

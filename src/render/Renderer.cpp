@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/Error.h"
+#include "core/NormalEstimation.h"
 #include "render/DrawPointsPass.h"
 #include "render/FinishSurfacePass.h"
 #include "render/PresentPass.h"
@@ -38,7 +39,11 @@ double FrameResult::totalMilliseconds() const {
 
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<double> spacing,
                    std::size_t maxChunkPoints, PointMemory memory)
-    : Renderer(context, cloud, estimatePointSpacing(cloud, spacing), maxChunkPoints, memory) {}
+    : Renderer(context, cloud, estimatePointSpacing(cloud, spacing), maxChunkPoints, memory) {
+    if (!cloud.hasNormals()) {
+        setPointNormals(pointNormals(cloud));
+    }
+}
 
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
                    std::size_t maxChunkPoints, PointMemory memory)
@@ -61,6 +66,15 @@ void Renderer::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
 }
 
 Renderer::~Renderer() = default;
+
+RenderSettings Renderer::resolvedSettings(const RenderSettings& settings) const {
+    RenderSettings resolved = settings;
+    NormalSource& normals = resolved.surface.normals;
+    if (normals != NormalSource::Screen) {
+        normals = cloud_.hasNormals() ? NormalSource::Points : NormalSource::Screen;
+    }
+    return resolved;
+}
 
 PresentPass& Renderer::present(const std::string& color, const std::string& depth) {
     return lazyPass(presents_[{color, depth}], sources_, color, depth);
@@ -162,8 +176,9 @@ std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, int
     return passes;
 }
 
-FrameResult Renderer::render(const Camera& camera, const RenderSettings& settings,
+FrameResult Renderer::render(const Camera& camera, const RenderSettings& requested,
                              FrameOutputs outputs) {
+    const RenderSettings settings = resolvedSettings(requested);
     const int limit = capabilities().maxTextureSize;
     if (camera.width < 1 || camera.height < 1 || camera.width > limit || camera.height > limit) {
         throw Error(

@@ -49,11 +49,13 @@ class Renderer {
   public:
     /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` and `memory` see
     /// GpuPointCloud (PointMemory::Borrow: `cloud` outlives the renderer unchanged). The local
-    /// spacing is estimated as estimatePointSpacing says.
+    /// spacing is estimated as estimatePointSpacing says, and normals (pointNormals) where the
+    /// cloud has none.
     Renderer(GlContext& context, const PointCloud& cloud,
              std::optional<double> spacing = std::nullopt, std::size_t maxChunkPoints = 0,
              PointMemory memory = PointMemory::Copy);
-    /// With the spacing estimated beforehand (off the render thread).
+    /// With the spacing estimated beforehand (off the render thread); the cloud's own normals
+    /// only, until setPointNormals() gives estimated ones.
     Renderer(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
              std::size_t maxChunkPoints = 0, PointMemory memory = PointMemory::Copy);
     ~Renderer();
@@ -75,6 +77,13 @@ class Renderer {
     /// Gives the cloud the local spacing `spacing` (estimateLocalSpacing's form, one entry per
     /// point) in place of the one the constructor estimated, or none.
     void setLocalSpacing(const std::vector<glm::vec4>& spacing);
+    /// Gives the points normals (one per point, unit or 0 for none): NormalSource::Auto then
+    /// uses them.
+    void setPointNormals(const std::vector<glm::vec3>& normals) { cloud_.setNormals(normals); }
+    /// `settings` with SurfaceSettings::normals resolved for this cloud: Auto becomes Points
+    /// where the cloud has normals, else Screen, and so does Points without them (the passes
+    /// see no Auto).
+    RenderSettings resolvedSettings(const RenderSettings& settings) const;
     /// Replaces the points' colours (one per point, sRGB-encoded): another colouring.
     void setColors(const std::vector<Rgba8>& colors) { cloud_.setColors(colors); }
     /// The camera of the last frame's pipeline images (all but "image"): the frame's own

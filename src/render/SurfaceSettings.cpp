@@ -9,6 +9,24 @@
 
 namespace subscan {
 
+namespace {
+
+constexpr std::pair<NormalSource, std::string_view> kNormalSources[] = {
+    {NormalSource::Auto, "auto"},
+    {NormalSource::Points, "points"},
+    {NormalSource::Screen, "screen"},
+};
+
+}  // namespace
+
+std::string toString(NormalSource source) {
+    return nameOf(kNormalSources, source);
+}
+
+NormalSource parseNormalSource(std::string_view text) {
+    return parseName(kNormalSources, text, "normal source");
+}
+
 void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
     json = {
         {"visibility_radius", settings.visibilityRadius},
@@ -17,6 +35,7 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
         {"pull_depth_slope", settings.pullDepthSlope},
         {"fill_radius", settings.fillRadius},
         {"fill_directions", settings.fillDirections},
+        {"normals", nameOf(kNormalSources, settings.normals)},
         {"normal_radius", settings.normalRadius},
         {"restrict_to_points", settings.restrictToPoints},
         {"local_spacing", settings.localSpacing},
@@ -26,16 +45,18 @@ void to_json(nlohmann::json& json, const SurfaceSettings& settings) {
 }
 
 void from_json(const nlohmann::json& json, SurfaceSettings& settings) {
-    rejectUnknownKeys(json, "surface",
-                      {"visibility_radius", "visibility_threshold", "edge_rule", "pull_depth_slope",
-                       "fill_radius", "fill_directions", "normal_radius", "restrict_to_points",
-                       "local_spacing", "subpixel_outline", "outline_normals"});
+    rejectUnknownKeys(
+        json, "surface",
+        {"visibility_radius", "visibility_threshold", "edge_rule", "pull_depth_slope",
+         "fill_radius", "fill_directions", "normals", "normal_radius", "restrict_to_points",
+         "local_spacing", "subpixel_outline", "outline_normals"});
     readSetting(json, "visibility_radius", settings.visibilityRadius, 0.1f, 1000.0f);
     readSetting(json, "visibility_threshold", settings.visibilityThreshold, 0.0f, 2.0f);
     readSetting(json, "edge_rule", settings.edgeRule);
     readSetting(json, "pull_depth_slope", settings.pullDepthSlope, 0.1f, 1e6f);
     readSetting(json, "fill_radius", settings.fillRadius, 0.1f, 1000.0f);
     readSetting(json, "fill_directions", settings.fillDirections, 1, 8);
+    readEnum(json, "normals", settings.normals, kNormalSources, "normal source");
     readSetting(json, "normal_radius", settings.normalRadius, 0.1f, 1000.0f);
     readSetting(json, "restrict_to_points", settings.restrictToPoints);
     readSetting(json, "local_spacing", settings.localSpacing);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
@@ -7,6 +9,16 @@
 #include <nlohmann/json_fwd.hpp>
 
 namespace subscan {
+
+/// Where the surface's normals come from (DESIGN.md §5 step 5): the points' own (the file's, or
+/// estimated once by PCA of their neighbours; the rasterizer keeps the nearest point's and
+/// pull-push carries them into the gaps), or the paper's, rebuilt from the filled depth for every
+/// view. Auto: the points' where the renderer has them, else the screen's. The renderer
+/// resolves Auto before its passes see the settings.
+enum class NormalSource { Auto, Points, Screen };
+/// Names as the CLI and JSON spell them; the parser throws subscan::Error listing the choices.
+std::string toString(NormalSource source);
+NormalSource parseNormalSource(std::string_view text);
 
 /// The screen-space reconstruction (DESIGN.md §5 steps 3-5). Radii are multiples of the point
 /// spacing h, so the defaults fit any scan at any scale; each pass turns its radius into a
@@ -22,8 +34,9 @@ struct SurfaceSettings {
                                        // behind the nearest one (the front-most surface)
     float fillRadius = 1.0f;           // the expected gap between points (x h)
     int fillDirections = 8;            // of 8 directions, how many must find points
-    float normalRadius = 1.5f;         // normal smoothing (x h)
-    bool restrictToPoints = true;      // passes skip the screen outside the points' bounds
+    NormalSource normals = NormalSource::Auto;
+    float normalRadius = 1.5f;     // screen-space normals' smoothing (x h)
+    bool restrictToPoints = true;  // passes skip the screen outside the points' bounds
     // Radii scale with each point's local spacing where the renderer has it
     // (estimatePointSpacing), instead of the one global h.
     bool localSpacing = true;

@@ -39,7 +39,8 @@ TEST(EvaluationGLTest, SculptureScanWithNoiseMeetsTheTargets) {
     test::expectQualityTargets(report);
 }
 
-/// The surface's metrics for `scene`'s points with the normals' outline rule on or off.
+/// The surface's metrics for `scene`'s points with the screen-space normals' outline rule on or
+/// off.
 QualityMetrics surfaceWithOutlineNormals(const std::string& scene, bool outlineNormals) {
     const auto truth = makeBuiltInScene(scene);
     const PointCloud points = makeSyntheticScene(scene + "?points=40000");
@@ -48,6 +49,7 @@ QualityMetrics surfaceWithOutlineNormals(const std::string& scene, bool outlineN
     settings.width = 256;
     settings.height = 256;
     RenderSettings render;
+    render.surface.normals = NormalSource::Screen;  // the rule is the screen-space normals'
     render.surface.outlineNormals = outlineNormals;
     return evaluate(test::glTestContext(), *truth, points, settings, render).surface;
 }

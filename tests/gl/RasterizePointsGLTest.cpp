@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 #include <ostream>
 #include <random>
@@ -250,6 +251,83 @@ TEST_P(RasterPathGLTest, ColorAlphaIsTheWinnersLocalSpacingOnScreen) {
             }
         }
     }
+}
+
+TEST_P(RasterPathGLTest, PointNormalsAreTheWinnersFacingTheEye) {
+    GlContext& context = test::glTestContext();
+    if (GetParam() == RasterPath::Int64 && !context.capabilities().int64Atomics) {
+        GTEST_SKIP() << context.capabilities().renderer << " has no 64-bit atomics";
+    }
+    const Camera camera = smallCamera();
+    PointCloud cloud = testCloud(camera, 3);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+    // Random directions, half of them facing away from the eye (a normal's sign is arbitrary
+    // without a sensor), and some points without a normal.
+    std::mt19937 random(6);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    cloud.normals.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        cloud.normals[i] =
+            i % 9 == 0 ? glm::vec3(0.0f)
+                       : glm::normalize(glm::vec3(gauss(random), gauss(random), gauss(random)));
+    }
+    for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
+        SCOPED_TRACE(chunk ? "chunks of 97" : "one chunk");
+        Renderer renderer(context, cloud, std::nullopt, chunk);
+        ASSERT_TRUE(renderer.gpuCloud().hasNormals());
+        RenderSettings settings;
+        settings.raster.path = GetParam();
+        settings.raster.mode = RenderMode::Surface;
+        renderer.render(camera, settings, FrameOutputs::Everything);
+        const std::vector<float> normals =
+            renderer.resources().texture("pointNormals").readFloats();
+        const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
+        int flipped = 0, none = 0;
+        for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
+            const std::uint32_t winner = reference.winner[pixel];
+            if (winner == kEmpty) {
+                continue;
+            }
+            const glm::dvec3 p(viewFromCloud *
+                               glm::dvec4(glm::dvec3(cloud.positions[winner]), 1.0));
+            glm::dvec3 expected = glm::dmat3(viewFromCloud) *
+                                  glm::dvec3(unpackNormal(packNormal(cloud.normals[winner])));
+            if (glm::dot(expected, -p) < 0.0) {
+                expected = -expected;
+                ++flipped;
+            }
+            none += cloud.normals[winner] == glm::vec3(0.0f);
+            for (int c = 0; c < 3; ++c) {
+                // RGBA16F: 11 significant bits of a component up to 1.
+                EXPECT_NEAR(normals[4 * pixel + c], expected[c], 1e-3) << pixel;
+            }
+        }
+        EXPECT_GT(flipped, 100);  // both orientations occur
+        EXPECT_GT(none, 20);      // and points without a normal
+    }
+}
+
+TEST(RasterizePointsGLTest, PackedNormalsKeepTheirDirection) {
+    // The octahedral map's snorm16 grid is ~3e-5 wide: every direction within 0.01 degrees.
+    std::mt19937 random(8);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    double worst = 0.0;
+    for (int i = 0; i < 20000; ++i) {
+        const glm::vec3 n = glm::normalize(glm::vec3(gauss(random), gauss(random), gauss(random)));
+        const glm::dvec3 back(unpackNormal(packNormal(n)));
+        // The angle from the cross product: acos loses it near 1.
+        worst =
+            std::max(worst, std::asin(std::min(1.0, glm::length(glm::cross(glm::dvec3(n), back)))));
+    }
+    EXPECT_LT(worst, 0.01 * std::numbers::pi / 180.0);
+    for (const glm::vec3& axis :
+         {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::vec3(0, -1, 0)}) {
+        EXPECT_NE(packNormal(axis), 0u);  // 0 means "no normal"
+        EXPECT_LT(glm::length(unpackNormal(packNormal(axis)) - axis), 1e-4f);
+    }
+    EXPECT_EQ(packNormal(glm::vec3(0.0f)), 0u);
+    EXPECT_EQ(packNormal(glm::vec3(std::nanf(""), 0.0f, 1.0f)), 0u);
+    EXPECT_EQ(unpackNormal(0u), glm::vec3(0.0f));
 }
 
 INSTANTIATE_TEST_SUITE_P(RasterizePointsGLTest, RasterPathGLTest,

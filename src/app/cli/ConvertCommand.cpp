@@ -12,6 +12,7 @@
 #include "app/cli/CommandSupport.h"
 #include "app/cli/Commands.h"
 #include "core/Error.h"
+#include "core/NormalEstimation.h"
 #include "io/Las14Writer.h"
 #include "io/LasWriter.h"
 #include "io/PcdWriter.h"
@@ -28,6 +29,7 @@ namespace {
 struct ConvertOptions {
     std::string source;
     std::string output;
+    bool estimateNormals = false;
 };
 
 /// A format convert writes, and what of a cloud it can hold besides positions, colour and
@@ -154,6 +156,12 @@ int runConvert(const ConvertOptions& options) {
     }
     if (const RecordOutput kind = recordOutput(output, options.source);
         kind != RecordOutput::None) {
+        if (options.estimateNormals) {
+            throw Error(fmt::format(
+                "{}: --estimate-normals writes PLY, PCD or XYZ; LAS, LAZ and COPC output with "
+                "normals is not supported yet",
+                options.output));
+        }
         const std::uint64_t points = convertRecords(options.source, output, kind);
         fmt::print("{}: {} points written as {} (from {}), every attribute as LAS 1.4 holds it\n",
                    options.output, points,
@@ -164,7 +172,21 @@ int runConvert(const ConvertOptions& options) {
         return 0;
     }
     const OutputFormat& format = *outputFormat(output);  // the option's check accepted it
-    const LoadedScan scan = loadScanForCommand(options.source);
+    LoadedScan scan = loadScanForCommand(options.source);
+    if (options.estimateNormals) {
+        if (!format.normals) {
+            throw Error(
+                fmt::format("{}: {} cannot hold normals; --estimate-normals needs PLY, "
+                            "PCD or XYZ",
+                            options.output, format.name));
+        }
+        // In place of the file's own, if any: asked for, they are the estimate's.
+        std::optional<glm::vec3> sensor;
+        if (scan.sensor) {
+            sensor = glm::vec3(scan.sensor->position - scan.cloud.origin);
+        }
+        scan.cloud.normals = estimateNormals(scan.cloud, sensor);
+    }
     format.write(output, scan.cloud);
     warnAboutWhatIsNotWritten(options.output, format, scan.cloud);
     fmt::print("{}: {} points written as {} (from {})\n", options.output, scan.cloud.size(),
@@ -196,6 +218,9 @@ Command addConvertCommand(CLI::App& parent) {
                                          path, supportedExtensions());
             },
             "FILE");
+    convert->add_flag("--estimate-normals", options->estimateNormals,
+                      "Write normals estimated from each point's neighbours (PCA), facing the "
+                      "sensor where the file records one (PLY, PCD and XYZ output)");
     return {convert, [options] { return runConvert(*options); }};
 }
 

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "core/Error.h"
+#include "core/NormalEstimation.h"
 
 namespace subscan::viewer {
 
@@ -32,6 +33,9 @@ void ScanLoadJob::load() {
     try {
         PreparedScan prepared{source_, loadScan(source_, reportProgress), {}};
         prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
+        if (!prepared.scan.cloud.hasNormals()) {
+            prepared.normals = pointNormals(prepared.scan.cloud);
+        }
         result_ = std::move(prepared);
     } catch (const LoadCancelled&) {
         error_ = std::make_exception_ptr(Error(source_ + ": loading was cancelled"));

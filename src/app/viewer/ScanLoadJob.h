@@ -5,18 +5,22 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "core/LocalSpacing.h"
 #include "io/ScanLoader.h"
 
 namespace subscan::viewer {
 
-/// A scan as the viewer needs it: the cloud for the GPU upload and its spacing (h and the local
-/// spacing), both made off the render thread.
+/// A scan as the viewer needs it: the cloud for the GPU upload, its spacing (h and the local
+/// spacing) and normals, all made off the render thread.
 struct PreparedScan {
     std::string source;
     LoadedScan scan;
     PointSpacing spacing;  // estimatePointSpacing's result (h = 0: the renderer picks one)
+    std::vector<glm::vec3> normals;  // estimated where the cloud has none of its own (pointNormals)
 };
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)

@@ -413,6 +413,9 @@ void Viewer::finishLoading() {
         auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
         auto renderer =
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
+        if (!prepared.normals.empty()) {
+            renderer->setPointNormals(prepared.normals);
+        }
         renderer_ = std::move(renderer);
         scan_ = std::move(scan);
         scanColors_ = std::move(fileColors);

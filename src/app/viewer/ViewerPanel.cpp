@@ -27,6 +27,8 @@ constexpr Stage kStages[] = {Stage::Final,      Stage::Depth,   Stage::Pyramid,
                              Stage::Fill,       Stage::Normals, Stage::Shaded};
 constexpr RasterPath kRasterPaths[] = {RasterPath::Auto, RasterPath::Int64, RasterPath::TwoPass32};
 constexpr Resolution kResolutions[] = {Resolution::Full, Resolution::Half, Resolution::Auto};
+constexpr NormalSource kNormalSources[] = {NormalSource::Auto, NormalSource::Points,
+                                           NormalSource::Screen};
 constexpr std::pair<TimingMode, const char*> kTimings[] = {
     {TimingMode::Auto, "auto"},
     {TimingMode::GpuQueries, "GPU queries"},
@@ -397,8 +399,14 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
     ImGui::SliderFloat("fill radius (h)", &surface.fillRadius, 0.25f, 16.0f, "%.2f", kLogarithmic);
     helpTooltip("The expected gap between points; fill beyond it is background.");
     ImGui::SliderInt("fill directions", &surface.fillDirections, 1, 8);
+    choiceCombo<NormalSource>("normals", surface.normals, kNormalSources,
+                              [](NormalSource source) { return toString(source); });
+    helpTooltip(
+        "points: the points' own normals (the file's, else estimated at load), carried into the "
+        "gaps; screen: the paper's, rebuilt from the filled depth every frame; auto: points.");
     ImGui::SliderFloat("normal radius (h)", &surface.normalRadius, 0.25f, 16.0f, "%.2f",
                        kLogarithmic);
+    helpTooltip("Smoothing of the screen-space normals.");
     ImGui::Checkbox("local spacing", &surface.localSpacing);
     helpTooltip(
         "Radii scale with each point's own spacing where the scan's density varies (a LiDAR "
