@@ -52,7 +52,8 @@ EvaluationSettings viewsNearTheScanner(const SyntheticSource& source, int views,
 }
 
 TEST(LidarEvaluationGLTest, StationSourceGivesMetricsFromViewsNearTheStation) {
-    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     const EvaluationSettings settings = viewsNearTheScanner(source, 2, 96);
     ASSERT_EQ(settings.viewpoints.size(), 2u);
     // Each view's eye stands within 1.5 m of the station (1 m up, 1 m back).
@@ -77,7 +78,8 @@ TEST(LidarEvaluationGLTest, StationSourceGivesMetricsFromViewsNearTheStation) {
 TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
     // At 320 px the far ground's rings lie several pixels apart: the global h (the spacing
     // near the station) leaves them apart, the local spacing closes them.
-    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=100000");
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=100000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     const EvaluationSettings settings = viewsNearTheScanner(source, 2, 320);
     RenderSettings local;
     RenderSettings global;
@@ -97,7 +99,8 @@ TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
 }
 
 TEST(LidarEvaluationGLTest, OrbitViewsLookDownAtTheWholeStationScene) {
-    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     EvaluationSettings settings;
     settings.views = 4;
     adaptToScanner(settings, *source.scene, source.scanner, ViewsFrom::Orbit);
@@ -127,7 +130,8 @@ TEST(LidarEvaluationGLTest, OrbitViewsLookDownAtTheWholeStationScene) {
 TEST(LidarEvaluationGLTest, FromTheOrbitTheFillKeepsNearTheStationsPoints) {
     // Seen from above, the station's far ground is a few sparse rings: the fill must stay
     // within them, not run on past the outermost in blocks of coarse pyramid texels.
-    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=100000");
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=100000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     EvaluationSettings settings;
     settings.views = 2;
     settings.width = 320;
@@ -143,7 +147,8 @@ TEST(LidarEvaluationGLTest, FromTheOrbitTheFillKeepsNearTheStationsPoints) {
 }
 
 TEST(LidarEvaluationGLTest, OcclusionsAreJudgedByTheStationsSpacingWhereTheTruthIs) {
-    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     EvaluationSettings settings;
     settings.views = 1;
     adaptToScanner(settings, *source.scene, source.scanner, ViewsFrom::Orbit);
@@ -188,7 +193,8 @@ TEST(LidarEvaluationGLTest, OcclusionsAreJudgedByTheStationsSpacingWhereTheTruth
 }
 
 TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {
-    const SyntheticSource source = makeSyntheticSource("outdoor-airborne?points=2000");
+    SyntheticSource source = makeSyntheticSource("outdoor-airborne?points=2000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     EvaluationSettings settings;
     settings.views = 4;
     adaptToScanner(settings, *source.scene, source.scanner);
@@ -208,7 +214,8 @@ TEST(LidarEvaluationGLTest, AirborneTruthLeavesWallsAlongTheTrackUnsampled) {
 }
 
 TEST(LidarEvaluationGLTest, TemporalEvaluationFollowsTheScannersPath) {
-    const SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=30000");
+    source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     EvaluationSettings settings = viewsNearTheScanner(source, 4, 48);
     const Bounds bounds = source.scene->bounds();
     auto eyeOf = [&](const OrbitView& view) {

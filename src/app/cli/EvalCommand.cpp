@@ -49,6 +49,9 @@ int runEval(const EvalOptions& options) {
             SyntheticSource source = makeSyntheticSource(spec);
             truth = std::move(source.scene);
             points = std::move(source.points);
+            // The virtual scanner's normals are the truth's: the reconstruction must estimate
+            // its own, as from a real scanner's points.
+            points.normals.clear();
             scanner = source.scanner;
         } catch (const Error& error) {
             throw Error(fmt::format("{}: {}", options.source, error.what()));
