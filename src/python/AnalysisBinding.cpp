@@ -196,6 +196,8 @@ py::object evaluateMesh(const py::object& meshArgumentObject, const py::object& 
                 SyntheticSource synthetic = makeSyntheticSource(spec);
                 truth = std::move(synthetic.scene);
                 points = std::move(synthetic.points);
+                // The truth's normals: the reconstruction estimates its own (as `subscan eval`).
+                points.normals.clear();
                 adaptToScanner(evaluation, *truth, synthetic.scanner);
             } catch (const Error& error) {
                 throw Error(fmt::format("{}: {}", source, error.what()));

@@ -81,6 +81,8 @@ RenderSettings settingsArgument(const pybind11::handle& argument);
 UpAxis upAxisArgument(const std::string& up, const CloudData& cloud);
 
 /// ValueError naming `name` unless low <= value <= high (NaN is outside every range).
+/// A 3-vector from any sequence of 3 finite numbers; ValueError naming `name` otherwise.
+glm::dvec3 vectorArgument(const pybind11::handle& object, std::string_view name);
 void checkRange(double value, double low, double high, std::string_view name);
 
 /// The path of a str or os.PathLike argument.

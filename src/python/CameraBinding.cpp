@@ -42,18 +42,6 @@ Camera checked(const Camera& camera) {
     }
 }
 
-glm::dvec3 vectorArgument(const py::handle& object, std::string_view name) {
-    const auto array = py::array_t<double, py::array::forcecast>::ensure(object);
-    if (!array || array.ndim() != 1 || array.shape(0) != 3) {
-        throw py::value_error(fmt::format("{} must be 3 numbers", name));
-    }
-    const glm::dvec3 value(array.at(0), array.at(1), array.at(2));
-    if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z)) {
-        throw py::value_error(fmt::format("{} must be finite", name));
-    }
-    return value;
-}
-
 py::array_t<double> matrixOf(const glm::dmat4& matrix) {
     py::array_t<double> result(std::vector<py::ssize_t>{4, 4});
     auto out = result.mutable_unchecked<2>();

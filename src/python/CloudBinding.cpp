@@ -47,6 +47,18 @@ const Bounds& CloudData::framed() const {
     return framed_;
 }
 
+glm::dvec3 vectorArgument(const py::handle& object, std::string_view name) {
+    const auto array = py::array_t<double, py::array::forcecast>::ensure(object);
+    if (!array || array.ndim() != 1 || array.shape(0) != 3) {
+        throw py::value_error(fmt::format("{} must be 3 numbers", name));
+    }
+    const glm::dvec3 value(array.at(0), array.at(1), array.at(2));
+    if (!std::isfinite(value.x) || !std::isfinite(value.y) || !std::isfinite(value.z)) {
+        throw py::value_error(fmt::format("{} must be finite", name));
+    }
+    return value;
+}
+
 void checkRange(double value, double low, double high, std::string_view name) {
     if (!(value >= low && value <= high)) {
         throw py::value_error(fmt::format("{} {} is outside {}..{}", name, value, low, high));
@@ -771,6 +783,32 @@ Bad arrays (wrong shape, empty, NaN or infinite values, wrong types) raise Value
         .def_property_readonly("format", &CloudData::format,
                                "Where the cloud came from: the file format ('ply', 'las', "
                                "'pcd', 'xyz', 'e57', 'off'), 'synthetic', 'numpy' or 'open3d'.")
+        .def(
+            "estimate_normals",
+            [](const CloudData& self, const py::object& sensorArgument) {
+                PointCloud cloud = self.cloud();
+                std::optional<glm::vec3> sensor;
+                if (!sensorArgument.is_none()) {
+                    sensor = glm::vec3(vectorArgument(sensorArgument, "sensor") - cloud.origin);
+                } else if (self.sensor) {
+                    sensor = glm::vec3(self.sensor->position - cloud.origin);
+                }
+                {
+                    const py::gil_scoped_release release;
+                    cloud.normals = estimateNormals(cloud, sensor);
+                }
+                auto result = std::make_shared<CloudData>(std::move(cloud), self.format());
+                result->sensor = self.sensor;
+                result->grid = self.grid;
+                return result;
+            },
+            py::arg("sensor") = py::none(),
+            R"doc(A copy of this cloud with normals estimated from each point's nearest neighbours, as
+the renderer estimates them for a cloud without its own (PCA over the 12 to 64 neighbours the
+point's lie flattest in; in place of any the cloud has). They face `sensor` (x, y, z in the
+cloud's coordinates), else the sensor the file recorded (a PCD VIEWPOINT, an E57 pose); without
+either their sign is arbitrary. Clouds are immutable: use the returned one, e.g.
+cloud = cloud.estimate_normals().)doc")
         .def("__len__", [](const CloudData& self) { return self.cloud().size(); })
         .def("__repr__", [](const CloudData& self) {
             const PointCloud& cloud = self.cloud();
