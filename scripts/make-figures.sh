@@ -59,14 +59,14 @@ for kind in global local; do
     build/src/subscan render synthetic:outdoor-station --mode surface --view sensor --width 480 --height 360 "${settings[@]}" -o "$tmp/station-$kind.png"
 done
 side_by_side "$tmp/station-global.png" "$tmp/station-local.png" docs/images/local-spacing-station.png
-# The normals towards the outline: the bunny's mesh (the truth), its vertices' surface with the
-# normals as blended, and with them towards the outline.
+# The screen-space normals towards the outline: the bunny's mesh (the truth), its vertices'
+# surface with those normals as blended, and with them towards the outline.
 bunny="$data/bun_zipper.ply"
 if [[ -f "$bunny" ]]; then
-    echo '{"surface": {"outline_normals": false}}' >"$tmp/blended.json"
+    echo '{"surface": {"normals": "screen", "outline_normals": false}}' >"$tmp/blended.json"
+    echo '{"surface": {"normals": "screen"}}' >"$tmp/towards.json"
     for kind in blended towards; do
-        settings=()
-        [[ $kind == blended ]] && settings=(--settings "$tmp/blended.json")
+        settings=(--settings "$tmp/$kind.json")
         build/src/subscan eval "$bunny" --points vertices --width 256 --height 256 --views 1 "${settings[@]}" --export-views "$tmp/$kind" >/dev/null
     done
     side_by_side "$tmp/towards/view0_truth.png" "$tmp/blended/view0_surface.png" "$tmp/truth-blended.png"
