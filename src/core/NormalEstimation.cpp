@@ -74,12 +74,12 @@ std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
     }
     const PositionsAdaptor adaptor{positions};
     const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    constexpr std::size_t kLargest = kNormalNeighbourhoods.back();
+    constexpr std::size_t kMostNeighbours = kNormalNeighbourhoods.back();
     inParallel(positions.size(), [&](std::size_t i) {
-        std::array<std::uint32_t, kLargest> indices{};
-        std::array<float, kLargest> squared{};
+        std::array<std::uint32_t, kMostNeighbours> indices{};
+        std::array<float, kMostNeighbours> squared{};
         const std::size_t found =
-            tree.knnSearch(&positions[i].x, kLargest, indices.data(), squared.data());
+            tree.knnSearch(&positions[i].x, kMostNeighbours, indices.data(), squared.data());
         glm::vec3 normal = flattestPlaneNormal(positions, indices.data(), found);
         if (sensor && glm::dot(normal, *sensor - positions[i]) < 0.0f) {
             normal = -normal;

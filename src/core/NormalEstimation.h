@@ -30,6 +30,12 @@ inline constexpr std::array<std::size_t, 6> kNormalNeighbourhoods = {12, 16, 24,
 std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
                                        const std::optional<glm::vec3>& sensor = std::nullopt);
 
+/// Up to this many points a cloud without normals of its own gets them estimated when it is
+/// loaded for rendering (about 4 s for 1.1 M points on two cores, bench/README.md); larger ones
+/// keep the screen-space normals unless the settings ask for the points' (`surface.normals:
+/// points`), so that opening a survey does not wait minutes for them.
+inline constexpr std::size_t kAlwaysEstimateNormalsPoints = 2'000'000;
+
 /// The normals the renderer draws the cloud with: the file's where it has them, else
 /// estimateNormals() towards `sensor` (file coordinates) where one is known.
 std::vector<glm::vec3> pointNormals(const PointCloud& cloud,

@@ -16,7 +16,6 @@
 #include <glm/vec3.hpp>
 #include <nlohmann/json.hpp>
 
-#include "core/NormalEstimation.h"
 #include "core/Parallel.h"
 #include "eval/GroundTruth.h"
 #include "gpu/ShaderSources.h"
@@ -224,9 +223,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
                           const EvaluationSettings& settings, const RenderSettings& render) {
     const PointSpacing pointSpacing = estimatePointSpacing(points);
     Renderer renderer(context, points, pointSpacing);
-    if (!points.hasNormals()) {
-        renderer.setPointNormals(pointNormals(points));
-    }
+    renderer.prepareNormals(points, render.surface.normals);
     ImageShader shader(context, renderer.gpuCloud());
     const double h = renderer.spacing();
     std::optional<SpacingAtTruth> spacingAtTruth;

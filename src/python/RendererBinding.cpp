@@ -14,6 +14,7 @@
 
 #include "core/Coloring.h"
 #include "core/Error.h"
+#include "core/NormalEstimation.h"
 #include "gpu/GlContext.h"
 #include "python/Bindings.h"
 #include "render/FrameBuffers.h"
@@ -87,7 +88,9 @@ class RendererState {
         // allows (the Cloud is immutable and kept alive here): no 160 MB copy for 10 M points.
         renderer_ = std::make_unique<Renderer>(*context_, cloud->cloud(), cloud->pointSpacing(), 0,
                                                PointMemory::Borrow);
-        if (!cloud->cloud().hasNormals()) {
+        // As Renderer::prepareNormals does for `auto` (the CLI's default), estimated once per
+        // Cloud.
+        if (!cloud->cloud().hasNormals() && cloud->cloud().size() <= kAlwaysEstimateNormalsPoints) {
             renderer_->setPointNormals(cloud->estimatedNormals());
         }
         if (!ownColors) {

@@ -40,7 +40,14 @@ double FrameResult::totalMilliseconds() const {
 Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<double> spacing,
                    std::size_t maxChunkPoints, PointMemory memory)
     : Renderer(context, cloud, estimatePointSpacing(cloud, spacing), maxChunkPoints, memory) {
-    if (!cloud.hasNormals()) {
+    prepareNormals(cloud, NormalSource::Auto);
+}
+
+void Renderer::prepareNormals(const PointCloud& cloud, NormalSource requested) {
+    const bool wanted =
+        requested == NormalSource::Points ||
+        (requested == NormalSource::Auto && cloud.size() <= kAlwaysEstimateNormalsPoints);
+    if (wanted && !cloud_.hasNormals()) {
         setPointNormals(pointNormals(cloud));
     }
 }

@@ -49,8 +49,8 @@ class Renderer {
   public:
     /// `spacing` overrides the estimated point spacing h; `maxChunkPoints` and `memory` see
     /// GpuPointCloud (PointMemory::Borrow: `cloud` outlives the renderer unchanged). The local
-    /// spacing is estimated as estimatePointSpacing says, and normals (pointNormals) where the
-    /// cloud has none.
+    /// spacing is estimated as estimatePointSpacing says, and normals as prepareNormals(cloud,
+    /// NormalSource::Auto) says.
     Renderer(GlContext& context, const PointCloud& cloud,
              std::optional<double> spacing = std::nullopt, std::size_t maxChunkPoints = 0,
              PointMemory memory = PointMemory::Copy);
@@ -80,6 +80,10 @@ class Renderer {
     /// Gives the points normals (one per point, unit or 0 for none): NormalSource::Auto then
     /// uses them.
     void setPointNormals(const std::vector<glm::vec3>& normals) { cloud_.setNormals(normals); }
+    /// Estimates normals (pointNormals) for `cloud`, the one the renderer was made for, where it
+    /// has none and `requested` wants them: Points always, Auto up to
+    /// kAlwaysEstimateNormalsPoints points. Nothing where the renderer has normals already.
+    void prepareNormals(const PointCloud& cloud, NormalSource requested);
     /// `settings` with SurfaceSettings::normals resolved for this cloud: Auto becomes Points
     /// where the cloud has normals, else Screen, and so does Points without them (the passes
     /// see no Auto).

@@ -33,7 +33,9 @@ void ScanLoadJob::load() {
     try {
         PreparedScan prepared{source_, loadScan(source_, reportProgress), {}};
         prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
-        if (!prepared.scan.cloud.hasNormals()) {
+        // As Renderer::prepareNormals does for `auto`, here off the render thread.
+        if (!prepared.scan.cloud.hasNormals() &&
+            prepared.scan.cloud.size() <= kAlwaysEstimateNormalsPoints) {
             prepared.normals = pointNormals(prepared.scan.cloud);
         }
         result_ = std::move(prepared);
