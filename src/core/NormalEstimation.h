@@ -17,8 +17,9 @@ namespace subscan {
 /// Pauly et al. 2002), which is a large one on a noisy flat part and a small one on a curved
 /// clean part. Measured through `eval` at 1024² (bench/README.md, "Normals that belong to the
 /// points"): a fixed 16 gave 3.7 degrees mean on the bunny's vertices and 5.5 on its range
-/// scans, these sizes 3.4 and 3.5.
-inline constexpr std::array<std::size_t, 6> kNormalNeighbourhoods = {12, 16, 24, 32, 48, 64};
+/// scans, these sizes 3.4 and 3.9; adding 64 gives 3.4 and 3.5 but costs a third more time
+/// (the search for the largest is three quarters of it).
+inline constexpr std::array<std::size_t, 5> kNormalNeighbourhoods = {12, 16, 24, 32, 48};
 
 /// Per point, the unit normal of the plane through its nearest points in the least-squares
 /// sense: the eigenvector of their covariance with the smallest eigenvalue (principal component
@@ -31,7 +32,7 @@ std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
                                        const std::optional<glm::vec3>& sensor = std::nullopt);
 
 /// Up to this many points a cloud without normals of its own gets them estimated when it is
-/// loaded for rendering (about 4 s for 1.1 M points on two cores, bench/README.md); larger ones
+/// loaded for rendering (about 3 s for 1.1 M points on two cores, bench/README.md); larger ones
 /// keep the screen-space normals unless the settings ask for the points' (`surface.normals:
 /// points`), so that opening a survey does not wait minutes for them.
 inline constexpr std::size_t kAlwaysEstimateNormalsPoints = 2'000'000;

@@ -804,7 +804,7 @@ Bad arrays (wrong shape, empty, NaN or infinite values, wrong types) raise Value
             },
             py::arg("sensor") = py::none(),
             R"doc(A copy of this cloud with normals estimated from each point's nearest neighbours, as
-the renderer estimates them for a cloud without its own (PCA over the 12 to 64 neighbours the
+the renderer estimates them for a cloud without its own (PCA over the 12 to 48 neighbours the
 point's lie flattest in; in place of any the cloud has). They face `sensor` (x, y, z in the
 cloud's coordinates), else the sensor the file recorded (a PCD VIEWPOINT, an E57 pose); without
 either their sign is arbitrary. Clouds are immutable: use the returned one, e.g.
