@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -260,10 +261,69 @@ std::uint8_t toColorChannel(const std::byte* p) {
     }
 }
 
+/// Where a record's normal lies among its extra bytes: PDAL's float (or double) fields
+/// NormalX, NormalY and NormalZ, as `subscan index` and `convert` write them.
+struct NormalFields {
+    std::array<std::size_t, 3> offsets{};  // from the record's start
+    bool doubles = false;
+};
+
+/// The extra bytes VLR's fields (LAS 1.4 R15, section 2.6.3: 192-byte descriptors, each field's
+/// size from its data type, or from `options` for type 0), the normal's where all three are
+/// there as plain floats or doubles (no scale or offset) inside the record; else nullopt.
+std::optional<NormalFields> findNormalFields(std::span<const std::byte> file,
+                                             const LasHeader& header) {
+    constexpr std::string_view kSpecUserId = "LASF_Spec";
+    constexpr std::uint16_t kExtraBytesRecordId = 4;
+    constexpr std::size_t kDescriptorSize = 192;
+    constexpr std::size_t kTypeSizes[] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
+    const std::optional<std::span<const std::byte>> vlr =
+        findLasVlr(file, header, kSpecUserId, kExtraBytesRecordId);
+    if (!vlr) {
+        return std::nullopt;
+    }
+    std::size_t offset = kLasPointFormats[header.pointFormat].recordSize;
+    std::array<std::optional<std::size_t>, 3> found;
+    std::array<std::uint8_t, 3> types{};
+    for (std::size_t at = 0; at + kDescriptorSize <= vlr->size(); at += kDescriptorSize) {
+        const std::byte* descriptor = vlr->data() + at;
+        const auto type = std::to_integer<std::uint8_t>(descriptor[2]);
+        const auto options = std::to_integer<std::uint8_t>(descriptor[3]);
+        const char* name = reinterpret_cast<const char*>(descriptor + 4);
+        const std::string_view field(name, strnlen(name, 32));
+        if (type >= std::size(kTypeSizes)) {
+            return std::nullopt;  // a deprecated array type: the later offsets are unknown
+        }
+        const std::size_t size = type == 0 ? options : kTypeSizes[type];
+        constexpr std::uint8_t kScaleOrOffset = 0x18;  // options bits 3 and 4
+        for (int axis = 0; axis < 3; ++axis) {
+            if (field == std::array{"NormalX", "NormalY", "NormalZ"}[axis] &&
+                (type == 9 || type == 10) && (options & kScaleOrOffset) == 0) {
+                found[axis] = offset;
+                types[axis] = type;
+            }
+        }
+        offset += size;
+    }
+    if (!found[0] || !found[1] || !found[2] || types[0] != types[1] || types[1] != types[2]) {
+        return std::nullopt;
+    }
+    NormalFields fields;
+    fields.doubles = types[0] == 10;
+    for (int axis = 0; axis < 3; ++axis) {
+        fields.offsets[axis] = *found[axis];
+        if (*found[axis] + (fields.doubles ? 8 : 4) > header.recordLength) {
+            return std::nullopt;  // a descriptor beyond the record: not what it claims
+        }
+    }
+    return fields;
+}
+
 /// The hot loop: the caller has checked that all `count` records lie inside the file.
 template <ColorDepth depth>
 void decodePoints(const std::byte* points, std::size_t count, const LasHeader& header,
-                  std::size_t colorOffset, PointCloudBuilder& builder, const ReadContext& context) {
+                  std::size_t colorOffset, const std::optional<NormalFields>& normal,
+                  PointCloudBuilder& builder, const ReadContext& context) {
     constexpr std::size_t kProgressEvery = 1 << 16;
     const std::size_t stride = header.recordLength;
     const ClassificationField classification = classificationField(header.pointFormat);
@@ -281,6 +341,15 @@ void decodePoints(const std::byte* points, std::size_t count, const LasHeader& h
             const std::byte* rgb = p + colorOffset;
             record.color = {toColorChannel<depth>(rgb), toColorChannel<depth>(rgb + 2),
                             toColorChannel<depth>(rgb + 4), 255};
+        }
+        if (normal) {
+            for (int axis = 0; axis < 3; ++axis) {
+                const std::byte* field = p + normal->offsets[axis];
+                record.normal[axis] =
+                    normal->doubles ? saturateToFloat(std::bit_cast<double>(
+                                          loadLittleEndian<std::uint64_t>(field)))
+                                    : std::bit_cast<float>(loadLittleEndian<std::uint32_t>(field));
+            }
         }
         builder.add(record);
         if (i % kProgressEvery == 0) {
@@ -430,8 +499,10 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
     const ColorDepth depth =
         colorOffset ? detectColorDepth(points, count, header.recordLength, *colorOffset)
                     : ColorDepth::None;
+    const std::optional<NormalFields> normal = findNormalFields(file, header);
     PointAttributes attributes;
     attributes.color = colorOffset.has_value();
+    attributes.normal = normal.has_value();
     attributes.intensity = true;
     attributes.classification = true;
     PointCloudBuilder builder(attributes, count);
@@ -440,15 +511,16 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
     const ReadContext& recordContext = header.laszipRecord ? silent : context;
     switch (depth) {
         case ColorDepth::None:
-            decodePoints<ColorDepth::None>(points, count, header, 0, builder, recordContext);
+            decodePoints<ColorDepth::None>(points, count, header, 0, normal, builder,
+                                           recordContext);
             break;
         case ColorDepth::EightBit:
-            decodePoints<ColorDepth::EightBit>(points, count, header, *colorOffset, builder,
+            decodePoints<ColorDepth::EightBit>(points, count, header, *colorOffset, normal, builder,
                                                recordContext);
             break;
         case ColorDepth::SixteenBit:
-            decodePoints<ColorDepth::SixteenBit>(points, count, header, *colorOffset, builder,
-                                                 recordContext);
+            decodePoints<ColorDepth::SixteenBit>(points, count, header, *colorOffset, normal,
+                                                 builder, recordContext);
             break;
     }
     context.reportProgress(count, count);

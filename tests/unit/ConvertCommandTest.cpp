@@ -1,10 +1,13 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numbers>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <unistd.h>
 
@@ -90,6 +93,39 @@ TEST(ConvertCommandTest, EstimatedNormalsReplaceTheFilesAndFollowTheSurface) {
     EXPECT_EQ(test::lineCount(refused.err), 1u) << refused.err;
     EXPECT_THAT(refused.err, HasSubstr("cannot hold normals"));
     EXPECT_FALSE(std::filesystem::exists(las));
+}
+
+TEST(ConvertCommandTest, NormalsSurviveLazAndCopcAsPdalsExtraBytes) {
+    // LAZ and COPC from a cloud with normals hold them as the float extra bytes NormalX, NormalY
+    // and NormalZ (PDAL's names); the LAS reader finds them by their descriptors. Floats stored
+    // as they are: equal bit for bit.
+    const test::TempDir dir;
+    const std::string source = "synthetic:sphere?points=2000";
+    const LoadedScan original = loadScan(source);
+    ASSERT_TRUE(original.cloud.hasNormals());
+    const auto ply = dir / "sphere.ply";
+    convert(source, ply);
+    for (const std::string name : {"sphere.laz", "sphere.copc.laz"}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / name;
+        convert(ply.string(), output);
+        const LoadedScan read = loadScan(output.string());
+        ASSERT_EQ(read.cloud.size(), original.cloud.size());
+        // COPC reorders the points by node: the same normals as a multiset, each still with
+        // its point: the sphere's are radial (the unit sphere about the origin; positions at
+        // the file's scale, far finer than 1e-4).
+        const auto lexicographic = [](const glm::vec3& l, const glm::vec3& r) {
+            return std::tie(l.x, l.y, l.z) < std::tie(r.x, r.y, r.z);
+        };
+        std::vector<glm::vec3> expected = original.cloud.normals, got = read.cloud.normals;
+        std::sort(expected.begin(), expected.end(), lexicographic);
+        std::sort(got.begin(), got.end(), lexicographic);
+        EXPECT_EQ(got, expected);
+        for (std::size_t i = 0; i < read.cloud.size(); ++i) {
+            const glm::dvec3 radial = glm::normalize(read.cloud.fileCoordinates(i));
+            ASSERT_LT(glm::length(glm::dvec3(read.cloud.normals[i]) - radial), 1e-4) << i;
+        }
+    }
 }
 
 TEST(ConvertCommandTest, RealLasToEveryFormatKeepsPointsAndColours) {
