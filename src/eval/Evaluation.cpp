@@ -348,10 +348,17 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
                                 const EvaluationSettings& settings,
                                 const TemporalEvaluationSettings& temporal,
                                 const RenderSettings& render) {
-    Renderer renderer(context, points);
+    const PointSpacing spacing = estimatePointSpacing(points);
+    Renderer renderer(context, points, spacing);
     // Their own renderers, so the filter's histories run on undisturbed by the other methods.
-    Renderer filtered(context, points);
-    Renderer converged(context, points);
+    Renderer filtered(context, points, spacing);
+    Renderer converged(context, points, spacing);
+    if (const std::vector<glm::vec3> normals = normalsFor(points, render.surface.normals);
+        !normals.empty()) {
+        for (Renderer* each : {&renderer, &filtered, &converged}) {
+            each->setPointNormals(normals);
+        }
+    }
     ImageShader shader(context, renderer.gpuCloud());
     RenderSettings surfaceSettings = render;
     surfaceSettings.raster.mode = RenderMode::Surface;

@@ -80,9 +80,9 @@ RenderSettings settingsArgument(const pybind11::handle& argument);
 /// (upAxisFor: auto is Z for LAS-family files); ValueError for any other name.
 UpAxis upAxisArgument(const std::string& up, const CloudData& cloud);
 
-/// ValueError naming `name` unless low <= value <= high (NaN is outside every range).
 /// A 3-vector from any sequence of 3 finite numbers; ValueError naming `name` otherwise.
 glm::dvec3 vectorArgument(const pybind11::handle& object, std::string_view name);
+/// ValueError naming `name` unless low <= value <= high (NaN is outside every range).
 void checkRange(double value, double low, double high, std::string_view name);
 
 /// The path of a str or os.PathLike argument.

@@ -43,12 +43,18 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
     prepareNormals(cloud, NormalSource::Auto);
 }
 
-void Renderer::prepareNormals(const PointCloud& cloud, NormalSource requested) {
+std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested) {
     const bool wanted =
         requested == NormalSource::Points ||
         (requested == NormalSource::Auto && cloud.size() <= kAlwaysEstimateNormalsPoints);
-    if (wanted && !cloud_.hasNormals()) {
-        setPointNormals(pointNormals(cloud));
+    return wanted && !cloud.hasNormals() ? pointNormals(cloud) : std::vector<glm::vec3>();
+}
+
+void Renderer::prepareNormals(const PointCloud& cloud, NormalSource requested) {
+    if (!cloud_.hasNormals()) {
+        if (std::vector<glm::vec3> normals = normalsFor(cloud, requested); !normals.empty()) {
+            setPointNormals(normals);
+        }
     }
 }
 

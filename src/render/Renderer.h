@@ -35,6 +35,12 @@ class SubsurfaceScatteringPass;
 class SingleScatteringPass;
 class PresentPass;
 
+/// The normals a renderer of `cloud` needs estimated (pointNormals) for `requested`: where the
+/// cloud has none of its own, for Points always, for Auto up to kAlwaysEstimateNormalsPoints
+/// points; else none (empty). Seconds for millions of points: callers that make several
+/// renderers of one cloud estimate once and give each setPointNormals.
+std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested);
+
 struct FrameResult {
     std::vector<PassTiming> passes;
     int divisor = 1;  // output pixels per pipeline pixel and side (RasterSettings::resolution)
@@ -80,9 +86,8 @@ class Renderer {
     /// Gives the points normals (one per point, unit or 0 for none): NormalSource::Auto then
     /// uses them.
     void setPointNormals(const std::vector<glm::vec3>& normals) { cloud_.setNormals(normals); }
-    /// Estimates normals (pointNormals) for `cloud`, the one the renderer was made for, where it
-    /// has none and `requested` wants them: Points always, Auto up to
-    /// kAlwaysEstimateNormalsPoints points. Nothing where the renderer has normals already.
+    /// Gives the renderer normalsFor(cloud, requested), `cloud` being the one it was made for,
+    /// unless it has normals already.
     void prepareNormals(const PointCloud& cloud, NormalSource requested);
     /// `settings` with SurfaceSettings::normals resolved for this cloud: Auto becomes Points
     /// where the cloud has normals, else Screen, and so does Points without them (the passes

@@ -120,9 +120,13 @@ double median(std::vector<double> values) {
 /// One mode along the camera path: a renderer and settings of its own, so that the memory it
 /// reports is this mode's alone, and its frame and pass times.
 struct ModeRun {
-    ModeRun(GlContext& context, const PointCloud& cloud, RenderSettings modeSettings,
+    ModeRun(GlContext& context, const PointCloud& cloud, const PointSpacing& spacing,
+            const std::vector<glm::vec3>& normals, RenderSettings modeSettings,
             const BenchMode& mode)
-        : settings(std::move(modeSettings)), renderer(context, cloud) {
+        : settings(std::move(modeSettings)), renderer(context, cloud, spacing) {
+        if (!normals.empty()) {
+            renderer.setPointNormals(normals);
+        }
         settings.raster.mode = mode.mode;
         settings.raster.stage = Stage::Final;
         if (mode.method) {
@@ -240,8 +244,12 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
                              45.0);
     };
     std::vector<std::unique_ptr<ModeRun>> runs;
+    // Once for every mode's renderer.
+    const PointSpacing spacing = estimatePointSpacing(scan.cloud);
+    const std::vector<glm::vec3> normals = normalsFor(scan.cloud, settings.surface.normals);
     for (const BenchMode& mode : modes) {
-        runs.push_back(std::make_unique<ModeRun>(context, scan.cloud, settings, mode));
+        runs.push_back(
+            std::make_unique<ModeRun>(context, scan.cloud, spacing, normals, settings, mode));
         for (int frame = 0; frame < options.warmup; ++frame) {
             runs.back()->render(cameraAt(frame * options.frames / std::max(options.warmup, 1)));
         }

@@ -131,7 +131,8 @@ int runRender(const RenderOptions& options) {
     const Camera camera = frame.camera(scan);
     const std::unique_ptr<GlContext> context = frame.context();
     // `scan` outlives the renderer unchanged: the GPU may read its points in place.
-    Renderer renderer(*context, scan.cloud, std::nullopt, 0, PointMemory::Borrow);
+    Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud), 0,
+                      PointMemory::Borrow);
     renderer.prepareNormals(scan.cloud, settings.surface.normals);
     // The radiance of a linear picture is one of the buffers the picture alone does not keep.
     const FrameOutputs outputs = options.exportDirectory.empty() && !linearPicture

@@ -158,7 +158,8 @@ int runTurntable(const TurntableOptions& options) {
 
     const std::unique_ptr<GlContext> context = frame.context();
     // `scan` outlives the renderer unchanged: the GPU may read its points in place.
-    Renderer renderer(*context, scan.cloud, std::nullopt, 0, PointMemory::Borrow);
+    Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud), 0,
+                      PointMemory::Borrow);
     renderer.prepareNormals(scan.cloud, settings.surface.normals);
     std::optional<FrameFolder> temporary;
     std::filesystem::path folder = output;

@@ -36,7 +36,12 @@ void ScanLoadJob::load() {
         // As Renderer::prepareNormals does for `auto`, here off the render thread.
         if (!prepared.scan.cloud.hasNormals() &&
             prepared.scan.cloud.size() <= kAlwaysEstimateNormalsPoints) {
-            prepared.normals = pointNormals(prepared.scan.cloud);
+            prepared.normals = pointNormals(prepared.scan.cloud, std::nullopt, [this] {
+                return cancelled_.load(std::memory_order_relaxed);
+            });
+            if (cancelled_.load(std::memory_order_relaxed)) {
+                throw LoadCancelled{};
+            }
         }
         result_ = std::move(prepared);
     } catch (const LoadCancelled&) {

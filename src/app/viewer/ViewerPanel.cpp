@@ -402,8 +402,10 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
     choiceCombo<NormalSource>("normals", surface.normals, kNormalSources,
                               [](NormalSource source) { return toString(source); });
     helpTooltip(
-        "points: the points' own normals (the file's, else estimated at load), carried into the "
-        "gaps; screen: the paper's, rebuilt from the filled depth every frame; auto: points.");
+        "points: the points' own normals (the file's, else estimated at load for clouds of up "
+        "to 2 M points), carried into the gaps; screen: the paper's, rebuilt from the filled "
+        "depth every frame. auto and points: the points' where the scan has them, else the "
+        "screen's.");
     ImGui::SliderFloat("normal radius (h)", &surface.normalRadius, 0.25f, 16.0f, "%.2f",
                        kLogarithmic);
     helpTooltip("Smoothing of the screen-space normals.");

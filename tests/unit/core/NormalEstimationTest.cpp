@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -235,6 +237,26 @@ TEST(NormalEstimationTest, PointsOnALineOrRepeatedHaveNoNormal) {
     const std::vector<glm::vec3> two = estimateNormals(cloudOf({{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}}));
     ASSERT_EQ(two.size(), 2u);
     EXPECT_EQ(two[0], glm::vec3(0.0f));
+}
+
+TEST(NormalEstimationTest, ACancelledEstimateStops) {
+    // The viewer's load job cancels an estimate nobody waits for: a thread stops at its next look
+    // at the shared flag, which the first sets on its first query.
+    const PointCloud cloud =
+        cloudOf(noisyPlane({0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, 250, 1.0, 0.0, 4));
+    const auto estimatedIn = [](const std::vector<glm::vec3>& normals) {
+        return std::count_if(normals.begin(), normals.end(),
+                             [](const glm::vec3& n) { return n != glm::vec3(0.0f); });
+    };
+    std::atomic<int> asked{0};
+    const std::vector<glm::vec3> stopped =
+        estimateNormals(cloud, std::nullopt, [&asked] { return ++asked > 0; });
+    ASSERT_EQ(stopped.size(), cloud.size());
+    EXPECT_GE(asked.load(), 1);
+    // Another thread looks at the flag on every query, but may have begun before it was set and
+    // asks itself only every 16384 queries: a few of its 62,500 / threads at most.
+    EXPECT_LT(estimatedIn(stopped), static_cast<std::ptrdiff_t>(cloud.size() / 10));
+    EXPECT_EQ(estimatedIn(estimateNormals(cloud)), static_cast<std::ptrdiff_t>(cloud.size()));
 }
 
 TEST(NormalEstimationTest, TheFilesNormalsComeFirst) {
