@@ -74,12 +74,16 @@ glm::vec3 flattestPlaneNormal(const std::vector<glm::vec3>& positions, const std
 }  // namespace
 
 std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
-                                       const std::optional<glm::vec3>& sensor,
+                                       const std::optional<glm::dvec3>& sensor,
                                        const std::function<bool()>& cancelled) {
     const std::vector<glm::vec3>& positions = cloud.positions;
     std::vector<glm::vec3> normals(positions.size(), glm::vec3(0.0f));
     if (positions.size() < 3) {
         return normals;
+    }
+    std::optional<glm::vec3> sensorInCloud;  // where the positions are relative to the origin
+    if (sensor) {
+        sensorInCloud = glm::vec3(*sensor - cloud.origin);
     }
     const PositionsAdaptor adaptor{positions};
     const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
@@ -100,25 +104,12 @@ std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
         const std::size_t found =
             tree.knnSearch(&positions[i].x, kMostNeighbours, indices.data(), squared.data());
         glm::vec3 normal = flattestPlaneNormal(positions, indices.data(), found);
-        if (sensor && glm::dot(normal, *sensor - positions[i]) < 0.0f) {
+        if (sensorInCloud && glm::dot(normal, *sensorInCloud - positions[i]) < 0.0f) {
             normal = -normal;
         }
         normals[i] = normal;
     });
     return normals;
-}
-
-std::vector<glm::vec3> pointNormals(const PointCloud& cloud,
-                                    const std::optional<glm::dvec3>& sensor,
-                                    const std::function<bool()>& cancelled) {
-    if (cloud.hasNormals()) {
-        return cloud.normals;
-    }
-    std::optional<glm::vec3> sensorInCloud;
-    if (sensor) {
-        sensorInCloud = glm::vec3(*sensor - cloud.origin);
-    }
-    return estimateNormals(cloud, sensorInCloud, cancelled);
 }
 
 }  // namespace subscan

@@ -27,12 +27,12 @@ inline constexpr std::array<std::size_t, 5> kNormalNeighbourhoods = {12, 16, 24,
 /// analysis, Hoppe et al. 1992), over the neighbourhood of kNormalNeighbourhoods they lie
 /// flattest in. Where the neighbours determine no plane (fewer than 3 distinct points, or all
 /// on one line) the normal is 0.
-/// Oriented towards `sensor` (cloud coordinates, i.e. relative to `cloud.origin`) where one is
-/// known; else its sign is arbitrary and the renderer faces it to the eye. Runs on every core.
+/// Oriented towards `sensor` (file coordinates) where one is known; else its sign is arbitrary
+/// and the renderer faces it to the eye. Runs on every core.
 /// `cancelled` (may be empty) is asked now and then, from any thread; once it says yes the
 /// work stops and the result is incomplete.
 std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
-                                       const std::optional<glm::vec3>& sensor = std::nullopt,
+                                       const std::optional<glm::dvec3>& sensor = std::nullopt,
                                        const std::function<bool()>& cancelled = {});
 
 /// Up to this many points a cloud without normals of its own gets them estimated when it is
@@ -41,11 +41,5 @@ std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
 /// points`, which `render`, `turntable`, `bench` and `eval` honour whatever the size), so that
 /// opening a survey does not wait minutes for them.
 inline constexpr std::size_t kAlwaysEstimateNormalsPoints = 2'000'000;
-
-/// The normals the renderer draws the cloud with: the file's where it has them, else
-/// estimateNormals() towards `sensor` (file coordinates) where one is known.
-std::vector<glm::vec3> pointNormals(const PointCloud& cloud,
-                                    const std::optional<glm::dvec3>& sensor = std::nullopt,
-                                    const std::function<bool()>& cancelled = {});
 
 }  // namespace subscan

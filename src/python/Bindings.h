@@ -36,8 +36,9 @@ class CloudData {
     /// estimatePointSpacing with that h: the local spacing too where the renderer wants it,
     /// computed once for every Renderer of this cloud (call without the GIL).
     const PointSpacing& pointSpacing() const;
-    /// pointNormals(cloud()) for a cloud without normals of its own, computed once for every
-    /// Renderer of this cloud, as the CLI's renderer estimates them (call without the GIL).
+    /// normalsFor(cloud(), NormalSource::Auto): the normals the CLI's renderer estimates by
+    /// default (none where the cloud has its own, or is too large), computed once for every
+    /// Renderer of this cloud (call without the GIL).
     const std::vector<glm::vec3>& estimatedNormals() const;
 
     /// framingBounds(cloud()), computed on the first call (a pass over a sample of the points:

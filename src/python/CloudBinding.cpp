@@ -19,6 +19,7 @@
 #include "core/Spacing.h"
 #include "io/ScanLoader.h"
 #include "python/Bindings.h"
+#include "render/Renderer.h"
 
 namespace py = pybind11;
 
@@ -38,7 +39,8 @@ const PointSpacing& CloudData::pointSpacing() const {
 }
 
 const std::vector<glm::vec3>& CloudData::estimatedNormals() const {
-    std::call_once(normalsOnce_, [this] { estimatedNormals_ = pointNormals(cloud_); });
+    std::call_once(normalsOnce_,
+                   [this] { estimatedNormals_ = normalsFor(cloud_, NormalSource::Auto); });
     return estimatedNormals_;
 }
 
@@ -787,11 +789,11 @@ Bad arrays (wrong shape, empty, NaN or infinite values, wrong types) raise Value
             "estimate_normals",
             [](const CloudData& self, const py::object& sensorArgument) {
                 PointCloud cloud = self.cloud();
-                std::optional<glm::vec3> sensor;
+                std::optional<glm::dvec3> sensor;
                 if (!sensorArgument.is_none()) {
-                    sensor = glm::vec3(vectorArgument(sensorArgument, "sensor") - cloud.origin);
+                    sensor = vectorArgument(sensorArgument, "sensor");
                 } else if (self.sensor) {
-                    sensor = glm::vec3(self.sensor->position - cloud.origin);
+                    sensor = self.sensor->position;
                 }
                 {
                     const py::gil_scoped_release release;

@@ -90,8 +90,8 @@ class RendererState {
                                                PointMemory::Borrow);
         // As Renderer::prepareNormals does for `auto` (the CLI's default), estimated once per
         // Cloud.
-        if (!cloud->cloud().hasNormals() && cloud->cloud().size() <= kAlwaysEstimateNormalsPoints) {
-            renderer_->setPointNormals(cloud->estimatedNormals());
+        if (const std::vector<glm::vec3>& normals = cloud->estimatedNormals(); !normals.empty()) {
+            renderer_->setPointNormals(normals);
         }
         if (!ownColors) {
             renderer_->setColors(colors);

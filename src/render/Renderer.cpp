@@ -43,11 +43,13 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, std::optional<do
     prepareNormals(cloud, NormalSource::Auto);
 }
 
-std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested) {
+std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested,
+                                  const std::function<bool()>& cancelled) {
     const bool wanted =
         requested == NormalSource::Points ||
         (requested == NormalSource::Auto && cloud.size() <= kAlwaysEstimateNormalsPoints);
-    return wanted && !cloud.hasNormals() ? pointNormals(cloud) : std::vector<glm::vec3>();
+    return wanted && !cloud.hasNormals() ? estimateNormals(cloud, std::nullopt, cancelled)
+                                         : std::vector<glm::vec3>();
 }
 
 void Renderer::prepareNormals(const PointCloud& cloud, NormalSource requested) {

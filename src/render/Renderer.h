@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -35,11 +36,13 @@ class SubsurfaceScatteringPass;
 class SingleScatteringPass;
 class PresentPass;
 
-/// The normals a renderer of `cloud` needs estimated (pointNormals) for `requested`: where the
+/// The normals a renderer of `cloud` needs estimated (estimateNormals) for `requested`: where the
 /// cloud has none of its own, for Points always, for Auto up to kAlwaysEstimateNormalsPoints
 /// points; else none (empty). Seconds for millions of points: callers that make several
 /// renderers of one cloud estimate once and give each setPointNormals.
-std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested);
+/// `cancelled` as estimateNormals takes it.
+std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested,
+                                  const std::function<bool()>& cancelled = {});
 
 struct FrameResult {
     std::vector<PassTiming> passes;

@@ -181,9 +181,9 @@ int runConvert(const ConvertOptions& options) {
                             options.output, format.name));
         }
         // In place of the file's own, if any: asked for, they are the estimate's.
-        std::optional<glm::vec3> sensor;
+        std::optional<glm::dvec3> sensor;
         if (scan.sensor) {
-            sensor = glm::vec3(scan.sensor->position - scan.cloud.origin);
+            sensor = scan.sensor->position;
         }
         scan.cloud.normals = estimateNormals(scan.cloud, sensor);
     }

@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "core/Error.h"
-#include "core/NormalEstimation.h"
+#include "render/Renderer.h"
 
 namespace subscan::viewer {
 
@@ -34,14 +34,11 @@ void ScanLoadJob::load() {
         PreparedScan prepared{source_, loadScan(source_, reportProgress), {}};
         prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
         // As Renderer::prepareNormals does for `auto`, here off the render thread.
-        if (!prepared.scan.cloud.hasNormals() &&
-            prepared.scan.cloud.size() <= kAlwaysEstimateNormalsPoints) {
-            prepared.normals = pointNormals(prepared.scan.cloud, std::nullopt, [this] {
-                return cancelled_.load(std::memory_order_relaxed);
-            });
-            if (cancelled_.load(std::memory_order_relaxed)) {
-                throw LoadCancelled{};
-            }
+        prepared.normals = normalsFor(prepared.scan.cloud, NormalSource::Auto, [this] {
+            return cancelled_.load(std::memory_order_relaxed);
+        });
+        if (cancelled_.load(std::memory_order_relaxed)) {
+            throw LoadCancelled{};
         }
         result_ = std::move(prepared);
     } catch (const LoadCancelled&) {

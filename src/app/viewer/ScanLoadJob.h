@@ -20,7 +20,7 @@ struct PreparedScan {
     std::string source;
     LoadedScan scan;
     PointSpacing spacing;  // estimatePointSpacing's result (h = 0: the renderer picks one)
-    std::vector<glm::vec3> normals;  // estimated where the cloud has none of its own (pointNormals)
+    std::vector<glm::vec3> normals;  // normalsFor(cloud, auto): empty where none are estimated
 };
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)
