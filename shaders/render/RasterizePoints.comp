@@ -33,6 +33,14 @@ layout(std140, binding = SUBSCAN_UBO_PASS) uniform RasterBlock {
 };
 layout(binding = SUBSCAN_TEXELS_POSITIONS) uniform samplerBuffer positions;  // x, y, z per point
 layout(binding = SUBSCAN_TEXELS_COLORS) uniform usamplerBuffer colors;
+
+/// Chunk point `local` in view space.
+vec3 viewPositionOfPoint(uint local) {
+    int first = 3 * int(local);
+    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
+                         texelFetch(positions, first + 2).r);
+    return (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+}
 #if STAGE_DEPTH
 layout(binding = SUBSCAN_IMAGE_OUT0, r32ui) uniform uimage2D depthBits;
 #elif STAGE_INDEX
@@ -77,10 +85,7 @@ float spacingRatio(uint local) {
     if (surface.spacing.x < 0.5) {
         return 1.0;
     }
-    int first = 3 * int(local);
-    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
-                         texelFetch(positions, first + 2).r);
-    vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+    vec3 viewPosition = viewPositionOfPoint(local);
     vec4 spacing = texelFetch(localSpacing, int(local));
     vec3 across = mat3(frame.viewFromCloud) * spacing.xyz;  // in units of h
     float distance = projectiveDepth(-viewPosition.z);
@@ -95,10 +100,7 @@ float spacingRatio(uint local) {
 /// arbitrary where no sensor oriented it, and the side seen is the side shaded.
 vec3 viewNormal(uint local) {
     vec3 normal = mat3(frame.viewFromCloud) * unpackNormal(texelFetch(pointNormals, int(local)).r);
-    int first = 3 * int(local);
-    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
-                         texelFetch(positions, first + 2).r);
-    vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+    vec3 viewPosition = viewPositionOfPoint(local);
     return dot(normal, towardsEye(viewPosition)) < 0.0 ? -normal : normal;
 }
 
@@ -141,10 +143,7 @@ void main() {
     if (local >= raster.pointCount) {
         return;
     }
-    int first = 3 * int(local);
-    vec3 position = vec3(texelFetch(positions, first).r, texelFetch(positions, first + 1).r,
-                         texelFetch(positions, first + 2).r);
-    vec3 viewPosition = (frame.viewFromCloud * vec4(position, 1.0)).xyz;
+    vec3 viewPosition = viewPositionOfPoint(local);
     vec2 window;
     ivec2 pixel;
     float depth;
