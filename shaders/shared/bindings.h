@@ -17,12 +17,14 @@ using uvec4 = glm::uvec4;
 using mat4 = glm::mat4;
 #endif
 
+// The macros keep their comments beside them, aligned, which the formatter would break.
+// clang-format off
 // ---- uniform blocks (std140) ----
 #define SUBSCAN_UBO_FRAME 0
 #define SUBSCAN_UBO_PASS 1
 #define SUBSCAN_UBO_PYRAMID 2
 #define SUBSCAN_UBO_SURFACE 3
-#define SUBSCAN_UBO_LIGHTS 4    // ShadeParams for a pass other than Shade that needs the lights
+#define SUBSCAN_UBO_LIGHTS 4  // ShadeParams for a pass other than Shade that needs the lights
 #define SUBSCAN_UBO_TEMPORAL 5  // TemporalParams (Temporal, and FinishSurface's fused filter)
 
 // ---- plain uniforms ----
@@ -32,15 +34,13 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_END 3      // ivec2: the texel past the region's last (shared/region.glsl)
 
 // ---- shader storage blocks (std430) ----
-#define SUBSCAN_SSBO_DEPTH_INDEX 4  // uint64 per pixel: depth bits << 32 | point index
-#define SUBSCAN_SSBO_PYRAMID 5      // float per texel, all levels: min depth
-#define SUBSCAN_SSBO_PULL_VALUES 6  // vec4 per texel, all levels: w * (depth, r, g, b)
-#define SUBSCAN_SSBO_PULL_WEIGHTS \
-    7                               // vec2 per texel, all levels: clamped weight w and
-                                    // w * the local spacing (in h) of the points pulled
-#define SUBSCAN_SSBO_PUSH_VALUES 8  // vec4 per texel, levels >= 1: complete (depth, r, g, b)
-#define SUBSCAN_SSBO_NORMALS \
-    9                                 // vec4 per texel: screen-space normals (levels >= 1):
+#define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
+#define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
+#define SUBSCAN_SSBO_PULL_VALUES 6    // vec4 per texel, all levels: w * (depth, r, g, b)
+#define SUBSCAN_SSBO_PULL_WEIGHTS 7   // vec2 per texel, all levels: clamped weight w and
+                                      // w * the local spacing (in h) of the points pulled
+#define SUBSCAN_SSBO_PUSH_VALUES 8    // vec4 per texel, levels >= 1: complete (depth, r, g, b)
+#define SUBSCAN_SSBO_NORMALS 9        // vec4 per texel: screen-space normals (levels >= 1):
                                       // view-space normal, w unused; point normals (all levels):
                                       // pulled w_n * normal, w_n, pushed in place (levels >= 1)
                                       // to the complete normal, 1
@@ -49,32 +49,29 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_COLOR_SUMS 12    // uvec4 per pixel: fixed-point linear RGB sums, point count
 #define SUBSCAN_SSBO_CLEAR 13         // uint words GpuClear fills (its own binding: no pass's)
 #define SUBSCAN_SSBO_OCCUPANCY 14     // uint per pixel: which of its 4x4 sub-cells hold points
-#define SUBSCAN_SSBO_POINT_CENTROIDS \
-    15  // uint per texel, levels >= 1: where in the texel its
-        // points lie on average (unorm16x2 of the texel)
-#define SUBSCAN_SSBO_FILL_SPARSE \
-    16  // uint per level-1 texel: what it adds to its pixels' gap
-        // test (FillRemoval.glsl's sparseEnclosure)
+#define SUBSCAN_SSBO_POINT_CENTROIDS 15  // uint per texel, levels >= 1: where in the texel its
+                                         // points lie on average (unorm16x2 of the texel)
+#define SUBSCAN_SSBO_FILL_SPARSE 16      // uint per level-1 texel: what it adds to its pixels'
+                                         // gap test (FillRemoval.glsl's sparseEnclosure)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
-#define SUBSCAN_TEXELS_PYRAMID 0        // r32f view of SUBSCAN_SSBO_PYRAMID
-#define SUBSCAN_TEXELS_PULL_VALUES 1    // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
-#define SUBSCAN_TEXELS_PULL_WEIGHTS 2   // rg32f view of SUBSCAN_SSBO_PULL_WEIGHTS
-#define SUBSCAN_TEXELS_PUSH_VALUES 3    // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
-#define SUBSCAN_TEXELS_NORMALS 4        // rgba32f view of SUBSCAN_SSBO_NORMALS
-#define SUBSCAN_TEXELS_FILL_REACH 5     // r32ui view of SUBSCAN_SSBO_FILL_REACH
-#define SUBSCAN_TEXELS_POSITIONS 6      // r32f: x, y, z per point (cloud-relative), one chunk
-#define SUBSCAN_TEXELS_COLORS 7         // r32ui: RGBA8, sRGB-encoded, per point, one chunk
-#define SUBSCAN_TEXELS_ALBEDO_ROOTS 8   // r32f: sqrt(1 - reduced albedo) by total reflectance
+#define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
+#define SUBSCAN_TEXELS_PULL_VALUES 1   // rgba32f view of SUBSCAN_SSBO_PULL_VALUES
+#define SUBSCAN_TEXELS_PULL_WEIGHTS 2  // rg32f view of SUBSCAN_SSBO_PULL_WEIGHTS
+#define SUBSCAN_TEXELS_PUSH_VALUES 3   // rgba32f view of SUBSCAN_SSBO_PUSH_VALUES
+#define SUBSCAN_TEXELS_NORMALS 4       // rgba32f view of SUBSCAN_SSBO_NORMALS
+#define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
+#define SUBSCAN_TEXELS_POSITIONS 6     // r32f: x, y, z per point (cloud-relative), one chunk
+#define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
+#define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
 #define SUBSCAN_TEXELS_LOCAL_SPACING 9  // rgba16f per point, one chunk (estimateLocalSpacing)
-#define SUBSCAN_TEXELS_POINT_NORMALS \
-    10  // r32ui per point, one chunk: octahedral snorm16x2 unit
-        // normal, 0 for none (the rasterizer's; it shares its
-        // unit with the first light map, which it never reads)
-#define SUBSCAN_TEXELS_POINT_CENTROIDS \
-    14                                 // r32ui view of SUBSCAN_SSBO_POINT_CENTROIDS (after
-                                       // the light maps: 16 units are all GL promises)
-#define SUBSCAN_TEXELS_FILL_SPARSE 15  // r32ui view of SUBSCAN_SSBO_FILL_SPARSE
+#define SUBSCAN_TEXELS_POINT_NORMALS 10    // r32ui per point, one chunk: octahedral snorm16x2
+                                           // unit normal, 0 for none (the rasterizer's; it
+                                           // shares its unit with the first light map, which
+                                           // it never reads)
+#define SUBSCAN_TEXELS_POINT_CENTROIDS 14  // r32ui view of SUBSCAN_SSBO_POINT_CENTROIDS (after
+                                           // the light maps: 16 units are all GL promises)
+#define SUBSCAN_TEXELS_FILL_SPARSE 15      // r32ui view of SUBSCAN_SSBO_FILL_SPARSE
 
 // ---- textures read with texelFetch ----
 // sampler2D per directional light (units 10 .. 10 + SUBSCAN_MAX_LIGHTS - 1): its light map
@@ -96,14 +93,15 @@ using mat4 = glm::mat4;
 #define SUBSCAN_ATTRIBUTE_COLOR 1
 
 // ---- limits ----
-#define SUBSCAN_MAX_PYRAMID_LEVELS 16     // 1 + ceil(log2(65536)): the largest image side
-#define SUBSCAN_MAX_LIGHTS 4              // directional lights besides the head light
+#define SUBSCAN_MAX_PYRAMID_LEVELS 16  // 1 + ceil(log2(65536)): the largest image side
+#define SUBSCAN_MAX_LIGHTS 4           // directional lights besides the head light
 #define SUBSCAN_MAX_PROFILE_GAUSSIANS 12  // terms of a diffusion profile the shading transmits
 
 // ---- compute work group sizes ----
 #define SUBSCAN_POINTS_GROUP_SIZE 256
 #define SUBSCAN_IMAGE_GROUP_SIZE 8
 #define SUBSCAN_CLEAR_GROUP_SIZE 256  // GpuClear's buffer fill, one word per invocation and step
+// clang-format on
 
 // Per-frame camera and viewport. Images have row 0 at the top, like the PNG output.
 struct FrameParams {
