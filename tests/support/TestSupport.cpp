@@ -210,6 +210,17 @@ void expectPositionsNear(const PointCloud& actual, const PointCloud& expected, d
     }
 }
 
+PointCloud cloudOf(const std::vector<glm::dvec3>& positions) {
+    PointCloudBuilder builder({}, positions.size());
+    for (const glm::dvec3& position : positions) {
+        PointRecord record;
+        record.position = position;
+        builder.add(record);
+    }
+    std::vector<std::string> warnings;
+    return builder.finish(warnings);
+}
+
 PointCloud utmCloudWithEveryAttribute() {
     const glm::dvec3 corner(512345.25, 5432109.5, 97.0);
     const glm::dvec3 offsets[] = {{0, 0, 0}, {10, 0, 0}, {0, 10, 0}, {2.5, 5, 10}, {10, 10, 7.5}};

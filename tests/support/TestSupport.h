@@ -91,6 +91,9 @@ void expectPosition(const PointCloud& cloud, std::size_t i, double x, double y, 
 /// counterpart's file coordinates on every axis (the caller says why that tolerance).
 void expectPositionsNear(const PointCloud& actual, const PointCloud& expected, double tolerance);
 
+/// A cloud of these positions (file coordinates) and nothing else, as a reader builds it.
+PointCloud cloudOf(const std::vector<glm::dvec3>& positions);
+
 /// The writers' round-trip cloud: 5 points with colour, intensity and normals at UTM-like
 /// coordinates, 10 m across from (512345.25, 5432109.5, 97) to (512355.25, 5432119.5, 107).
 /// Every coordinate is a multiple of 0.25 m, so the float positions relative to the centre are

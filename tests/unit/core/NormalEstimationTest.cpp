@@ -15,20 +15,12 @@
 #include "core/PointCloud.h"
 #include "scan/SyntheticScenes.h"
 #include "scan/VirtualScanner.h"
+#include "support/TestSupport.h"
 
 namespace subscan {
 namespace {
 
-PointCloud cloudOf(const std::vector<glm::dvec3>& positions) {
-    PointCloudBuilder builder({}, positions.size());
-    for (const glm::dvec3& p : positions) {
-        PointRecord record;
-        record.position = p;
-        builder.add(record);
-    }
-    std::vector<std::string> warnings;
-    return builder.finish(warnings);
-}
+using test::cloudOf;
 
 /// A square grid of spacing `spacing` on the plane through `centre` with unit normal `normal`,
 /// `side` x `side` points, each moved along the normal by Gaussian noise of deviation `noise`.

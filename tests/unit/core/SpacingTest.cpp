@@ -9,9 +9,12 @@
 
 #include "core/PointCloud.h"
 #include "core/Spacing.h"
+#include "support/TestSupport.h"
 
 namespace subscan {
 namespace {
+
+using test::cloudOf;
 
 PointCloud gridPlane(int side, double step, int copies = 1) {
     PointCloudBuilder builder({}, static_cast<std::size_t>(side * side * copies));
@@ -89,17 +92,6 @@ std::vector<double> bruteForceNearest(const PointCloud& cloud, std::size_t sampl
         nearest.push_back(std::sqrt(best));
     }
     return nearest;
-}
-
-PointCloud cloudOf(const std::vector<glm::dvec3>& positions) {
-    PointCloudBuilder builder({}, positions.size());
-    for (const glm::dvec3& position : positions) {
-        PointRecord record;
-        record.position = position;
-        builder.add(record);
-    }
-    std::vector<std::string> warnings;
-    return builder.finish(warnings);
 }
 
 TEST(SpacingTest, SampledQueriesFindTheirExactNearestNeighbourInTheWholeCloud) {
