@@ -751,6 +751,7 @@ class Indexer {
     /// Reads the whole source in pieces, calling `each(records, count)`.
     template <class Each>
     void readAll(double from, double to, std::string_view phase, const Each& each) {
+        report(settings_, from, phase);  // the phase's name from its start
         source_.rewind();
         std::vector<std::byte> piece;
         std::uint64_t done = 0;

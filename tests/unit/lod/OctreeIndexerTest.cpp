@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <mutex>
@@ -11,6 +14,8 @@
 #include <tuple>
 #include <unordered_map>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include <gtest/gtest.h>
 
@@ -278,6 +283,37 @@ TEST(OctreeIndexerTest, OutOfCoreChunksGiveAnEvenOctreeAndLeaveNoFiles) {
     EXPECT_GE(indexed.summary.chunks, 4u);
     expectAnEvenOctree(source, input, indexed, 2'000);
     EXPECT_TRUE(std::filesystem::is_empty(folder.path()));
+}
+
+TEST(OctreeIndexerTest, AFullDiskWhileDistributingIsOneErrorAndLeavesNoFiles) {
+    // The chunk files are appended by the distribution's writer thread: its error must reach
+    // the caller as one sentence, and the temporary folder must go. A file-size limit of 64 KiB
+    // stands in for a full disk (EFBIG; SIGXFSZ ignored), in a child process, which the limit
+    // binds alone. Each chunk file needs about 450 KB (15,000 records of 30 bytes), so the
+    // limit is reached while distributing, before the chunks' top nodes are written.
+    const test::TempDir folder;
+    const std::vector<std::byte> input = terrainRecords(60'000, kScale, 5);
+    const auto indexWithinTheLimit = [&] {
+        const rlimit limit{64 << 10, 64 << 10};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+        std::signal(SIGXFSZ, SIG_IGN);
+        MemorySource source(input, kMillimetres);
+        CollectingSink sink;
+        IndexSettings settings = settingsIn(folder, 2'000, 1 << 20);
+        std::string phase;
+        settings.progress = [&](double, std::string_view now) { phase = now; };
+        try {
+            buildOctree(source, sink, settings);
+        } catch (const Error& error) {
+            std::fprintf(stderr, "%s; in: %s; left: %s\n", error.what(), phase.c_str(),
+                         std::filesystem::is_empty(folder.path()) ? "nothing" : "files");
+            std::exit(1);
+        }
+        std::exit(0);
+    };
+    EXPECT_EXIT(indexWithinTheLimit(), testing::ExitedWithCode(1),
+                "cannot write temporary data \\(is the disk full\\?\\); in: distributing; "
+                "left: nothing");
 }
 
 TEST(OctreeIndexerTest, PointsAtOnePositionEndInOneLeaf) {
