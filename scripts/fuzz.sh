@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan, in build-sanitize: scripts/sanitize-build.sh)
 # and fuzzes each reader (and the index writer) for N seconds, as many readers at a time as there are cores.
-#   scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off|index ...]   default: 300 s each, all
+#   scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off|index|ept ...]   default: 300 s each, all
 # Seeds: tiny files written here or by the unit tests that build them (LAZ, COPC, E57; from the
 # Release build in build/), plus small real scans from ../shared/data when present (copied into
 # the build folder only). A finding stops the script with a non-zero exit and
@@ -14,11 +14,11 @@ readers=()
 while [[ $# -gt 0 ]]; do
     case "$1" in
         --seconds) seconds="$2"; shift 2 ;;
-        ply|las|laz|copc|pcd|xyz|e57|off|index) readers+=("$1"); shift ;;
-        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off|index ...]" >&2; exit 2 ;;
+        ply|las|laz|copc|pcd|xyz|e57|off|index|ept) readers+=("$1"); shift ;;
+        *) echo "usage: scripts/fuzz.sh [--seconds N] [ply|las|laz|copc|pcd|xyz|e57|off|index|ept ...]" >&2; exit 2 ;;
     esac
 done
-[[ ${#readers[@]} -gt 0 ]] || readers=(ply las laz copc pcd xyz e57 off index)
+[[ ${#readers[@]} -gt 0 ]] || readers=(ply las laz copc pcd xyz e57 off index ept)
 
 scripts/setup-deps.sh
 build=build-sanitize
@@ -75,6 +75,11 @@ write_seeds() {  # reader directory
             printf 'OFF\n# cube\n8 6 12\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n' >"$dir/cube.off"
             printf 'STCNOFF 2 1 0\n1 2 3 0 0 1 0.5 0.5 0.5 1 0.25 0.75\n4OFF\n3 0 1 1\n' >"$dir/variants.off"
             printf 'COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n' >"$dir/colour.off"
+            ;;
+        ept)  # an ept.json, a NUL byte, a hierarchy page (EptFuzzer.cpp)
+            { printf '{"bounds":[0,0,0,8,8,8],"boundsConforming":[1,1,1,7,7,7],"dataType":"laszip",'
+              printf '"hierarchyType":"json","points":30,"span":128,"version":"1.0.0"}\0'
+              printf '{"0-0-0-0":10,"1-0-0-0":20,"1-1-1-1":-1}'; } >"$dir/small.ept"
             ;;
         index)  # format 7, 2 extra bytes, nodes of 5 points; then 38-byte records
             { printf '\x01\x02\x05'; seq 1 2000 | head -c 3800; } >"$dir/digits.bin"

@@ -488,44 +488,51 @@ LasRecords readLasRecords(std::span<const std::byte> file, ReadContext& context)
     return {header.pointFormat, header.recordLength, std::move(storage)};
 }
 
-PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
-    const LasHeader header = parseLasHeader(file, file.size(), context);
-    context.formatDetail = describe(header);
-    std::vector<std::byte> storage;
-    const std::byte* points = pointRecords(file, header, context, storage).data();
-    const auto count = static_cast<std::size_t>(header.pointCount);
-
+PointCloud lasRecordsToCloud(std::span<const std::byte> head, const LasHeader& header,
+                             std::span<const std::byte> records,
+                             std::span<const std::byte> colorSample, const ReadContext& context,
+                             std::vector<std::string>& warnings) {
+    const std::byte* points = records.data();
+    const std::size_t count = records.size() / header.recordLength;
     const std::optional<std::size_t> colorOffset = kLasPointFormats[header.pointFormat].colorOffset;
     const ColorDepth depth =
-        colorOffset ? detectColorDepth(points, count, header.recordLength, *colorOffset)
+        colorOffset ? detectColorDepth(colorSample.data(), colorSample.size() / header.recordLength,
+                                       header.recordLength, *colorOffset)
                     : ColorDepth::None;
-    const std::optional<NormalFields> normal = findNormalFields(file, header);
+    const std::optional<NormalFields> normal = findNormalFields(head, header);
     PointAttributes attributes;
     attributes.color = colorOffset.has_value();
     attributes.normal = normal.has_value();
     attributes.intensity = true;
     attributes.classification = true;
     PointCloudBuilder builder(attributes, count);
-    // Decompression already reported the progress of a LAZ file; the record pass is quick.
-    const ReadContext silent;
-    const ReadContext& recordContext = header.laszipRecord ? silent : context;
     switch (depth) {
         case ColorDepth::None:
-            decodePoints<ColorDepth::None>(points, count, header, 0, normal, builder,
-                                           recordContext);
+            decodePoints<ColorDepth::None>(points, count, header, 0, normal, builder, context);
             break;
         case ColorDepth::EightBit:
             decodePoints<ColorDepth::EightBit>(points, count, header, *colorOffset, normal, builder,
-                                               recordContext);
+                                               context);
             break;
         case ColorDepth::SixteenBit:
             decodePoints<ColorDepth::SixteenBit>(points, count, header, *colorOffset, normal,
-                                                 builder, recordContext);
+                                                 builder, context);
             break;
     }
     context.reportProgress(count, count);
+    return builder.finish(warnings);
+}
 
-    PointCloud cloud = builder.finish(context.warnings);
+PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
+    const LasHeader header = parseLasHeader(file, file.size(), context);
+    context.formatDetail = describe(header);
+    std::vector<std::byte> storage;
+    const std::span<const std::byte> records = pointRecords(file, header, context, storage);
+    // Decompression already reported the progress of a LAZ file; the record pass is quick.
+    const ReadContext silent;
+    PointCloud cloud = lasRecordsToCloud(file, header, records, records,
+                                         header.laszipRecord ? silent : context, context.warnings);
+    context.reportProgress(1, 1);
     warnIfBoundsDisagree(header, cloud.bounds, context);
     return cloud;
 }

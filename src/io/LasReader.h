@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/PointCloud.h"
+#include "io/LasHeader.h"
 #include "io/ReadContext.h"
 
 namespace subscan {
@@ -28,5 +29,14 @@ struct LasRecords {
 };
 
 LasRecords readLasRecords(std::span<const std::byte> file, ReadContext& context);
+
+/// Points of some of a LAS file's records, as readLas makes them: `head` holds the file's header
+/// and VLRs (where PDAL's normals lie among the extra bytes), `colorSample` the records that
+/// decide whether the 16-bit colour fields hold 8-bit values (readLas: all of them; a COPC
+/// file's nodes: its root's, so that every node decides alike). `context` receives progress.
+PointCloud lasRecordsToCloud(std::span<const std::byte> head, const LasHeader& header,
+                             std::span<const std::byte> records,
+                             std::span<const std::byte> colorSample, const ReadContext& context,
+                             std::vector<std::string>& warnings);
 
 }  // namespace subscan

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <numeric>
 #include <string>
 
 #include <fmt/format.h>
@@ -16,6 +17,8 @@
 #include "io/PlyReader.h"
 #include "io/ReadContext.h"
 #include "io/XyzReader.h"
+#include "lod/NodeSelection.h"
+#include "lod/NodeSource.h"
 #include "scan/SyntheticScenes.h"
 
 namespace subscan {
@@ -167,6 +170,24 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
 LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress) {
     const auto start = std::chrono::steady_clock::now();
     LoadedScan scan;
+    if (const std::filesystem::path path{std::string(source)};
+        !source.starts_with(kSyntheticPrefix) && lod::isEpt(path)) {
+        // Its sentences name the file they are about (ept.json, a hierarchy page, a tile).
+        const std::unique_ptr<lod::NodeSource> ept = lod::openEpt(path);
+        std::vector<std::size_t> every(ept->nodes().size());
+        std::iota(every.begin(), every.end(), std::size_t{0});
+        scan.warnings = ept->info().warnings;
+        scan.cloud = lod::loadNodes(*ept, every, scan.warnings);
+        scan.format = ept->info().format;
+        scan.formatDetail = ept->info().formatDetail;
+        if (progress) {
+            progress(1.0);
+        }
+        scan.loadMilliseconds =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        return scan;
+    }
     try {
         if (source.starts_with(kSyntheticPrefix)) {
             SyntheticSource synthetic = makeSyntheticSource(source.substr(kSyntheticPrefix.size()));

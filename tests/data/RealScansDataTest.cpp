@@ -265,9 +265,12 @@ TEST(RealScansDataTest, EveryReadableFileRenders) {
         const auto out = dir / "out.png";
         const auto buffers = dir / "buffers";
         // The camera the render used comes back in camera.json, to project the bounds with.
-        const auto result = runSubscan(
-            {"render", (data / expected.file).string(), "-o", out.string(), "--width", "96",
-             "--height", "72", "--background", "#000000", "--export-buffers", buffers.string()});
+        // Every file whole (--lod off): a streamed COPC file is framed by its top levels and
+        // its header's bounds instead (StreamedSourceDataTest).
+        const auto result =
+            runSubscan({"render", (data / expected.file).string(), "-o", out.string(), "--width",
+                        "96", "--height", "72", "--background", "#000000", "--export-buffers",
+                        buffers.string(), "--lod", "off"});
         ASSERT_EQ(result.exitCode, 0) << result.err;
         const Image8 image = readPng(out);
         const Camera camera = readCameraFile(buffers / "camera.json");

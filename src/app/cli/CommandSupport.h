@@ -10,6 +10,7 @@
 
 #include "io/PointRecordSource.h"
 #include "io/ScanLoader.h"
+#include "lod/NodeSource.h"
 #include "render/ScatteringSettings.h"
 
 namespace subscan::cli {
@@ -21,6 +22,17 @@ LoadedScan loadScanForCommand(std::string_view source);
 /// A record source's warnings (io/PointRecordSource.h) as "subscan: warning: ..." lines, as
 /// loadScanForCommand prints a reader's.
 void printSourceWarnings(const PointRecordSourceInfo& info);
+
+/// A streamed source's top levels (about 200,000 points, an even sample of the whole survey)
+/// with the whole survey's bounds: what a view of it is framed by. Says no warnings (a view
+/// loaded after it does).
+LoadedScan loadStreamedOverview(const lod::NodeSource& source);
+
+/// The nodes `camera` shows within `pointBudget` (lod::selectNodes), loaded on every core, with
+/// the whole survey's bounds (so that colouring by height does not depend on the budget).
+/// Prints a warning for each node left out.
+LoadedScan loadStreamedView(const lod::NodeSource& source, const Camera& camera,
+                            std::uint64_t pointBudget);
 
 /// Whether `a` and `b` are the same existing file, also through another spelling of the path or
 /// a link: the guard that keeps commands from writing over their inputs.

@@ -19,6 +19,8 @@
 #include "gpu/GlContext.h"
 #include "io/CameraJson.h"
 #include "io/Image.h"
+#include "lod/NodeSelection.h"
+#include "lod/NodeSource.h"
 #include "render/FrameBuffers.h"
 #include "render/RenderSettings.h"
 #include "render/Renderer.h"
@@ -33,6 +35,8 @@ struct RenderOptions {
     std::string exportDirectory;
     std::optional<int> samples;  // unset: 1, or kTemporalRestFrames with the filter on
     bool timings = false;
+    std::string lod = "auto";
+    std::optional<std::uint64_t> pointBudget;  // unset: by the renderer (lod::k*PointBudget)
 };
 
 /// Per-pass median over `timed` frames after one warm-up (llvmpipe compiles shaders lazily and
@@ -126,10 +130,23 @@ int runRender(const RenderOptions& options) {
     if (linearPicture) {
         checkLinearPictureRequest(output, settings, samples);
     }
-    LoadedScan scan = loadScanForCommand(frame.source);
-    frame.applyColoring(scan);
-    const Camera camera = frame.camera(scan);
+    const std::unique_ptr<lod::NodeSource> streamed =
+        lod::openStreamed(frame.source, lod::parseLodMode(options.lod));
     const std::unique_ptr<GlContext> context = frame.context();
+    LoadedScan scan;
+    Camera camera;
+    if (streamed) {
+        // Framed by an even sample of the whole survey, then the nodes that view shows.
+        camera = frame.camera(loadStreamedOverview(*streamed));
+        const std::uint64_t budget = options.pointBudget.value_or(context->capabilities().software
+                                                                      ? lod::kSoftwarePointBudget
+                                                                      : lod::kHardwarePointBudget);
+        scan = loadStreamedView(*streamed, camera, budget);
+    } else {
+        scan = loadScanForCommand(frame.source);
+        camera = frame.camera(scan);
+    }
+    frame.applyColoring(scan);
     // `scan` outlives the renderer unchanged: the GPU may read its points in place.
     Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud), 0,
                       PointMemory::Borrow);
@@ -195,6 +212,17 @@ Command addRenderCommand(CLI::App& parent) {
                      "settings turn the filter on)")
         ->check(CLI::Range(1, 2048));
     render->add_flag("--timings", options->timings, "Print per-pass milliseconds");
+    render
+        ->add_option("--lod", options->lod,
+                     "Levels of detail: auto (stream COPC files and EPT datasets, load the rest "
+                     "whole), on (stream, or refuse), off (load every file whole)")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
+    render
+        ->add_option("--point-budget", options->pointBudget,
+                     fmt::format("Most points a streamed view loads (default {} on software "
+                                 "rendering, {} on a GPU)",
+                                 lod::kSoftwarePointBudget, lod::kHardwarePointBudget))
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
     return {render, [options] { return runRender(*options); }};
 }
 

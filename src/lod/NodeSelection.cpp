@@ -1,0 +1,235 @@
+#include "lod/NodeSelection.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <queue>
+#include <thread>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+#include "core/Error.h"
+
+namespace subscan::lod {
+
+namespace {
+
+struct Sphere {
+    glm::dvec3 centre;
+    double radius = 0.0;
+};
+
+Sphere boundingSphere(const OctreeCube& cube, const laz::VoxelKey& key) {
+    const double side = 2.0 * cube.halfSize / static_cast<double>(std::int64_t{1} << key.level);
+    const glm::dvec3 min = cube.center - cube.halfSize + glm::dvec3(key.x, key.y, key.z) * side;
+    return {min + 0.5 * side, 0.5 * std::sqrt(3.0) * side};
+}
+
+/// The six planes of the camera's view volume in file coordinates (Gribb and Hartmann: rows of
+/// projection * view), each scaled to a unit normal pointing inwards.
+std::array<glm::dvec4, 6> viewPlanes(const Camera& camera) {
+    const glm::dmat4 clip = camera.projection() * camera.view;
+    const glm::dmat4 rows = glm::transpose(clip);
+    std::array<glm::dvec4, 6> planes{rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1],
+                                     rows[3] - rows[1], rows[3] + rows[2], rows[3] - rows[2]};
+    for (glm::dvec4& plane : planes) {
+        plane /= glm::length(glm::dvec3(plane));
+    }
+    return planes;
+}
+
+bool inView(const std::array<glm::dvec4, 6>& planes, const Sphere& sphere) {
+    return std::all_of(planes.begin(), planes.end(), [&](const glm::dvec4& plane) {
+        return glm::dot(glm::dvec3(plane), sphere.centre) + plane.w >= -sphere.radius;
+    });
+}
+
+/// The nearest distance from the eye to the sphere along the view, at least the near plane's.
+double nearestDistance(const Camera& camera, const Sphere& sphere) {
+    if (camera.orthographic()) {
+        return 1.0;  // pixels per unit do not change with distance
+    }
+    return std::max(glm::length(sphere.centre - camera.eye()) - sphere.radius, camera.nearPlane);
+}
+
+/// Pixels per scene unit at `distance`.
+double pixelsPerUnit(const Camera& camera, double distance) {
+    return camera.focalLengthPixels() / distance;
+}
+
+}  // namespace
+
+std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& camera,
+                                     std::uint64_t pointBudget) {
+    const OctreeCube& cube = source.info().cube;
+    const std::span<const StreamedNode> nodes = source.nodes();
+    const std::array<glm::dvec4, 6> planes = viewPlanes(camera);
+    const glm::dvec3 eye = camera.eye();
+    struct Candidate {
+        double pixels;
+        std::size_t index;
+        bool operator<(const Candidate& other) const {
+            // Larger first; among equals the earlier node, so that the order is the same on
+            // every run.
+            return pixels != other.pixels ? pixels < other.pixels : index > other.index;
+        }
+    };
+    const auto candidate = [&](std::size_t index) -> std::optional<Candidate> {
+        const Sphere sphere = boundingSphere(cube, nodes[index].key);
+        if (!inView(planes, sphere)) {
+            return std::nullopt;
+        }
+        const bool holdsEye = glm::length(sphere.centre - eye) <= sphere.radius;
+        const double pixels =
+            holdsEye ? std::numeric_limits<double>::infinity()
+                     : sphere.radius * pixelsPerUnit(camera, nearestDistance(camera, sphere));
+        return Candidate{pixels, index};
+    };
+
+    std::vector<std::size_t> selected{0};  // the root, whatever the budget
+    std::uint64_t points = nodes[0].pointCount;
+    std::priority_queue<Candidate> queue;
+    const auto offerChildren = [&](std::size_t parent) {
+        const laz::VoxelKey& key = nodes[parent].key;
+        const double spacing = cube.rootSpacing / static_cast<double>(std::int64_t{1} << key.level);
+        for (int octant = 0; octant < 8; ++octant) {
+            const laz::VoxelKey child{key.level + 1, 2 * key.x + (octant & 1),
+                                      2 * key.y + ((octant >> 1) & 1),
+                                      2 * key.z + ((octant >> 2) & 1)};
+            const std::size_t index = source.find(child);
+            if (index == nodes.size()) {
+                continue;
+            }
+            const Sphere sphere = boundingSphere(cube, child);
+            if (spacing * pixelsPerUnit(camera, nearestDistance(camera, sphere)) <
+                kFinestParentSpacingPixels) {
+                continue;
+            }
+            if (const std::optional<Candidate> next = candidate(index)) {
+                queue.push(*next);
+            }
+        }
+    };
+    offerChildren(0);
+    while (!queue.empty()) {
+        const Candidate next = queue.top();
+        queue.pop();
+        if (points + nodes[next.index].pointCount > pointBudget) {
+            break;
+        }
+        points += nodes[next.index].pointCount;
+        selected.push_back(next.index);
+        offerChildren(next.index);
+    }
+    return selected;
+}
+
+std::vector<std::size_t> topLevels(const NodeSource& source, std::uint64_t points) {
+    const std::span<const StreamedNode> nodes = source.nodes();
+    std::vector<std::size_t> chosen;
+    std::uint64_t taken = 0;
+    // nodes() is ordered by level: each level is taken whole or not at all.
+    for (std::size_t begin = 0; begin < nodes.size();) {
+        std::size_t end = begin;
+        std::uint64_t levelPoints = 0;
+        while (end < nodes.size() && nodes[end].key.level == nodes[begin].key.level) {
+            levelPoints += nodes[end++].pointCount;
+        }
+        if (begin > 0 && taken + levelPoints > points) {
+            break;
+        }
+        for (std::size_t i = begin; i < end; ++i) {
+            chosen.push_back(i);
+        }
+        taken += levelPoints;
+        begin = end;
+    }
+    return chosen;
+}
+
+PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> nodes,
+                     std::vector<std::string>& warnings, unsigned threads) {
+    std::vector<std::optional<PointCloud>> loaded(nodes.size());
+    std::vector<std::string> failures(nodes.size());
+    std::atomic<std::size_t> next{0};
+    const auto work = [&] {
+        for (std::size_t i = next++; i < nodes.size(); i = next++) {
+            try {
+                loaded[i] = source.load(nodes[i]);
+            } catch (const Error& error) {
+                failures[i] = fmt::format("{}; it is left out", error.what());
+            } catch (const std::bad_alloc&) {
+                failures[i] = fmt::format("{}: out of memory; it is left out",
+                                          nodeName(source.nodes()[nodes[i]].key));
+            }
+        }
+    };
+    {
+        const unsigned count =
+            std::clamp<unsigned>(threads != 0 ? threads : std::thread::hardware_concurrency(), 1,
+                                 static_cast<unsigned>(std::max<std::size_t>(nodes.size(), 1)));
+        std::vector<std::jthread> workers;
+        for (unsigned t = 1; t < count; ++t) {
+            workers.emplace_back(work);
+        }
+        work();
+    }
+
+    PointCloud cloud;
+    cloud.origin =
+        source.info().bounds.empty() ? source.info().cube.center : source.info().bounds.center();
+    std::size_t total = 0;
+    bool colors = true, normals = true, intensities = true, classifications = true;
+    bool any = false;
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (!failures[i].empty()) {
+            warnings.push_back(failures[i]);
+        }
+        if (loaded[i]) {
+            total += loaded[i]->size();
+            colors = colors && loaded[i]->hasColors();
+            normals = normals && loaded[i]->hasNormals();
+            intensities = intensities && loaded[i]->hasIntensities();
+            classifications = classifications && loaded[i]->hasClassifications();
+            any = true;
+        }
+    }
+    if (!any) {
+        colors = normals = intensities = classifications = false;
+    }
+    cloud.positions.reserve(total);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        if (!loaded[i]) {
+            continue;
+        }
+        PointCloud& part = *loaded[i];
+        const glm::dvec3 shift = part.origin - cloud.origin;
+        for (const glm::vec3& p : part.positions) {
+            cloud.positions.emplace_back(glm::dvec3(p) + shift);
+        }
+        if (!part.bounds.empty()) {
+            cloud.bounds.add(part.bounds.min);
+            cloud.bounds.add(part.bounds.max);
+        }
+        const auto append = [](auto& to, auto& from, bool keep) {
+            if (keep) {
+                to.insert(to.end(), from.begin(), from.end());
+            }
+        };
+        append(cloud.colors, part.colors, colors);
+        append(cloud.normals, part.normals, normals);
+        append(cloud.intensities, part.intensities, intensities);
+        append(cloud.classifications, part.classifications, classifications);
+        part = PointCloud{};
+    }
+    return cloud;
+}
+
+}  // namespace subscan::lod

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/Camera.h"
+#include "core/PointCloud.h"
+#include "lod/NodeSource.h"
+
+namespace subscan::lod {
+
+/// Children are loaded while their parent's spacing, seen from the camera where the child lies
+/// nearest, is at least this many pixels: below it the parent's points already lie closer
+/// together than pixels, and the children would add points, not detail.
+inline constexpr double kFinestParentSpacingPixels = 0.5;
+
+/// Points a view loads without --point-budget, where the renderer is Mesa's llvmpipe and where
+/// it is a GPU. On llvmpipe 1 M points cost about what the Happy Buddha's 1.1 M do (160 ms a
+/// 1080p surface frame, bench/README.md), and what the renderer estimates at load (local
+/// spacing, normals) takes a few seconds for them. The GPU's is a placeholder until measured.
+inline constexpr std::uint64_t kSoftwarePointBudget = 1'000'000;
+inline constexpr std::uint64_t kHardwarePointBudget = 10'000'000;
+
+/// The nodes `camera` shows within `pointBudget` points, as Potree chooses them: from the root,
+/// the node that looks largest next (its bounding sphere's radius in pixels; the node holding
+/// the eye first), skipping nodes outside the view and children that add no detail
+/// (kFinestParentSpacingPixels), until the next node does not fit the budget. The root is
+/// always taken. Parents come before their children; the same view gives the same nodes.
+/// Indices into source.nodes().
+std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& camera,
+                                     std::uint64_t pointBudget);
+
+/// The nodes of the levels from the root down, while they hold at most `points` in all (at
+/// least the root): a view-independent sample of the whole survey, to frame it by.
+std::vector<std::size_t> topLevels(const NodeSource& source, std::uint64_t points);
+
+/// Loads `nodes` on `threads` threads (0: every core) into one cloud, in the order given, its
+/// positions about the middle of the source's bounds. A node that cannot be read is left out
+/// with one warning that names the node (the caller names the source); the rest still shows.
+PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> nodes,
+                     std::vector<std::string>& warnings, unsigned threads = 0);
+
+}  // namespace subscan::lod

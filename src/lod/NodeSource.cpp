@@ -1,0 +1,414 @@
+#include "lod/NodeSource.h"
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/Error.h"
+#include "io/LasHeader.h"
+#include "io/LasReader.h"
+#include "io/MappedFile.h"
+#include "io/laz/LazDecoder.h"
+
+namespace subscan::lod {
+
+namespace {
+
+/// 2^15 nodes a side, about 3e-5 of the cube: deeper than any indexer goes for real surveys
+/// (PDAL's lone star scan: 4 levels; Autzen tiled 60 x 60: 8).
+constexpr int kDeepestStreamedLevel = 15;
+
+/// A key packed into one word, ordered as nodes() is: by level, then x, y, z (20 bits each;
+/// setNodes refuses keys deeper than kDeepestStreamedLevel, whose coordinates would not fit).
+std::uint64_t packedKey(const laz::VoxelKey& key) {
+    return (static_cast<std::uint64_t>(key.level) << 60) |
+           (static_cast<std::uint64_t>(key.x) << 40) | (static_cast<std::uint64_t>(key.y) << 20) |
+           static_cast<std::uint64_t>(key.z);
+}
+
+/// Reads a whole small file (JSON, an EPT tile).
+std::vector<std::byte> readWhole(const std::filesystem::path& path) {
+    std::ifstream stream(path, std::ios::binary);
+    if (!stream) {
+        throw Error("cannot be opened");
+    }
+    std::vector<char> text((std::istreambuf_iterator<char>(stream)),
+                           std::istreambuf_iterator<char>());
+    std::vector<std::byte> bytes(text.size());
+    std::transform(text.begin(), text.end(), bytes.begin(),
+                   [](char c) { return static_cast<std::byte>(c); });
+    return bytes;
+}
+
+nlohmann::json parseJson(std::string_view text) {
+    nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+    if (json.is_discarded()) {
+        throw Error("is not valid JSON");
+    }
+    return json;
+}
+
+/// "D-X-Y-Z" as EPT names nodes.
+std::optional<laz::VoxelKey> parseEptKey(const std::string& name) {
+    laz::VoxelKey key;
+    char tail = 0;
+    if (std::sscanf(name.c_str(), "%d-%d-%d-%d%c", &key.level, &key.x, &key.y, &key.z, &tail) !=
+        4) {
+        return std::nullopt;
+    }
+    return key;
+}
+
+class CopcSource final : public NodeSource {
+  public:
+    explicit CopcSource(const std::filesystem::path& path) : file_(path) {
+        const std::span<const std::byte> bytes = file_.bytes();
+        ReadContext context;
+        header_ = parseLasHeader(bytes, bytes.size(), context);
+        const std::optional<std::span<const std::byte>> record =
+            findLasVlr(bytes, header_, "copc", 1);
+        if (!record || !header_.laszipRecord) {
+            throw Error("is not a COPC file (no COPC info record)");
+        }
+        const laz::CopcInfo copc = laz::parseCopcInfo(*record);
+        layout_ = laz::parseLaszipRecord(*header_.laszipRecord, header_.pointFormat,
+                                         header_.recordLength);
+        std::vector<StreamedNode> nodes;
+        for (const laz::CopcNode& node : laz::readCopcHierarchy(bytes, copc)) {
+            nodes.push_back({node.key, node.chunk.pointCount});
+            chunks_[packedKey(node.key)] = node.chunk;
+        }
+        info_.name = path.string();
+        info_.format = "las";
+        info_.cube = {copc.center, copc.halfSize, copc.rootSpacing};
+        info_.bounds = header_.declaredBounds;
+        setNodes(std::move(nodes));
+        info_.formatDetail = fmt::format(
+            "COPC 1.0 (LAZ, LAS 1.{}, point format {}): octree of {} levels, {} nodes, root "
+            "spacing {:.6g}",
+            header_.versionMinor, header_.pointFormat, this->nodes().back().key.level + 1,
+            this->nodes().size(), copc.rootSpacing);
+        // Colour depth is decided on the root's records for every node alike.
+        rootRecords_ = records(0);
+    }
+
+    PointCloud load(std::size_t index) const override {
+        const std::vector<std::byte> decoded = index == 0 ? rootRecords_ : records(index);
+        std::vector<std::string> warnings;
+        return lasRecordsToCloud(file_.bytes(), header_, decoded, rootRecords_, ReadContext{},
+                                 warnings);
+    }
+
+  private:
+    std::vector<std::byte> records(std::size_t index) const {
+        const StreamedNode& node = nodes()[index];
+        const laz::Chunk& chunk = chunks_.at(packedKey(node.key));
+        std::vector<std::byte> decoded(chunk.pointCount * header_.recordLength);
+        try {
+            laz::decodeChunk(file_.bytes().subspan(chunk.offset, chunk.byteSize), chunk.pointCount,
+                             layout_, decoded.data());
+        } catch (const Error& error) {
+            throw Error(fmt::format("{}: {}", nodeName(node.key), error.what()));
+        }
+        if (file_.shrank()) {
+            throw Error(
+                fmt::format("{}: the file was truncated while it was read", nodeName(node.key)));
+        }
+        return decoded;
+    }
+
+    MappedFile file_;
+    LasHeader header_;
+    laz::LazLayout layout_;
+    std::map<std::uint64_t, laz::Chunk> chunks_;
+    std::vector<std::byte> rootRecords_;
+};
+
+class EptSource final : public NodeSource {
+  public:
+    explicit EptSource(const std::filesystem::path& json) : folder_(json.parent_path()) {
+        EptDescription ept;
+        try {
+            const std::vector<std::byte> bytes = readWhole(json);
+            ept = parseEptDescription({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+        } catch (const Error& error) {
+            throw Error(fmt::format("{}: {}", json.string(), error.what()));
+        }
+        info_.name = folder_.string();
+        info_.format = "las";  // LAZ tiles: LAS-family data (Z up)
+        info_.cube = ept.cube;
+        info_.bounds = ept.bounds;
+        std::vector<StreamedNode> nodes;
+        readHierarchy("0-0-0-0", nodes);
+        std::uint64_t listed = 0;
+        for (const StreamedNode& node : nodes) {
+            listed += node.pointCount;
+        }
+        if (listed != ept.points) {
+            info_.warnings.push_back(
+                fmt::format("ept.json declares {} points, but its hierarchy lists {}; the "
+                            "hierarchy's are read",
+                            ept.points, listed));
+        }
+        setNodes(std::move(nodes));
+        info_.formatDetail = fmt::format(
+            "EPT {} (LAZ tiles): octree of {} levels, {} nodes, root spacing {:.6g}", ept.version,
+            this->nodes().back().key.level + 1, this->nodes().size(), info_.cube.rootSpacing);
+    }
+
+    PointCloud load(std::size_t index) const override {
+        const StreamedNode& node = nodes()[index];
+        const std::filesystem::path tile =
+            folder_ / "ept-data" / fmt::format("{}.laz", eptName(node.key));
+        const auto fail = [&](const std::string& what) {
+            return Error(fmt::format("{}: {}", nodeName(node.key), what));
+        };
+        std::error_code missing;
+        if (!std::filesystem::is_regular_file(tile, missing)) {
+            throw fail(fmt::format("its tile {} is missing", tile.string()));
+        }
+        ReadContext context;
+        context.decodeThreads = 1;  // nodes load on threads of their own
+        PointCloud cloud;
+        try {
+            const MappedFile file(tile);
+            cloud = readLas(file.bytes(), context);
+        } catch (const Error& error) {
+            throw fail(fmt::format("{}: {}", tile.string(), error.what()));
+        }
+        if (cloud.size() != node.pointCount) {
+            throw fail(fmt::format("its tile holds {} points, but the hierarchy says {}",
+                                   cloud.size(), node.pointCount));
+        }
+        return cloud;
+    }
+
+  private:
+    static std::string eptName(const laz::VoxelKey& key) {
+        return fmt::format("{}-{}-{}-{}", key.level, key.x, key.y, key.z);
+    }
+
+    /// Reads ept-hierarchy/NAME.json and every page it points to.
+    void readHierarchy(const std::string& name, std::vector<StreamedNode>& nodes) {
+        const std::filesystem::path path = folder_ / "ept-hierarchy" / (name + ".json");
+        if (!visited_.insert(name).second) {
+            return;
+        }
+        EptHierarchyPage page;
+        try {
+            const std::vector<std::byte> bytes = readWhole(path);
+            page =
+                parseEptHierarchyPage({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+        } catch (const Error& error) {
+            const Error named(fmt::format("{}: {}", path.string(), error.what()));
+            if (name == "0-0-0-0") {
+                throw named;
+            }
+            // A page below the root: its subtree is left out, the rest still shows.
+            info_.warnings.push_back(
+                fmt::format("{}; the nodes it lists are left out", named.what()));
+            return;
+        }
+        nodes.insert(nodes.end(), page.nodes.begin(), page.nodes.end());
+        for (const laz::VoxelKey& key : page.pages) {
+            const std::string next = eptName(key);
+            if (next != name) {
+                readHierarchy(next, nodes);
+            }
+        }
+    }
+
+    std::filesystem::path folder_;
+    std::set<std::string> visited_;
+};
+
+}  // namespace
+
+EptDescription parseEptDescription(std::string_view text) {
+    const nlohmann::json ept = parseJson(text);
+    EptDescription description;
+    try {
+        const std::string dataType = ept.at("dataType").get<std::string>();
+        if (dataType != "laszip") {
+            throw Error(fmt::format(
+                "holds \"{}\" tiles; subscan reads EPT with LAZ tiles (\"laszip\") only",
+                dataType));
+        }
+        const std::string hierarchyType = ept.value("hierarchyType", "json");
+        if (hierarchyType != "json") {
+            throw Error(fmt::format("has a \"{}\" hierarchy; subscan reads JSON hierarchies only",
+                                    hierarchyType));
+        }
+        const std::vector<double> cube = ept.at("bounds").get<std::vector<double>>();
+        const std::vector<double> conforming = ept.value("boundsConforming", cube);
+        const double span = ept.at("span").get<double>();
+        const auto finite = [](const std::vector<double>& values) {
+            return values.size() == 6 && std::all_of(values.begin(), values.end(), [](double v) {
+                       return std::abs(v) <= kMaxCoordinate;
+                   });
+        };
+        if (!finite(cube) || !finite(conforming) || !(span >= 1.0 && span <= 1e9)) {
+            throw Error(
+                "has \"bounds\" or \"boundsConforming\" that are not 6 coordinates, or "
+                "a \"span\" outside 1 to 1e9");
+        }
+        const glm::dvec3 min(cube[0], cube[1], cube[2]), max(cube[3], cube[4], cube[5]);
+        const glm::dvec3 side = max - min;
+        if (!(side.x > 0.0) || std::abs(side.x - side.y) > 1e-9 * side.x ||
+            std::abs(side.x - side.z) > 1e-9 * side.x) {
+            throw Error("has \"bounds\" that are not a cube");
+        }
+        description.cube = {0.5 * (min + max), 0.5 * side.x, side.x / span};
+        description.bounds.add({conforming[0], conforming[1], conforming[2]});
+        description.bounds.add({conforming[3], conforming[4], conforming[5]});
+        description.points = ept.at("points").get<std::uint64_t>();
+        description.version = ept.value("version", "1.0.0");
+    } catch (const nlohmann::json::exception& error) {
+        throw Error(fmt::format("is not an EPT description ({})", error.what()));
+    }
+    return description;
+}
+
+EptHierarchyPage parseEptHierarchyPage(std::string_view text) {
+    const nlohmann::json json = parseJson(text);
+    if (!json.is_object()) {
+        throw Error("is not an EPT hierarchy (a JSON object)");
+    }
+    EptHierarchyPage page;
+    for (const auto& [name, count] : json.items()) {
+        const std::optional<laz::VoxelKey> key = parseEptKey(name);
+        if (!key || !count.is_number_integer()) {
+            throw Error(fmt::format("the entry \"{}\" is not a key D-X-Y-Z with a count", name));
+        }
+        const auto points = count.get<std::int64_t>();
+        if (points == -1) {
+            page.pages.push_back(*key);
+        } else if (points > 0) {
+            page.nodes.push_back({*key, static_cast<std::uint64_t>(points)});
+        } else if (points < -1) {
+            throw Error(fmt::format("the entry \"{}\" has a count of {}", name, points));
+        }
+    }
+    return page;
+}
+
+std::string nodeName(const laz::VoxelKey& key) {
+    return fmt::format("node {}-{}-{}-{}", key.level, key.x, key.y, key.z);
+}
+
+std::size_t NodeSource::find(const laz::VoxelKey& key) const {
+    if (key.level < 0 || key.level > kDeepestStreamedLevel || key.x < 0 || key.y < 0 || key.z < 0) {
+        return nodes_.size();
+    }
+    const std::uint64_t packed = packedKey(key);
+    const auto at = std::lower_bound(sortedKeys_.begin(), sortedKeys_.end(), packed);
+    return at != sortedKeys_.end() && *at == packed
+               ? static_cast<std::size_t>(at - sortedKeys_.begin())
+               : nodes_.size();
+}
+
+void NodeSource::setNodes(std::vector<StreamedNode> nodes) {
+    for (const StreamedNode& node : nodes) {
+        const std::int32_t cells = std::int32_t{1} << std::min(node.key.level, 30);
+        if (node.key.level < 0 || node.key.level > kDeepestStreamedLevel || node.key.x < 0 ||
+            node.key.y < 0 || node.key.z < 0 || node.key.x >= cells || node.key.y >= cells ||
+            node.key.z >= cells) {
+            throw Error(fmt::format("{}: {} lies outside the octree (levels 0 to {})", info_.name,
+                                    nodeName(node.key), kDeepestStreamedLevel));
+        }
+    }
+    std::sort(nodes.begin(), nodes.end(), [](const StreamedNode& a, const StreamedNode& b) {
+        return packedKey(a.key) < packedKey(b.key);
+    });
+    for (std::size_t i = 1; i < nodes.size(); ++i) {
+        if (packedKey(nodes[i].key) == packedKey(nodes[i - 1].key)) {
+            throw Error(fmt::format("{}: {} is listed twice", info_.name, nodeName(nodes[i].key)));
+        }
+    }
+    if (nodes.empty() || nodes.front().key.level != 0) {
+        throw Error(fmt::format("{}: the octree has no root node with points", info_.name));
+    }
+    info_.points = 0;
+    for (const StreamedNode& node : nodes) {
+        info_.points += node.pointCount;
+    }
+    sortedKeys_.clear();
+    for (const StreamedNode& node : nodes) {
+        sortedKeys_.push_back(packedKey(node.key));
+    }
+    nodes_ = std::move(nodes);
+}
+
+bool isEpt(const std::filesystem::path& path) {
+    std::error_code ignored;
+    return path.filename() == "ept.json" ||
+           std::filesystem::is_regular_file(path / "ept.json", ignored);
+}
+
+std::unique_ptr<NodeSource> openCopc(const std::filesystem::path& path) {
+    try {
+        return std::make_unique<CopcSource>(path);
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", path.string(), error.what()));
+    }
+}
+
+std::unique_ptr<NodeSource> openEpt(const std::filesystem::path& path) {
+    return std::make_unique<EptSource>(path.filename() == "ept.json" ? path : path / "ept.json");
+}
+
+LodMode parseLodMode(std::string_view name) {
+    if (name == "auto") {
+        return LodMode::Auto;
+    }
+    if (name == "on") {
+        return LodMode::On;
+    }
+    if (name == "off") {
+        return LodMode::Off;
+    }
+    throw Error(fmt::format("unknown level-of-detail mode \"{}\" (auto, on or off)", name));
+}
+
+std::unique_ptr<NodeSource> openStreamed(std::string_view source, LodMode mode) {
+    if (mode == LodMode::Off) {
+        return nullptr;
+    }
+    const std::filesystem::path path{std::string(source)};
+    if (!source.starts_with("synthetic:")) {
+        if (isEpt(path)) {
+            return openEpt(path);
+        }
+        std::error_code ignored;
+        if (std::filesystem::is_regular_file(path, ignored)) {
+            // Only a LAS file's header and VLRs are read to tell.
+            bool copc = false;
+            try {
+                const MappedFile file(path);
+                ReadContext context;
+                const LasHeader header = parseLasHeader(file.bytes(), file.bytes().size(), context);
+                copc = findLasVlr(file.bytes(), header, "copc", 1).has_value();
+            } catch (const Error&) {
+                copc = false;  // not LAS at all: the whole-file readers say what it is
+            }
+            if (copc) {
+                return openCopc(path);
+            }
+        }
+    }
+    if (mode == LodMode::On) {
+        throw Error(fmt::format(
+            "{}: is neither a COPC file nor an EPT dataset, which --lod on streams; index it "
+            "first (subscan index), or load it whole with --lod auto or off",
+            source));
+    }
+    return nullptr;
+}
+
+}  // namespace subscan::lod
