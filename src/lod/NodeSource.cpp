@@ -143,7 +143,7 @@ class EptSource final : public NodeSource {
         info_.name = folder_.string();
         info_.format = "las";  // LAZ tiles: LAS-family data (Z up)
         info_.cube = ept.cube;
-        info_.bounds = ept.bounds;
+        info_.bounds = sourcesBounds(folder_).value_or(ept.bounds);
         std::vector<StreamedNode> nodes;
         readHierarchy("0-0-0-0", nodes);
         std::uint64_t listed = 0;
@@ -192,6 +192,29 @@ class EptSource final : public NodeSource {
   private:
     static std::string eptName(const laz::VoxelKey& key) {
         return fmt::format("{}-{}-{}-{}", key.level, key.x, key.y, key.z);
+    }
+
+    /// The union of ept-sources/list.json's "bounds", where it gives them for every source:
+    /// the points' exact bounds (ept.json's "boundsConforming" are rounded outwards to whole
+    /// units, up to a metre off on PDAL's lone star scan).
+    static std::optional<Bounds> sourcesBounds(const std::filesystem::path& folder) {
+        try {
+            const std::vector<std::byte> bytes = readWhole(folder / "ept-sources" / "list.json");
+            const nlohmann::json list =
+                parseJson({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+            Bounds bounds;
+            for (const nlohmann::json& source : list) {
+                const std::vector<double> b = source.at("bounds").get<std::vector<double>>();
+                if (b.size() != 6) {
+                    return std::nullopt;
+                }
+                bounds.add({b[0], b[1], b[2]});
+                bounds.add({b[3], b[4], b[5]});
+            }
+            return bounds.empty() ? std::nullopt : std::optional<Bounds>(bounds);
+        } catch (const std::exception&) {
+            return std::nullopt;  // optional: the conforming bounds serve
+        }
     }
 
     /// Reads ept-hierarchy/NAME.json and every page it points to.

@@ -31,7 +31,7 @@ struct NodeSourceInfo {
     std::string format;        // "las": LoadedScan::format of LAS-family data (COPC, EPT)
     std::string formatDetail;  // e.g. "EPT 1.0.0 (LAZ tiles), octree of 4 levels, 13 nodes"
     OctreeCube cube;           // the octree's cube and root spacing
-    Bounds bounds;             // of every point, as the header declares them
+    Bounds bounds;             // of every point, as the header (or EPT's source list) says
     std::uint64_t points = 0;  // in all nodes
     /// What was left out when opening (a hierarchy page that cannot be read), one sentence
     /// each, naming the source's part but not the source.
