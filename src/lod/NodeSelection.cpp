@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -230,6 +231,22 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
         part = PointCloud{};
     }
     return cloud;
+}
+
+LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_t> nodes) {
+    const auto start = std::chrono::steady_clock::now();
+    LoadedScan scan;
+    scan.warnings = source.info().warnings;
+    scan.cloud = loadNodes(source, nodes, scan.warnings);
+    if (!scan.cloud.bounds.empty()) {
+        scan.cloud.bounds.add(source.info().bounds.min);
+        scan.cloud.bounds.add(source.info().bounds.max);
+    }
+    scan.format = source.info().format;
+    scan.formatDetail = source.info().formatDetail;
+    scan.loadMilliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return scan;
 }
 
 }  // namespace subscan::lod

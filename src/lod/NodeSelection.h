@@ -8,6 +8,7 @@
 
 #include "core/Camera.h"
 #include "core/PointCloud.h"
+#include "io/ScanLoader.h"
 #include "lod/NodeSource.h"
 
 namespace subscan::lod {
@@ -36,6 +37,14 @@ std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& cam
 /// The nodes of the levels from the root down, while they hold at most `points` in all (at
 /// least the root): a view-independent sample of the whole survey, to frame it by.
 std::vector<std::size_t> topLevels(const NodeSource& source, std::uint64_t points);
+
+/// Points of a streamed source's overview (topLevels): framingBounds samples as many.
+inline constexpr std::uint64_t kOverviewPoints = 200'000;
+
+/// `nodes` of `source` as a loaded scan (loadNodes on every core), with the whole survey's
+/// bounds (a view is framed, and coloured by height, alike whatever its nodes), the source's
+/// format and its warnings followed by those of the nodes left out.
+LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_t> nodes);
 
 /// Loads `nodes` on `threads` threads (0: every core) into one cloud, in the order given, its
 /// positions about the middle of the source's bounds. A node that cannot be read is left out

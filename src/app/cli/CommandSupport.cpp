@@ -1,6 +1,5 @@
 #include "app/cli/CommandSupport.h"
 
-#include <chrono>
 #include <filesystem>
 #include <limits>
 #include <sstream>
@@ -30,35 +29,14 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
-namespace {
-
-LoadedScan loadStreamed(const lod::NodeSource& source, std::span<const std::size_t> nodes) {
-    const auto start = std::chrono::steady_clock::now();
-    LoadedScan scan;
-    scan.warnings = source.info().warnings;
-    scan.cloud = lod::loadNodes(source, nodes, scan.warnings);
-    if (!scan.cloud.bounds.empty()) {
-        scan.cloud.bounds.add(source.info().bounds.min);
-        scan.cloud.bounds.add(source.info().bounds.max);
-    }
-    scan.format = source.info().format;
-    scan.formatDetail = source.info().formatDetail;
-    scan.loadMilliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return scan;
-}
-
-}  // namespace
-
 LoadedScan loadStreamedOverview(const lod::NodeSource& source) {
-    constexpr std::uint64_t kOverviewPoints = 200'000;  // framingBounds samples as many
     // Its warnings are the view's too, which says them.
-    return loadStreamed(source, lod::topLevels(source, kOverviewPoints));
+    return lod::loadStreamedScan(source, lod::topLevels(source, lod::kOverviewPoints));
 }
 
 LoadedScan loadStreamedView(const lod::NodeSource& source, const Camera& camera,
                             std::uint64_t pointBudget) {
-    LoadedScan scan = loadStreamed(source, lod::selectNodes(source, camera, pointBudget));
+    LoadedScan scan = lod::loadStreamedScan(source, lod::selectNodes(source, camera, pointBudget));
     for (const std::string& warning : scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", source.info().name, warning);
     }

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "core/Error.h"
+#include "lod/NodeSelection.h"
 #include "render/Renderer.h"
 
 namespace subscan::viewer {
@@ -31,13 +32,17 @@ void ScanLoadJob::load() {
         progress_.store(fraction, std::memory_order_relaxed);
     };
     try {
-        PreparedScan prepared{source_, loadScan(source_, reportProgress), {}};
-        prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
-        // As Renderer::prepareNormals does for `auto`, here off the render thread.
-        prepared.normals = normalsFor(prepared.scan.cloud, NormalSource::Auto, [this] {
-            return cancelled_.load(std::memory_order_relaxed);
-        });
-        if (cancelled_.load(std::memory_order_relaxed)) {
+        PreparedScan prepared;
+        prepared.source = source_;
+        prepared.streamed = lod::openStreamed(source_, lod::LodMode::Auto);
+        if (prepared.streamed) {
+            prepared.nodes = lod::topLevels(*prepared.streamed, lod::kOverviewPoints);
+            prepared.scan = lod::loadStreamedScan(*prepared.streamed, prepared.nodes);
+        } else {
+            prepared.scan = loadScan(source_, reportProgress);
+        }
+        if (!prepareForRenderer(prepared,
+                                [this] { return cancelled_.load(std::memory_order_relaxed); })) {
             throw LoadCancelled{};
         }
         result_ = std::move(prepared);
@@ -50,6 +55,12 @@ void ScanLoadJob::load() {
         error_ = std::current_exception();
     }
     finished_.store(true, std::memory_order_release);
+}
+
+bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {
+    prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
+    prepared.normals = normalsFor(prepared.scan.cloud, NormalSource::Auto, cancelled);
+    return !cancelled();
 }
 
 PreparedScan ScanLoadJob::take() {

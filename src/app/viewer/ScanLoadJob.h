@@ -2,6 +2,8 @@
 
 #include <atomic>
 #include <exception>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -11,6 +13,7 @@
 
 #include "core/LocalSpacing.h"
 #include "io/ScanLoader.h"
+#include "lod/NodeSource.h"
 
 namespace subscan::viewer {
 
@@ -21,10 +24,20 @@ struct PreparedScan {
     LoadedScan scan;
     PointSpacing spacing;  // estimatePointSpacing's result (h = 0: the renderer picks one)
     std::vector<glm::vec3> normals;  // normalsFor(cloud, auto): empty where none are estimated
+    /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
+    /// it (the overview when first opened, then the nodes a view shows). Null: loaded whole.
+    std::shared_ptr<const lod::NodeSource> streamed;
+    std::vector<std::size_t> nodes;
 };
 
+/// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as
+/// Renderer::prepareNormals does for `auto`, here off the render thread. Returns false where
+/// `cancelled` turned true meanwhile.
+bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled);
+
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)
-/// while a big file is decoded. Destroying an unfinished job cancels it at the reader's next
+/// while a big file is decoded; a COPC file or EPT dataset only its overview (topLevels), which
+/// StreamedViewJob refines. Destroying an unfinished job cancels it at the reader's next
 /// progress report and waits for the thread.
 class ScanLoadJob {
   public:

@@ -1,11 +1,13 @@
 #include "app/viewer/Viewer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <limits>
 #include <new>
+#include <thread>
 #include <utility>
 
 #include <epoxy/gl.h>
@@ -59,6 +61,8 @@ constexpr double kMaxFlyStepSeconds = 0.25;
 // Idle: wake up now and then even without events; loading: redraw the progress bar smoothly.
 constexpr double kIdleWaitSeconds = 0.25;
 constexpr double kLoadingWaitSeconds = 1.0 / 30.0;
+/// A streamed scan loads the nodes of a view once the camera has rested this long.
+constexpr double kRefineAfterRestSeconds = 0.3;
 // A script's resize waits this long for the window system.
 constexpr double kResizeTimeoutSeconds = 2.0;
 
@@ -126,6 +130,7 @@ int Viewer::run() {
             startLoading(*std::exchange(pendingOpen_, std::nullopt));
         }
         finishLoading();
+        refineStreamedView();
 
         const double now = glfwGetTime();
         const double seconds = now - lastFrameTime_;
@@ -175,7 +180,7 @@ void Viewer::installCallbacks() {
 }
 
 void Viewer::waitForEvents() {
-    if (loading_) {
+    if (loading_ || refining_ || dueRefinement()) {
         glfwWaitEventsTimeout(kLoadingWaitSeconds);
     } else if (unattended_ || flying_ || frameIsStale()) {
         // A change made while drawing the last frame (the panel, a script) shows at once.
@@ -397,51 +402,124 @@ void Viewer::finishLoading() {
     const std::unique_ptr<ScanLoadJob> job = std::move(loading_);
     status_.loadingSource.reset();
     try {
-        PreparedScan prepared = job->take();
-        for (const std::string& warning : prepared.scan.warnings) {
-            fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
-        }
-        const UpAxis up =
-            options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y);
-        // Before the cloud moves on: an organised grid's camera is fitted to its points.
-        std::optional<std::pair<glm::dvec3, glm::dvec3>> look = sensorLook(prepared.scan, up);
-        std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
-        prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, options_.coloring, up);
-        // Built before the old one goes, so a failure keeps the scan on screen. The renderer
-        // reads the points where they are (no copy where the driver allows): the scan stays at
-        // its address until the renderer that reads it has gone.
-        auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
-        auto renderer =
-            std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
-        if (!prepared.normals.empty()) {
-            renderer->setPointNormals(prepared.normals);
-        }
-        renderer_ = std::move(renderer);
-        scan_ = std::move(scan);
-        scanColors_ = std::move(fileColors);
-        scanUp_ = up;
-        sensorLook_ = std::move(look);
-        status_.coloring = options_.coloring;
-        const PointCloud& cloud = *scan_;
-        bounds_ = cloud.bounds;
-        status_.scanSource = prepared.source;
-        status_.scanFormat =
-            prepared.scan.formatDetail.empty() ? prepared.scan.format : prepared.scan.formatDetail;
-        status_.points = cloud.size();
-        status_.spacing = renderer_->spacing();
-        status_.loadMilliseconds = prepared.scan.loadMilliseconds;
-        const glm::ivec2 size = viewportSize();
-        camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
-                               framingBounds(cloud));
-        renderedCamera_.reset();
-        renderedImage_ = false;
-        glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());
-        initialScanShown_ = true;
+        show(job->take(), true);
     } catch (const Error& error) {
         if (!initialScanShown_) {
             throw;  // nothing to show: the command fails as `subscan render` would
         }
         fail(error.what());
+    }
+}
+
+void Viewer::show(PreparedScan prepared, bool newScan) {
+    for (const std::string& warning : prepared.scan.warnings) {
+        fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
+    }
+    const UpAxis up =
+        newScan ? options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y)
+                : scanUp_;
+    // Before the cloud moves on: an organised grid's camera is fitted to its points.
+    std::optional<std::pair<glm::dvec3, glm::dvec3>> look =
+        newScan ? sensorLook(prepared.scan, up) : sensorLook_;
+    std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
+    const Coloring coloring = newScan ? options_.coloring : status_.coloring;
+    prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);
+    // Built before the old one goes, so a failure keeps the scan on screen. The renderer
+    // reads the points where they are (no copy where the driver allows): the scan stays at
+    // its address until the renderer that reads it has gone.
+    auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
+    auto renderer =
+        std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
+    if (!prepared.normals.empty()) {
+        renderer->setPointNormals(prepared.normals);
+    }
+    renderer_ = std::move(renderer);
+    scan_ = std::move(scan);
+    scanColors_ = std::move(fileColors);
+    scanUp_ = up;
+    sensorLook_ = std::move(look);
+    streamed_ = std::move(prepared.streamed);
+    streamedNodes_ = std::move(prepared.nodes);
+    status_.coloring = coloring;
+    const PointCloud& cloud = *scan_;
+    status_.points = cloud.size();
+    status_.spacing = renderer_->spacing();
+    status_.streamedNodes = streamedNodes_.size();
+    status_.streamedNodesInAll = streamed_ ? streamed_->nodes().size() : 0;
+    status_.streamedPointsInAll = streamed_ ? streamed_->info().points : 0;
+    renderedCamera_.reset();
+    renderedImage_ = false;
+    if (!newScan) {
+        return;
+    }
+    refining_.reset();
+    refinedCamera_.reset();
+    stillCamera_.reset();
+    bounds_ = cloud.bounds;
+    status_.scanSource = prepared.source;
+    status_.scanFormat =
+        prepared.scan.formatDetail.empty() ? prepared.scan.format : prepared.scan.formatDetail;
+    status_.loadMilliseconds = prepared.scan.loadMilliseconds;
+    const glm::ivec2 size = viewportSize();
+    camera_ =
+        ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1), framingBounds(cloud));
+    glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());
+    initialScanShown_ = true;
+}
+
+std::optional<Camera> Viewer::dueRefinement() const {
+    if (!streamed_ || !renderer_ || loading_ || refining_) {
+        return std::nullopt;
+    }
+    const glm::ivec2 size = viewportSize();
+    const Camera camera = camera_.camera(std::max(size.x, 1), std::max(size.y, 1));
+    if (refinedCamera_ && sameCamera(*refinedCamera_, camera)) {
+        return std::nullopt;
+    }
+    return camera;
+}
+
+void Viewer::refineStreamedView() {
+    if (refining_) {
+        if (!refining_->finished()) {
+            return;
+        }
+        const std::unique_ptr<StreamedViewJob> job = std::move(refining_);
+        status_.streamingView = false;
+        try {
+            if (std::optional<PreparedScan> prepared = job->take()) {
+                show(std::move(*prepared), false);
+            }
+        } catch (const Error& error) {
+            fail(error.what());
+        }
+    }
+    const std::optional<Camera> camera = dueRefinement();
+    if (!camera) {
+        return;
+    }
+    // Interactive: once the camera has rested a moment, so that an orbit does not start a
+    // load at every step. Unattended (scripts, tests): at once, and waited for, so that every
+    // frame shows what `render` would.
+    const double now = glfwGetTime();
+    if (!stillCamera_ || !sameCamera(*stillCamera_, *camera)) {
+        stillCamera_ = camera;
+        stillSince_ = now;
+    }
+    if (!unattended_ && now - stillSince_ < kRefineAfterRestSeconds) {
+        return;
+    }
+    refinedCamera_ = camera;
+    const std::uint64_t budget =
+        context_.capabilities().software ? lod::kSoftwarePointBudget : lod::kHardwarePointBudget;
+    refining_ = std::make_unique<StreamedViewJob>(streamed_, status_.scanSource, *camera, budget,
+                                                  streamedNodes_);
+    status_.streamingView = true;
+    if (unattended_) {
+        while (!refining_->finished()) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        refineStreamedView();
     }
 }
 

@@ -10,6 +10,7 @@
 
 #include "app/viewer/ImGuiSession.h"
 #include "app/viewer/ScanLoadJob.h"
+#include "app/viewer/StreamedViewJob.h"
 #include "app/viewer/ViewerCamera.h"
 #include "app/viewer/ViewerPanel.h"
 #include "app/viewer/ViewerScript.h"
@@ -94,6 +95,15 @@ class Viewer {
     void waitForEvents();
     void startLoading(const std::string& source);
     void finishLoading();
+    /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
+    /// start afresh), or another set of the streamed scan's nodes (the view stays).
+    void show(PreparedScan prepared, bool newScan);
+    /// The camera whose nodes a streamed scan should load next: the view, where it is not the
+    /// one last refined for and no load runs.
+    std::optional<Camera> dueRefinement() const;
+    /// A streamed scan: takes a finished StreamedViewJob's nodes, and starts one for the view
+    /// once the camera rests.
+    void refineStreamedView();
     void runScript();
     void runScriptCommand(const ScriptCommand& command);
     /// Merges `patch` (JSON text in the settings file's form) into the settings, checked as a
@@ -161,6 +171,14 @@ class Viewer {
     /// Where `V` puts the eye and what it looks at: the scan's sensor, when it records one.
     std::optional<std::pair<glm::dvec3, glm::dvec3>> sensorLook_;
     std::unique_ptr<ScanLoadJob> loading_;
+    // A streamed scan (COPC, EPT): its source, the nodes on screen, the job loading a view's,
+    // the camera as last seen and since when it rests, and the view last refined for.
+    std::shared_ptr<const lod::NodeSource> streamed_;
+    std::vector<std::size_t> streamedNodes_;
+    std::unique_ptr<StreamedViewJob> refining_;
+    std::optional<Camera> stillCamera_;
+    double stillSince_ = 0.0;
+    std::optional<Camera> refinedCamera_;
     bool initialScanShown_ = false;
     std::optional<std::string> pendingOpen_;
 

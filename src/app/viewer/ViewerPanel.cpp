@@ -242,6 +242,12 @@ void ViewerPanel::drawScan(const PanelStatus& status, PanelRequests& requests) {
         ImGui::TextWrapped("%s", status.scanSource.c_str());
         ImGui::TextWrapped("%s", status.scanFormat.c_str());
         ImGui::Text("%s points, h = %.4g", groupedThousands(status.points).c_str(), status.spacing);
+        if (status.streamedNodesInAll > 0) {
+            ImGui::TextWrapped("streamed: %zu of %zu nodes, of %s points%s", status.streamedNodes,
+                               status.streamedNodesInAll,
+                               groupedThousands(status.streamedPointsInAll).c_str(),
+                               status.streamingView ? "; loading the view's nodes" : "");
+        }
         ImGui::Text("loaded in %.0f ms", status.loadMilliseconds);
         constexpr Coloring kColorings[] = {Coloring::Auto,           Coloring::Rgb,
                                            Coloring::Intensity,      Coloring::Height,

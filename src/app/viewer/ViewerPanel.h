@@ -27,6 +27,12 @@ struct PanelStatus {
     double loadMilliseconds = 0.0;
     Coloring coloring = Coloring::Auto;        // what the points' colours show
     std::optional<std::string> loadingSource;  // a load in progress
+    // A streamed scan (COPC, EPT): the nodes shown, of how many, of how many points in all
+    // (0: loaded whole), and whether the view's nodes are loading.
+    std::size_t streamedNodes = 0;
+    std::size_t streamedNodesInAll = 0;
+    std::uint64_t streamedPointsInAll = 0;
+    bool streamingView = false;
     double loadingProgress = 0.0;
     std::string glRenderer;
     bool int64Atomics = false;
