@@ -44,6 +44,14 @@ class PresentPass;
 std::vector<glm::vec3> normalsFor(const PointCloud& cloud, NormalSource requested,
                                   const std::function<bool()>& cancelled = {});
 
+/// What a streamed view (the nodes a camera selects from a COPC file or EPT dataset) estimates
+/// normals for, where `requested` was asked: `auto` estimates none there (screen-space normals,
+/// unless the file has its own), since a view's million points took 4 of 6.7 s to estimate
+/// (`render`, llvmpipe, 2 cores) and every new view would estimate again; `points` still does.
+inline NormalSource streamedNormals(NormalSource requested) {
+    return requested == NormalSource::Auto ? NormalSource::Screen : requested;
+}
+
 struct FrameResult {
     std::vector<PassTiming> passes;
     int divisor = 1;  // output pixels per pipeline pixel and side (RasterSettings::resolution)

@@ -150,7 +150,8 @@ int runRender(const RenderOptions& options) {
     // `scan` outlives the renderer unchanged: the GPU may read its points in place.
     Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud), 0,
                       PointMemory::Borrow);
-    renderer.prepareNormals(scan.cloud, settings.surface.normals);
+    renderer.prepareNormals(scan.cloud, streamed ? streamedNormals(settings.surface.normals)
+                                                 : settings.surface.normals);
     // The radiance of a linear picture is one of the buffers the picture alone does not keep.
     const FrameOutputs outputs = options.exportDirectory.empty() && !linearPicture
                                      ? FrameOutputs::Picture

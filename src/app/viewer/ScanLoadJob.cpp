@@ -59,7 +59,9 @@ void ScanLoadJob::load() {
 
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {
     prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
-    prepared.normals = normalsFor(prepared.scan.cloud, NormalSource::Auto, cancelled);
+    prepared.normals = normalsFor(
+        prepared.scan.cloud,
+        prepared.streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto, cancelled);
     return !cancelled();
 }
 

@@ -31,8 +31,8 @@ struct PreparedScan {
 };
 
 /// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as
-/// Renderer::prepareNormals does for `auto`, here off the render thread. Returns false where
-/// `cancelled` turned true meanwhile.
+/// Renderer::prepareNormals does for `auto` (streamedNormals(auto) for a streamed scan), here
+/// off the render thread. Returns false where `cancelled` turned true meanwhile.
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled);
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)
