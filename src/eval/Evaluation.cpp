@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <string>
+#include <system_error>
 #include <tuple>
 #include <vector>
 
@@ -20,6 +24,10 @@
 #include "eval/GroundTruth.h"
 #include "gpu/ShaderSources.h"
 #include "io/Image.h"
+#include "io/PointRecordSource.h"
+#include "lod/CopcWriter.h"
+#include "lod/NodeSelection.h"
+#include "lod/NodeSource.h"
 #include "render/FrameUniforms.h"
 #include "render/PresentPass.h"
 #include "render/ReducedResolution.h"
@@ -219,6 +227,54 @@ std::vector<float> SpacingAtTruth::at(const Camera& camera, const GroundTruthIma
     return spacing;
 }
 
+/// The points of an evaluation indexed as a streamed survey: a COPC file in a temporary folder
+/// of its own, removed with it.
+class StreamedPoints {
+  public:
+    explicit StreamedPoints(const PointCloud& points) {
+        std::string pattern = (std::filesystem::temp_directory_path() / "subscan-eval-XXXXXX");
+        if (::mkdtemp(pattern.data()) == nullptr) {
+            throw Error(fmt::format("{}: cannot make a temporary folder for the indexed points",
+                                    std::filesystem::temp_directory_path().string()));
+        }
+        folder_ = pattern;
+        const std::unique_ptr<PointRecordSource> records =
+            cloudRecordSource(points, "the evaluated points");
+        lod::IndexSettings index;
+        index.temporaryDirectory = folder_;
+        lod::writeCopc(*records, folder_ / "points.copc.laz", index);
+        source_ = lod::openCopc(folder_ / "points.copc.laz");
+    }
+    ~StreamedPoints() {
+        source_.reset();
+        std::error_code ignored;
+        std::filesystem::remove_all(folder_, ignored);
+    }
+    StreamedPoints(const StreamedPoints&) = delete;
+    StreamedPoints& operator=(const StreamedPoints&) = delete;
+
+    const lod::NodeSource& source() const { return *source_; }
+
+  private:
+    std::filesystem::path folder_;
+    std::unique_ptr<lod::NodeSource> source_;
+};
+
+/// The nodes a view selects, with a renderer of their own prepared as `render` prepares a
+/// streamed view.
+struct StreamedView {
+    StreamedView(GlContext& context, const StreamedPoints& points, const Camera& camera,
+                 std::uint64_t budget, NormalSource normals)
+        : cloud(lod::loadStreamedScan(points.source(),
+                                      lod::selectNodes(points.source(), camera, budget))
+                    .cloud),
+          renderer(std::make_unique<Renderer>(context, cloud, estimatePointSpacing(cloud))) {
+        renderer->prepareNormals(cloud, streamedNormals(normals));
+    }
+    PointCloud cloud;
+    std::unique_ptr<Renderer> renderer;
+};
+
 EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointCloud& points,
                           const EvaluationSettings& settings, const RenderSettings& render) {
     const PointSpacing pointSpacing = estimatePointSpacing(points);
@@ -229,6 +285,13 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
     std::optional<SpacingAtTruth> spacingAtTruth;
     if (settings.occlusionsByLocalSpacing) {
         spacingAtTruth.emplace(points, pointSpacing);
+    }
+
+    // A streamed survey: the points as a COPC file, each view's nodes loaded into a renderer
+    // of their own.
+    std::optional<StreamedPoints> streamed;
+    if (settings.pointBudget) {
+        streamed.emplace(points);
     }
 
     EvaluationReport report;
@@ -272,13 +335,20 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         surfaceSettings.raster.mode = RenderMode::Surface;
         surfaceSettings.raster.stage = Stage::Final;
         surfaceSettings.temporal.enabled = false;  // one frame per view (eval --temporal has it)
+        std::optional<StreamedView> streamedView;
+        if (streamed) {
+            streamedView.emplace(context, *streamed, camera, *settings.pointBudget,
+                                 render.surface.normals);
+            report.surfacePoints += static_cast<double>(streamedView->cloud.size()) / views;
+        }
+        Renderer& surfaceRenderer = streamedView ? *streamedView->renderer : renderer;
         const int divisor =
-            renderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
+            surfaceRenderer.render(camera, surfaceSettings, FrameOutputs::Everything).divisor;
         report.surfaceReducedViews += divisor == 1 ? 0 : 1;
-        ReconstructionImages images{atOutputPixels(renderer, "surfaceDepth", 1, camera),
-                                    rgbOf(atOutputPixels(renderer, "normals", 4, camera))};
+        ReconstructionImages images{atOutputPixels(surfaceRenderer, "surfaceDepth", 1, camera),
+                                    rgbOf(atOutputPixels(surfaceRenderer, "normals", 4, camera))};
         QualityMetrics metrics = compareToGroundTruth(images, groundTruth, h);
-        const std::vector<std::uint8_t> surfaceImage = renderer.readImage();
+        const std::vector<std::uint8_t> surfaceImage = surfaceRenderer.readImage();
         metrics.psnrDb = psnr(surfaceImage, truthImage);
         surfaceViews.push_back(metrics);
         if (!settings.exportDirectory.empty()) {
@@ -502,6 +572,7 @@ nlohmann::json toJson(const EvaluationReport& report) {
         {"points", report.points},
         {"spacing", report.spacing},
         {"surface_reduced_views", report.surfaceReducedViews},
+        {"surface_points", report.surfacePoints},
         {"methods",
          {{"points", method(report.points1px)},
           {"splats", splats},

@@ -50,6 +50,11 @@ struct EvaluationSettings {
     /// instead of h alone: a LiDAR scan's far rings lie tens of h apart, and the fill between
     /// them is off the plane by a share of that gap without anything showing through.
     bool occlusionsByLocalSpacing = false;
+    /// When set, the surface is reconstructed as a streamed survey is: the points are indexed
+    /// into a COPC file in a temporary folder, and each view loads the nodes it selects within
+    /// this budget (lod::selectNodes), with the renderer's spacing and normals for them as
+    /// `render` makes them. The points and splats baselines still draw every point.
+    std::optional<std::uint64_t> pointBudget;
 };
 
 /// Where the views of a LiDAR scan's evaluation stand: near its scanner (ViewsFrom::Scanner),
@@ -100,6 +105,7 @@ struct EvaluationReport {
     int splatSize = 0;  // the best splat size in pixels (by PSNR)
     QualityMetrics surface;
     int surfaceReducedViews = 0;  // views the surface reconstructed at reduced resolution
+    double surfacePoints = 0.0;   // with a point budget: the points a view loaded, on average
 };
 
 /// Renders `points` with each method and compares with `truth` seen by the same cameras.

@@ -18,21 +18,12 @@ class CloudRecordSource final : public PointRecordSource {
   public:
     explicit CloudRecordSource(const std::string& source) {
         LoadedScan scan = loadScan(source);
-        cloud_ = std::move(scan.cloud);
-        Bounds bounds;
-        for (std::size_t i = 0; i < cloud_.size(); ++i) {
-            bounds.add(cloud_.fileCoordinates(i));
-        }
-        try {
-            writer_.emplace(cloud_.hasColors(), cloud_.hasNormals(), bounds);
-        } catch (const Error& error) {
-            throwNamed(source, error);
-        }
-        info_ = convertedSourceInfo(source, cloud_.size(), *writer_, bounds);
+        start(std::move(scan.cloud), source);
         for (const std::string& warning : scan.warnings) {
             info_.warnings.push_back(fmt::format("{}: {}", source, warning));
         }
     }
+    CloudRecordSource(PointCloud cloud, const std::string& name) { start(std::move(cloud), name); }
 
     const PointRecordSourceInfo& info() const override { return info_; }
 
@@ -62,6 +53,20 @@ class CloudRecordSource final : public PointRecordSource {
     void rewind() override { next_ = 0; }
 
   private:
+    void start(PointCloud cloud, const std::string& source) {
+        cloud_ = std::move(cloud);
+        Bounds bounds;
+        for (std::size_t i = 0; i < cloud_.size(); ++i) {
+            bounds.add(cloud_.fileCoordinates(i));
+        }
+        try {
+            writer_.emplace(cloud_.hasColors(), cloud_.hasNormals(), bounds);
+        } catch (const Error& error) {
+            throwNamed(source, error);
+        }
+        info_ = convertedSourceInfo(source, cloud_.size(), *writer_, bounds);
+    }
+
     PointCloud cloud_;
     std::optional<ConvertedRecordWriter> writer_;
     PointRecordSourceInfo info_;
@@ -72,6 +77,10 @@ class CloudRecordSource final : public PointRecordSource {
 
 std::unique_ptr<PointRecordSource> openCloudRecordSource(const std::string& source) {
     return std::make_unique<CloudRecordSource>(source);
+}
+
+std::unique_ptr<PointRecordSource> cloudRecordSource(PointCloud cloud, const std::string& name) {
+    return std::make_unique<CloudRecordSource>(std::move(cloud), name);
 }
 
 }  // namespace subscan

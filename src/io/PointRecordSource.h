@@ -9,6 +9,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/PointCloud.h"
+
 namespace subscan {
 
 /// The one form every input takes on its way into a COPC file (`subscan index`) or a LAS-family
@@ -69,6 +71,10 @@ class PointRecordSource {
 /// decoding threads (LAZ chunks); 0 uses every core. An input without points is an error.
 std::unique_ptr<PointRecordSource> openPointRecordSource(const std::filesystem::path& path,
                                                          unsigned threads = 0);
+
+/// A cloud in memory as records (quantized as `convert` quantizes clouds), named `name` in
+/// sentences: what `eval --point-budget` indexes.
+std::unique_ptr<PointRecordSource> cloudRecordSource(PointCloud cloud, const std::string& name);
 
 /// Several inputs as one source: one record format (the widest any input needs: format 7 when
 /// one has colour, 8 when one has NIR; extra bytes must be the same fields in all) and one

@@ -176,8 +176,13 @@ LoadedScan loadScan(std::string_view source, const std::function<void(double)>& 
         const std::unique_ptr<lod::NodeSource> ept = lod::openEpt(path);
         std::vector<std::size_t> every(ept->nodes().size());
         std::iota(every.begin(), every.end(), std::size_t{0});
+        // Loaded whole: the bounds are the points' own, not the description's.
         scan.warnings = ept->info().warnings;
         scan.cloud = lod::loadNodes(*ept, every, scan.warnings);
+        if (scan.cloud.size() == 0) {
+            throw Error(fmt::format("{}: none of its {} nodes could be read ({})", source,
+                                    every.size(), scan.warnings.back()));
+        }
         scan.format = ept->info().format;
         scan.formatDetail = ept->info().formatDetail;
         if (progress) {

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <optional>
@@ -156,12 +157,16 @@ std::vector<std::size_t> topLevels(const NodeSource& source, std::uint64_t point
 }
 
 PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> nodes,
-                     std::vector<std::string>& warnings, unsigned threads) {
+                     std::vector<std::string>& warnings, unsigned threads,
+                     const std::function<bool()>& cancelled) {
     std::vector<std::optional<PointCloud>> loaded(nodes.size());
     std::vector<std::string> failures(nodes.size());
     std::atomic<std::size_t> next{0};
     const auto work = [&] {
         for (std::size_t i = next++; i < nodes.size(); i = next++) {
+            if (cancelled && cancelled()) {
+                return;
+            }
             try {
                 loaded[i] = source.load(nodes[i]);
             } catch (const Error& error) {
@@ -233,20 +238,43 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
     return cloud;
 }
 
-LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_t> nodes) {
+LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_t> nodes,
+                            bool withSourceWarnings, const std::function<bool()>& cancelled) {
     const auto start = std::chrono::steady_clock::now();
     LoadedScan scan;
-    scan.warnings = source.info().warnings;
-    scan.cloud = loadNodes(source, nodes, scan.warnings);
-    if (!scan.cloud.bounds.empty()) {
-        scan.cloud.bounds.add(source.info().bounds.min);
-        scan.cloud.bounds.add(source.info().bounds.max);
+    if (withSourceWarnings) {
+        scan.warnings = source.info().warnings;
     }
+    scan.cloud = loadNodes(source, nodes, scan.warnings, 0, cancelled);
+    if (scan.cloud.size() == 0 && !nodes.empty() && !(cancelled && cancelled())) {
+        throw Error(fmt::format("{}: none of the {} nodes it needs could be read ({})",
+                                source.info().name, nodes.size(),
+                                scan.warnings.empty() ? "?" : scan.warnings.back()));
+    }
+    scan.cloud.bounds.add(source.info().bounds.min);
+    scan.cloud.bounds.add(source.info().bounds.max);
     scan.format = source.info().format;
     scan.formatDetail = source.info().formatDetail;
     scan.loadMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return scan;
+}
+
+LoadedScan loadStreamedOverview(const NodeSource& source, std::vector<std::size_t>* nodes) {
+    for (std::uint64_t points = kOverviewPoints;; points *= 8) {
+        std::vector<std::size_t> chosen = topLevels(source, points);
+        try {
+            LoadedScan scan = loadStreamedScan(source, chosen);
+            if (nodes != nullptr) {
+                *nodes = std::move(chosen);
+            }
+            return scan;
+        } catch (const Error&) {
+            if (chosen.size() == source.nodes().size()) {
+                throw;
+            }
+        }
+    }
 }
 
 }  // namespace subscan::lod

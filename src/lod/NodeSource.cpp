@@ -1,6 +1,7 @@
 #include "lod/NodeSource.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <glm/vector_relational.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
@@ -38,12 +40,11 @@ std::vector<std::byte> readWhole(const std::filesystem::path& path) {
     if (!stream) {
         throw Error("cannot be opened");
     }
-    std::vector<char> text((std::istreambuf_iterator<char>(stream)),
-                           std::istreambuf_iterator<char>());
-    std::vector<std::byte> bytes(text.size());
-    std::transform(text.begin(), text.end(), bytes.begin(),
-                   [](char c) { return static_cast<std::byte>(c); });
-    return bytes;
+    std::ostringstream text;
+    text << stream.rdbuf();
+    const std::string whole = std::move(text).str();
+    const auto* begin = reinterpret_cast<const std::byte*>(whole.data());
+    return {begin, begin + whole.size()};
 }
 
 nlohmann::json parseJson(std::string_view text) {
@@ -87,28 +88,78 @@ class CopcSource final : public NodeSource {
         info_.name = path.string();
         info_.format = "las";
         info_.cube = {copc.center, copc.halfSize, copc.rootSpacing};
-        info_.bounds = header_.declaredBounds;
+        if (!(info_.cube.halfSize > 0.0 && info_.cube.halfSize <= kMaxCoordinate &&
+              info_.cube.rootSpacing > 0.0 && std::isfinite(info_.cube.rootSpacing) &&
+              std::abs(info_.cube.center.x) <= kMaxCoordinate &&
+              std::abs(info_.cube.center.y) <= kMaxCoordinate &&
+              std::abs(info_.cube.center.z) <= kMaxCoordinate)) {
+            throw Error(
+                "the COPC info's cube (centre, half size, spacing) is not finite and "
+                "positive");
+        }
+        info_.bounds = boundsWithinCube(header_.declaredBounds);
         setNodes(std::move(nodes));
+        if (info_.points != header_.pointCount) {
+            info_.warnings.push_back(fmt::format(
+                "the COPC hierarchy's nodes hold {} points, but the LAS header declares {}; the "
+                "hierarchy's are read",
+                info_.points, header_.pointCount));
+        }
         info_.formatDetail = fmt::format(
             "COPC 1.0 (LAZ, LAS 1.{}, point format {}): octree of {} levels, {} nodes, root "
             "spacing {:.6g}",
             header_.versionMinor, header_.pointFormat, this->nodes().back().key.level + 1,
             this->nodes().size(), copc.rootSpacing);
-        // Colour depth is decided on the root's records for every node alike.
-        rootRecords_ = records(0);
+        // Colour depth is decided on the root's records for every node alike (a damaged root
+        // is left out when loaded; the others then decide each on their own).
+        try {
+            rootRecords_ = records(0);
+        } catch (const Error&) {
+            rootRecords_.clear();
+        }
     }
 
     PointCloud load(std::size_t index) const override {
-        const std::vector<std::byte> decoded = index == 0 ? rootRecords_ : records(index);
+        const std::vector<std::byte> decoded =
+            index == 0 && !rootRecords_.empty() ? rootRecords_ : records(index);
         std::vector<std::string> warnings;
-        return lasRecordsToCloud(file_.bytes(), header_, decoded, rootRecords_, ReadContext{},
+        return lasRecordsToCloud(file_.bytes(), header_, decoded,
+                                 rootRecords_.empty() ? decoded : rootRecords_, ReadContext{},
                                  warnings);
     }
 
   private:
+    /// The header's bounds where they are finite and lie in the octree's cube (a writer's
+    /// rounding aside); else the cube's, with a warning: they frame the view and are the
+    /// merged clouds' origin.
+    Bounds boundsWithinCube(const Bounds& declared) {
+        Bounds cube;
+        cube.add(info_.cube.center - info_.cube.halfSize);
+        cube.add(info_.cube.center + info_.cube.halfSize);
+        const glm::dvec3 slack(1e-6 * info_.cube.halfSize);
+        const bool inside = !declared.empty() &&
+                            glm::all(glm::greaterThanEqual(declared.min, cube.min - slack)) &&
+                            glm::all(glm::lessThanEqual(declared.max, cube.max + slack));
+        if (inside) {
+            return declared;
+        }
+        info_.warnings.push_back(fmt::format(
+            "the LAS header bounds ({} {} {} to {} {} {}) do not lie in the COPC octree's cube; "
+            "the cube's are used",
+            declared.min.x, declared.min.y, declared.min.z, declared.max.x, declared.max.y,
+            declared.max.z));
+        return cube;
+    }
+
     std::vector<std::byte> records(std::size_t index) const {
         const StreamedNode& node = nodes()[index];
         const laz::Chunk& chunk = chunks_.at(packedKey(node.key));
+        // A count LAZ cannot fit in the chunk's bytes is damage, not points to allocate for.
+        if (chunk.pointCount >
+            laz::kMostLazPointsPerByte * std::max<std::uint64_t>(chunk.byteSize, 1)) {
+            throw Error(fmt::format("{}: the hierarchy gives {} points for a chunk of {} bytes",
+                                    nodeName(node.key), chunk.pointCount, chunk.byteSize));
+        }
         std::vector<std::byte> decoded(chunk.pointCount * header_.recordLength);
         try {
             laz::decodeChunk(file_.bytes().subspan(chunk.offset, chunk.byteSize), chunk.pointCount,
@@ -157,6 +208,11 @@ class EptSource final : public NodeSource {
                             ept.points, listed));
         }
         setNodes(std::move(nodes));
+        try {
+            rootRecords_ = readTile(folder_ / "ept-data" / "0-0-0-0.laz").records.bytes;
+        } catch (const Error&) {
+            rootRecords_.clear();  // left out with a warning when loaded
+        }
         info_.formatDetail = fmt::format(
             "EPT {} (LAZ tiles): octree of {} levels, {} nodes, root spacing {:.6g}", ept.version,
             this->nodes().back().key.level + 1, this->nodes().size(), info_.cube.rootSpacing);
@@ -173,12 +229,16 @@ class EptSource final : public NodeSource {
         if (!std::filesystem::is_regular_file(tile, missing)) {
             throw fail(fmt::format("its tile {} is missing", tile.string()));
         }
-        ReadContext context;
-        context.decodeThreads = 1;  // nodes load on threads of their own
         PointCloud cloud;
         try {
-            const MappedFile file(tile);
-            cloud = readLas(file.bytes(), context);
+            const TileRecords records = readTile(tile);
+            std::vector<std::string> warnings;
+            // Colour depth decided on the root tile's records for every tile alike (a dark
+            // tile of 16-bit colours would otherwise pass for 8-bit and show 257 times too
+            // bright); a tile decides on its own where the root could not be read.
+            cloud = lasRecordsToCloud(records.file.bytes(), records.header, records.records.bytes,
+                                      rootRecords_.empty() ? records.records.bytes : rootRecords_,
+                                      ReadContext{}, warnings);
         } catch (const Error& error) {
             throw fail(fmt::format("{}: {}", tile.string(), error.what()));
         }
@@ -190,6 +250,20 @@ class EptSource final : public NodeSource {
     }
 
   private:
+    struct TileRecords {
+        MappedFile file;
+        LasHeader header;
+        LasRecords records;
+    };
+    static TileRecords readTile(const std::filesystem::path& tile) {
+        MappedFile file(tile);
+        ReadContext context;
+        context.decodeThreads = 1;  // nodes load on threads of their own
+        LasHeader header = parseLasHeader(file.bytes(), file.bytes().size(), context);
+        LasRecords records = readLasRecords(file.bytes(), context);
+        return {std::move(file), header, std::move(records)};
+    }
+
     static std::string eptName(const laz::VoxelKey& key) {
         return fmt::format("{}-{}-{}-{}", key.level, key.x, key.y, key.z);
     }
@@ -249,6 +323,7 @@ class EptSource final : public NodeSource {
 
     std::filesystem::path folder_;
     std::set<std::string> visited_;
+    std::vector<std::byte> rootRecords_;
 };
 
 }  // namespace
@@ -338,10 +413,10 @@ std::size_t NodeSource::find(const laz::VoxelKey& key) const {
 
 void NodeSource::setNodes(std::vector<StreamedNode> nodes) {
     for (const StreamedNode& node : nodes) {
-        const std::int32_t cells = std::int32_t{1} << std::min(node.key.level, 30);
-        if (node.key.level < 0 || node.key.level > kDeepestStreamedLevel || node.key.x < 0 ||
-            node.key.y < 0 || node.key.z < 0 || node.key.x >= cells || node.key.y >= cells ||
-            node.key.z >= cells) {
+        const bool levelKnown = node.key.level >= 0 && node.key.level <= kDeepestStreamedLevel;
+        const std::int32_t cells = std::int32_t{1} << (levelKnown ? node.key.level : 0);
+        if (!levelKnown || node.key.x < 0 || node.key.y < 0 || node.key.z < 0 ||
+            node.key.x >= cells || node.key.y >= cells || node.key.z >= cells) {
             throw Error(fmt::format("{}: {} lies outside the octree (levels 0 to {})", info_.name,
                                     nodeName(node.key), kDeepestStreamedLevel));
         }

@@ -98,7 +98,7 @@ EptHierarchyPage parseEptHierarchyPage(std::string_view text);
 /// Whether `path` names an EPT dataset (an ept.json, or a folder holding one).
 bool isEpt(const std::filesystem::path& path);
 
-/// Whether a scan is streamed by its levels of detail (`--lod`, "lod" in the settings): `auto`
+/// Whether a scan is streamed by its levels of detail (`--lod`): `auto`
 /// streams COPC files and EPT datasets and loads everything else whole, `on` refuses what
 /// cannot be streamed, `off` loads every file whole.
 enum class LodMode { Auto, On, Off };

@@ -832,9 +832,10 @@ class Indexer {
     }
 
     /// Reads the source again and appends every record to its chunk's file. Each chunk has a
-    /// buffer of an equal share of a quarter of the budget, taken once and written out whenever
-    /// it fills: memory stays within the budget whatever order the pieces come in (a survey's
-    /// come region by region), and each page is touched once. Buffers that grew by appending
+    /// buffer of an equal share of a quarter of the budget (at least 1,024 records, which
+    /// thousands of chunks under a small --memory would exceed it by), taken once and written
+    /// out whenever it fills: memory does not grow with the order the pieces come in (a
+    /// survey's come region by region), and each page is touched once. Buffers that grew by appending
     /// and were freed after every write-out spent 16.6 of 30.5 s indexing 44 M points here,
     /// copying as they grew and faulting in fresh pages each round.
     void distributeFromSource(const Chunking& chunking, ChunkStore& store) {

@@ -169,8 +169,11 @@ TEST(StreamedSourceDataTest, TheSameDepthAsTheWholeFileAtAFullBudget) {
         render(data / "lone_star.laz", "whole",
                {"--width", "512", "--height", "384", "--yaw", "30", "--pitch", "35"});
     const std::string camera = (folder / "whole" / "camera.json").string();
-    const ImageF copc = render(data / "lone_star.copc.laz", "copc", {"--camera", camera});
-    const ImageF ept = render(data / "ept" / "lone-star-laszip", "ept", {"--camera", camera});
+    // A budget of every point, whatever the renderer's default.
+    const ImageF copc = render(data / "lone_star.copc.laz", "copc",
+                               {"--camera", camera, "--point-budget", "518862"});
+    const ImageF ept = render(data / "ept" / "lone-star-laszip", "ept",
+                              {"--camera", camera, "--point-budget", "518862"});
     const ImageF copcWhole =
         render(data / "lone_star.copc.laz", "copc-off", {"--camera", camera, "--lod", "off"});
     ASSERT_EQ(copc.values.size(), whole.values.size());
@@ -249,6 +252,59 @@ TEST(StreamedSourceDataTest, ADamagedNodeIsLeftOutWithOneWarning) {
     EXPECT_THAT(result.err, HasSubstr("node 1-0-0-0: "));
     EXPECT_THAT(result.err, HasSubstr("node 1-1-0-0: its tile holds"));
     EXPECT_TRUE(std::filesystem::exists(folder / "out.png"));
+}
+
+TEST(StreamedSourceDataTest, AMissingRootOrBadBoundsStillShowTheRest) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const test::TempDir folder;
+    const auto picture = [&](const std::filesystem::path& scan) {
+        const test::CommandResult result =
+            test::runSubscan({"render", scan.string(), "-o", (folder / "out.png").string(),
+                              "--width", "64", "--height", "48", "--background", "#000000"});
+        const Image8 image = result.exitCode == 0 ? readPng(folder / "out.png") : Image8{};
+        std::size_t drawn = 0;
+        for (std::size_t i = 0; i < image.pixels.size(); i += 4) {
+            drawn += image.pixels[i] + image.pixels[i + 1] + image.pixels[i + 2] > 0;
+        }
+        return std::pair{result, drawn};
+    };
+    // The root tile missing: the overview takes the next level, the view leaves the root out.
+    const std::filesystem::path ept = folder / "ept";
+    std::filesystem::copy(data / "ept" / "lone-star-laszip", ept,
+                          std::filesystem::copy_options::recursive);
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(ept)) {
+        std::filesystem::permissions(entry.path(), std::filesystem::perms::owner_write,
+                                     std::filesystem::perm_options::add);
+    }
+    std::filesystem::remove(ept / "ept-data" / "0-0-0-0.laz");
+    const auto [rootless, rootlessDrawn] = picture(ept);
+    EXPECT_EQ(rootless.exitCode, 0) << rootless.err;
+    EXPECT_EQ(test::lineCount(rootless.err), 1u) << rootless.err;
+    EXPECT_THAT(rootless.err, HasSubstr("node 0-0-0-0: its tile "));
+    EXPECT_GT(rootlessDrawn, 300u);  // of 3,072 pixels: the scan covers about a fifth
+
+    // No tile at all: one sentence, no picture.
+    std::filesystem::remove_all(ept / "ept-data");
+    const auto [none, noneDrawn] = picture(ept);
+    EXPECT_EQ(none.exitCode, 1);
+    EXPECT_EQ(test::lineCount(none.err), 1u) << none.err;
+    EXPECT_THAT(none.err, HasSubstr("none of the 13 nodes it needs could be read"));
+
+    // A COPC header whose bounds are zeros: the octree's cube frames the view instead.
+    const std::filesystem::path copc = folder / "zeros.copc.laz";
+    std::filesystem::copy_file(data / "lone_star.copc.laz", copc);
+    std::filesystem::permissions(copc, std::filesystem::perms::owner_write,
+                                 std::filesystem::perm_options::add);
+    {
+        std::fstream file(copc, std::ios::in | std::ios::out | std::ios::binary);
+        file.seekp(179);  // max x, min x, max y, min y, max z, min z: six doubles
+        const std::string zeros(48, '\0');
+        file.write(zeros.data(), static_cast<std::streamsize>(zeros.size()));
+    }
+    const auto [zeroed, zeroedDrawn] = picture(copc);
+    EXPECT_EQ(zeroed.exitCode, 0) << zeroed.err;
+    EXPECT_THAT(zeroed.err, HasSubstr("do not lie in the COPC octree's cube; the cube's are used"));
+    EXPECT_GT(zeroedDrawn, 100u);  // the cube is larger than the bounds: a smaller picture
 }
 
 TEST(StreamedSourceDataTest, InfoDescribesAStreamedSourceFromItsHierarchy) {

@@ -75,6 +75,37 @@ TEST(LidarEvaluationGLTest, StationSourceGivesMetricsFromViewsNearTheStation) {
     EXPECT_GT(report.surface.coverage, 0.5);
 }
 
+TEST(LidarEvaluationGLTest, AStreamedSurfaceIsTheWholeCloudsAtAFullBudget) {
+    // eval --point-budget: the points indexed into a COPC file, each view loading its nodes.
+    // More points than one node holds (100,000), so that a budget can leave some out.
+    SyntheticSource source = makeSyntheticSource("outdoor-airborne?points=250000");
+    source.points.normals.clear();
+    EvaluationSettings settings = viewsNearTheScanner(source, 2, 128);
+    RenderSettings render;
+    render.surface.normals = NormalSource::Screen;  // what a streamed view uses under auto
+    const EvaluationReport whole =
+        evaluate(test::glTestContext(), *source.scene, source.points, settings, render);
+    settings.pointBudget = source.points.size();
+    const EvaluationReport all =
+        evaluate(test::glTestContext(), *source.scene, source.points, settings, render);
+    EXPECT_DOUBLE_EQ(all.surfacePoints, static_cast<double>(source.points.size()));
+    // The same points, quantized to the COPC file's grid (well below a millimetre here) and in
+    // another order: the metrics agree to a few pixels of 16,384 a view.
+    EXPECT_NEAR(all.surface.coverage, whole.surface.coverage, 0.002);
+    EXPECT_NEAR(all.surface.leakage, whole.surface.leakage, 0.002);
+    EXPECT_NEAR(all.surface.occlusionErrorRate, whole.surface.occlusionErrorRate, 0.002);
+    EXPECT_NEAR(all.surface.psnrDb, whole.surface.psnrDb, 0.2);
+
+    // A small budget: the views load part of the points and still show a surface.
+    settings.pointBudget = 100'000;
+    const EvaluationReport part =
+        evaluate(test::glTestContext(), *source.scene, source.points, settings, render);
+    EXPECT_LE(part.surfacePoints, 100'000.0);
+    EXPECT_GT(part.surfacePoints, 10'000.0);
+    EXPECT_GT(part.surface.coverage, 0.8);
+    EXPECT_LT(part.surface.coverage, all.surface.coverage + 0.01);
+}
+
 TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
     // At 320 px the far ground's rings lie several pixels apart: the global h (the spacing
     // near the station) leaves them apart, the local spacing closes them.

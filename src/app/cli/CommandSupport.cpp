@@ -29,11 +29,6 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
-LoadedScan loadStreamedOverview(const lod::NodeSource& source) {
-    // Its warnings are the view's too, which says them.
-    return lod::loadStreamedScan(source, lod::topLevels(source, lod::kOverviewPoints));
-}
-
 LoadedScan loadStreamedView(const lod::NodeSource& source, const Camera& camera,
                             std::uint64_t pointBudget) {
     LoadedScan scan = lod::loadStreamedScan(source, lod::selectNodes(source, camera, pointBudget));

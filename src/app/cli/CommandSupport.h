@@ -23,11 +23,6 @@ LoadedScan loadScanForCommand(std::string_view source);
 /// loadScanForCommand prints a reader's.
 void printSourceWarnings(const PointRecordSourceInfo& info);
 
-/// A streamed source's top levels (about 200,000 points, an even sample of the whole survey)
-/// with the whole survey's bounds: what a view of it is framed by. Says no warnings (a view
-/// loaded after it does).
-LoadedScan loadStreamedOverview(const lod::NodeSource& source);
-
 /// The nodes `camera` shows within `pointBudget` (lod::selectNodes), loaded on every core, with
 /// the whole survey's bounds (so that colouring by height does not depend on the budget).
 /// Prints a warning for each node left out.

@@ -88,6 +88,9 @@ int runEval(const EvalOptions& options) {
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
+    if (options.temporal && evaluation.pointBudget) {
+        throw Error("--point-budget measures still views; --temporal does not stream yet");
+    }
     if (options.temporal) {
         const TemporalReport report = evaluateTemporal(*context, *truth, points, evaluation,
                                                        options.temporalEvaluation, render);
@@ -124,10 +127,15 @@ int runEval(const EvalOptions& options) {
     }
     fmt::print("{}: {} points (h = {:.4g}), {} views of {}x{}", options.source, report.points,
                report.spacing, report.views, report.width, report.height);
-    fmt::print("{}\n", report.surfaceReducedViews == 0
-                           ? ""
-                           : fmt::format(" ({} of them reconstructed at reduced resolution)",
-                                         report.surfaceReducedViews));
+    fmt::print("{}{}\n",
+               report.surfaceReducedViews == 0
+                   ? ""
+                   : fmt::format(" ({} of them reconstructed at reduced resolution)",
+                                 report.surfaceReducedViews),
+               evaluation.pointBudget
+                   ? fmt::format("; the surface streamed within {} points: {:.0f} a view",
+                                 *evaluation.pointBudget, report.surfacePoints)
+                   : "");
     fmt::print("{:<14} {:>9} {:>9} {:>10} {:>10} {:>10} {:>10} {:>10} {:>8}\n", "method",
                "coverage", "leakage", "depth/h", "bias/h", "occluded", "normal°", "normal95",
                "PSNR");
@@ -184,6 +192,11 @@ Command addEvalCommand(CLI::App& parent) {
     eval->add_option("--step", options->temporalEvaluation.stepDegrees,
                      "Degrees of yaw between frames of --temporal")
         ->check(CLI::Range(0.0, 90.0));
+    eval->add_option("--point-budget", options->evaluation.pointBudget,
+                     "Reconstruct the surface as a streamed survey: the points indexed into a "
+                     "COPC file in a temporary folder, each view loading the nodes it selects "
+                     "within this many points")
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
     eval->add_flag("--json", options->json, "Machine-readable output");
     eval->add_flag("--software", options->software,
                    "Use Mesa's software rasterizer even when a GPU exists");

@@ -63,7 +63,11 @@ ScanSummary streamedSummary(const lod::NodeSource& source) {
         }
     }
     ScanSummary summary;
-    summary.scan.cloud = source.load(densest);
+    try {
+        summary.scan.cloud = source.load(densest);
+    } catch (const Error& error) {
+        throw Error(fmt::format("{}: {}", source.info().name, error.what()));
+    }
     summary.scan.cloud.bounds = source.info().bounds;
     summary.scan.format = source.info().format;
     summary.scan.formatDetail = source.info().formatDetail;

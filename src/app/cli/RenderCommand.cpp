@@ -137,7 +137,7 @@ int runRender(const RenderOptions& options) {
     Camera camera;
     if (streamed) {
         // Framed by an even sample of the whole survey, then the nodes that view shows.
-        camera = frame.camera(loadStreamedOverview(*streamed));
+        camera = frame.camera(lod::loadStreamedOverview(*streamed));
         const std::uint64_t budget = options.pointBudget.value_or(context->capabilities().software
                                                                       ? lod::kSoftwarePointBudget
                                                                       : lod::kHardwarePointBudget);

@@ -36,8 +36,7 @@ void ScanLoadJob::load() {
         prepared.source = source_;
         prepared.streamed = lod::openStreamed(source_, lod::LodMode::Auto);
         if (prepared.streamed) {
-            prepared.nodes = lod::topLevels(*prepared.streamed, lod::kOverviewPoints);
-            prepared.scan = lod::loadStreamedScan(*prepared.streamed, prepared.nodes);
+            prepared.scan = lod::loadStreamedOverview(*prepared.streamed, &prepared.nodes);
         } else {
             prepared.scan = loadScan(source_, reportProgress);
         }

@@ -30,7 +30,10 @@ void StreamedViewJob::load() {
             PreparedScan prepared;
             prepared.source = sourceName_;
             prepared.streamed = source_;
-            prepared.scan = lod::loadStreamedScan(*source_, nodes);
+            // The source's own warnings were said when it opened.
+            prepared.scan = lod::loadStreamedScan(*source_, nodes, false, [this] {
+                return cancelled_.load(std::memory_order_relaxed);
+            });
             prepared.nodes = std::move(nodes);
             if (prepareForRenderer(prepared,
                                    [this] { return cancelled_.load(std::memory_order_relaxed); })) {
