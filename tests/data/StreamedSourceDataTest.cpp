@@ -50,6 +50,16 @@ std::vector<std::size_t> everyNode(const NodeSource& source) {
     return all;
 }
 
+/// A copy of the shared data's `from` at `to` that the test may damage (the originals are
+/// read-only).
+void writableCopy(const std::filesystem::path& from, const std::filesystem::path& to) {
+    std::filesystem::copy(from, to, std::filesystem::copy_options::recursive);
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(to)) {
+        std::filesystem::permissions(entry.path(), std::filesystem::perms::owner_write,
+                                     std::filesystem::perm_options::add);
+    }
+}
+
 Camera framing(const NodeSource& source, double yaw, double pitch) {
     OrbitView orbit;
     orbit.yawDegrees = yaw;
@@ -207,12 +217,7 @@ TEST(StreamedSourceDataTest, ADamagedNodeIsLeftOutWithOneWarning) {
     SUBSCAN_REQUIRE_TEST_DATA(data);
     const test::TempDir folder;
     const std::filesystem::path ept = folder / "ept";
-    std::filesystem::copy(data / "ept" / "lone-star-laszip", ept,
-                          std::filesystem::copy_options::recursive);
-    for (const auto& entry : std::filesystem::recursive_directory_iterator(ept)) {
-        std::filesystem::permissions(entry.path(), std::filesystem::perms::owner_write,
-                                     std::filesystem::perm_options::add);
-    }
+    writableCopy(data / "ept" / "lone-star-laszip", ept);
     // A missing tile, a truncated one, and one whose count the hierarchy misstates.
     std::filesystem::remove(ept / "ept-data" / "3-5-4-3.laz");
     std::filesystem::resize_file(ept / "ept-data" / "1-0-0-0.laz", 5000);
@@ -270,12 +275,7 @@ TEST(StreamedSourceDataTest, AMissingRootOrBadBoundsStillShowTheRest) {
     };
     // The root tile missing: the overview takes the next level, the view leaves the root out.
     const std::filesystem::path ept = folder / "ept";
-    std::filesystem::copy(data / "ept" / "lone-star-laszip", ept,
-                          std::filesystem::copy_options::recursive);
-    for (const auto& entry : std::filesystem::recursive_directory_iterator(ept)) {
-        std::filesystem::permissions(entry.path(), std::filesystem::perms::owner_write,
-                                     std::filesystem::perm_options::add);
-    }
+    writableCopy(data / "ept" / "lone-star-laszip", ept);
     std::filesystem::remove(ept / "ept-data" / "0-0-0-0.laz");
     const auto [rootless, rootlessDrawn] = picture(ept);
     EXPECT_EQ(rootless.exitCode, 0) << rootless.err;
