@@ -1,6 +1,8 @@
 #include "lod/NodeSource.h"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -56,14 +58,27 @@ nlohmann::json parseJson(std::string_view text) {
 }
 
 /// "D-X-Y-Z" as EPT names nodes.
-std::optional<laz::VoxelKey> parseEptKey(const std::string& name) {
-    laz::VoxelKey key;
-    char tail = 0;
-    if (std::sscanf(name.c_str(), "%d-%d-%d-%d%c", &key.level, &key.x, &key.y, &key.z, &tail) !=
-        4) {
+std::optional<laz::VoxelKey> parseEptKey(std::string_view name) {
+    std::array<std::int32_t, 4> parts{};
+    const char* at = name.data();
+    const char* const end = name.data() + name.size();
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+        if (i > 0) {
+            if (at == end || *at != '-') {
+                return std::nullopt;
+            }
+            ++at;
+        }
+        const auto [next, error] = std::from_chars(at, end, parts[i]);
+        if (error != std::errc{}) {
+            return std::nullopt;  // not a number, or beyond 32 bits
+        }
+        at = next;
+    }
+    if (at != end) {
         return std::nullopt;
     }
-    return key;
+    return laz::VoxelKey{parts[0], parts[1], parts[2], parts[3]};
 }
 
 class CopcSource final : public NodeSource {
