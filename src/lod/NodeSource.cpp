@@ -515,6 +515,11 @@ std::unique_ptr<NodeSource> openStreamed(std::string_view source, LodMode mode) 
             }
         }
     }
+    std::error_code missing;
+    if (mode == LodMode::On && !source.starts_with("synthetic:") &&
+        !std::filesystem::exists(path, missing)) {
+        throw Error(fmt::format("{}: no such file or folder", source));
+    }
     if (mode == LodMode::On) {
         throw Error(fmt::format(
             "{}: is neither a COPC file nor an EPT dataset, which --lod on streams; index it "

@@ -354,6 +354,9 @@ TEST(StreamedSourceDataTest, WhatCannotBeStreamedIsOneSentence) {
     EXPECT_THAT(result.err, HasSubstr("is neither a COPC file nor an EPT dataset"));
     EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
     EXPECT_THROW(parseLodMode("sometimes"), Error);
+    EXPECT_EQ(test::errorMessage(
+                  [&] { openStreamed((data / "no-such-survey.copc.laz").string(), LodMode::On); }),
+              (data / "no-such-survey.copc.laz").string() + ": no such file or folder");
 }
 
 }  // namespace
