@@ -26,6 +26,11 @@ inline constexpr double kFinestParentSpacingPixels = 0.5;
 inline constexpr std::uint64_t kSoftwarePointBudget = 1'000'000;
 inline constexpr std::uint64_t kHardwarePointBudget = 10'000'000;
 
+/// `requested`, or where it is 0 the default of the renderer (`software`: Mesa's llvmpipe).
+inline std::uint64_t pointBudgetFor(std::uint64_t requested, bool software) {
+    return requested != 0 ? requested : software ? kSoftwarePointBudget : kHardwarePointBudget;
+}
+
 /// The nodes `camera` shows within `pointBudget` points, as Potree chooses them: from the root,
 /// the node that looks largest next (its bounding sphere's radius in pixels; the node holding
 /// the eye first), skipping nodes outside the view and children that add no detail

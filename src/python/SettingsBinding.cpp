@@ -15,7 +15,8 @@ namespace subscan::python {
 
 namespace {
 
-constexpr const char* kSections[] = {"raster", "surface", "shading", "scattering", "temporal"};
+constexpr const char* kSections[] = {"raster",     "surface",  "shading",
+                                     "scattering", "temporal", "streaming"};
 
 /// `settings` with the settings-file JSON `patch` written over it (absent keys keep their
 /// values); ValueError with the library's sentence for unknown keys and bad values.
@@ -99,7 +100,8 @@ RenderSettings settingsArgument(const py::handle& argument) {
 
 void bindSettings(py::module_& module) {
     py::class_<SettingsSection>(module, "SettingsSection", R"doc(
-One section of a Settings (settings.raster, .surface, .shading, .scattering, .temporal): its
+One section of a Settings (settings.raster, .surface, .shading, .scattering, .temporal,
+.streaming): its
 keys are attributes, read as plain Python values and written with the settings file's checks.
 A key the section lacks raises AttributeError; a bad value raises ValueError.
 )doc")
@@ -123,7 +125,8 @@ A key the section lacks raises AttributeError; a bad value raises ValueError.
 
     py::class_<SettingsData, SettingsHandle>(module, "Settings", R"doc(
 Every pipeline setting, as `subscan render --settings FILE` reads it and --save-settings writes
-it: sections raster, surface, shading, scattering and temporal, each a set of keys.
+it: sections raster, surface, shading, scattering, temporal and streaming, each a set of keys
+(streaming: how `render` and the viewer read COPC and EPT surveys; a Renderer loads whole).
 
     s = subscan.Settings(raster={"mode": "sss"}, scattering={"material": "skin1"})
     s.surface.visibility_threshold = 0.2

@@ -43,6 +43,11 @@ constexpr std::pair<Stage, std::string_view> kStages[] = {
     {Stage::Fill, "fill"},       {Stage::Normals, "normals"},
     {Stage::Shaded, "shaded"},
 };
+constexpr std::pair<lod::LodMode, std::string_view> kLodModes[] = {
+    {lod::LodMode::Auto, "auto"},
+    {lod::LodMode::On, "on"},
+    {lod::LodMode::Off, "off"},
+};
 constexpr std::pair<Resolution, std::string_view> kResolutions[] = {
     {Resolution::Full, "full"},
     {Resolution::Half, "half"},
@@ -152,11 +157,26 @@ void from_json(const nlohmann::json& json, TemporalSettings& settings) {
     readSetting(json, "max_frames", settings.maxFrames, 1, 2048);
 }
 
+void to_json(nlohmann::json& json, const StreamingSettings& settings) {
+    json = {
+        {"lod", nameOf(kLodModes, settings.lod)},
+        {"point_budget", settings.pointBudget},
+    };
+}
+
+void from_json(const nlohmann::json& json, StreamingSettings& settings) {
+    rejectUnknownKeys(json, "streaming", {"lod", "point_budget"});
+    readEnum(json, "lod", settings.lod, kLodModes, "level-of-detail mode");
+    // 2^40 points: more than any survey a machine of today holds.
+    readSetting(json, "point_budget", settings.pointBudget, std::uint64_t{0},
+                std::uint64_t{1} << 40);
+}
+
 void to_json(nlohmann::json& json, const RenderSettings& settings) {
     json = {
         {"raster", settings.raster},     {"surface", settings.surface},
         {"shading", settings.shading},   {"scattering", settings.scattering},
-        {"temporal", settings.temporal},
+        {"temporal", settings.temporal}, {"streaming", settings.streaming},
     };
 }
 
@@ -166,10 +186,10 @@ void from_json(const nlohmann::json& json, RenderSettings& settings) {
     }
     for (const auto& [key, value] : json.items()) {
         if (key != "raster" && key != "surface" && key != "shading" && key != "scattering" &&
-            key != "temporal") {
+            key != "temporal" && key != "streaming") {
             throw Error(
                 fmt::format("unknown settings section '{}' (expected raster, surface, "
-                            "shading, scattering, temporal)",
+                            "shading, scattering, temporal, streaming)",
                             key));
         }
     }
@@ -179,6 +199,7 @@ void from_json(const nlohmann::json& json, RenderSettings& settings) {
     json.value("shading", nlohmann::json::object()).get_to(settings.shading);
     json.value("scattering", nlohmann::json::object()).get_to(settings.scattering);
     json.value("temporal", nlohmann::json::object()).get_to(settings.temporal);
+    json.value("streaming", nlohmann::json::object()).get_to(settings.streaming);
 }
 
 RenderSettings readSettingsFile(const std::filesystem::path& path, const RenderSettings& defaults) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -9,6 +10,7 @@
 
 #include "gpu/GpuClear.h"
 #include "gpu/PassTimer.h"
+#include "lod/NodeSource.h"
 #include "render/ScatteringSettings.h"
 #include "render/SurfaceSettings.h"
 
@@ -75,15 +77,26 @@ struct TemporalSettings {
     bool operator==(const TemporalSettings&) const = default;
 };
 
+/// How a COPC file or EPT dataset is read (docs/surveys.md): streamed by its levels of detail
+/// or whole (lod::LodMode), and the most points a streamed view loads (0: the renderer's
+/// default, lod::pointBudgetFor).
+struct StreamingSettings {
+    lod::LodMode lod = lod::LodMode::Auto;
+    std::uint64_t pointBudget = 0;
+
+    bool operator==(const StreamingSettings&) const = default;
+};
+
 /// Every setting of a frame, one struct per concern; the JSON the CLI's --settings and the
 /// viewer read and write: {"raster": {...}, "surface": {...}, "shading": {...},
-/// "scattering": {...}, "temporal": {...}}.
+/// "scattering": {...}, "temporal": {...}, "streaming": {...}}.
 struct RenderSettings {
     RasterSettings raster;
     SurfaceSettings surface;
     ShadingSettings shading;
     ScatteringSettings scattering;
     TemporalSettings temporal;
+    StreamingSettings streaming;
 
     bool operator==(const RenderSettings&) const = default;
 };
@@ -98,6 +111,8 @@ void to_json(nlohmann::json& json, const RasterSettings& settings);
 void from_json(const nlohmann::json& json, RasterSettings& settings);
 void to_json(nlohmann::json& json, const TemporalSettings& settings);
 void from_json(const nlohmann::json& json, TemporalSettings& settings);
+void to_json(nlohmann::json& json, const StreamingSettings& settings);
+void from_json(const nlohmann::json& json, StreamingSettings& settings);
 void to_json(nlohmann::json& json, const RenderSettings& settings);
 void from_json(const nlohmann::json& json, RenderSettings& settings);
 

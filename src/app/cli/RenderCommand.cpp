@@ -35,8 +35,8 @@ struct RenderOptions {
     std::string exportDirectory;
     std::optional<int> samples;  // unset: 1, or kTemporalRestFrames with the filter on
     bool timings = false;
-    std::string lod = "auto";
-    std::optional<std::uint64_t> pointBudget;  // unset: by the renderer (lod::k*PointBudget)
+    std::optional<std::string> lod;            // unset: the settings' (streaming.lod)
+    std::optional<std::uint64_t> pointBudget;  // unset: the settings' (streaming.point_budget)
 };
 
 /// Per-pass median over `timed` frames after one warm-up (llvmpipe compiles shaders lazily and
@@ -111,6 +111,12 @@ int runRender(const RenderOptions& options) {
             std::filesystem::path(options.exportDirectory) / "camera.json", "the camera");
     }
     RenderSettings settings = frame.settings();
+    if (options.lod) {
+        settings.streaming.lod = lod::parseLodMode(*options.lod);
+    }
+    if (options.pointBudget) {
+        settings.streaming.pointBudget = *options.pointBudget;
+    }
     const RasterSettings& raster = settings.raster;
     // The filter on without --samples: its picture at rest, as the viewer shows it.
     const int samples =
@@ -131,16 +137,15 @@ int runRender(const RenderOptions& options) {
         checkLinearPictureRequest(output, settings, samples);
     }
     const std::unique_ptr<lod::NodeSource> streamed =
-        lod::openStreamed(frame.source, lod::parseLodMode(options.lod));
+        lod::openStreamed(frame.source, settings.streaming.lod);
     const std::unique_ptr<GlContext> context = frame.context();
     LoadedScan scan;
     Camera camera;
     if (streamed) {
         // Framed by an even sample of the whole survey, then the nodes that view shows.
         camera = frame.camera(lod::loadStreamedOverview(*streamed));
-        const std::uint64_t budget = options.pointBudget.value_or(context->capabilities().software
-                                                                      ? lod::kSoftwarePointBudget
-                                                                      : lod::kHardwarePointBudget);
+        const std::uint64_t budget =
+            lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software);
         scan = loadStreamedView(*streamed, camera, budget);
     } else {
         scan = loadScanForCommand(frame.source);

@@ -16,8 +16,8 @@ struct LoadCancelled {};
 
 }  // namespace
 
-ScanLoadJob::ScanLoadJob(std::string source)
-    : source_(std::move(source)), thread_([this] { load(); }) {}
+ScanLoadJob::ScanLoadJob(std::string source, lod::LodMode lod)
+    : source_(std::move(source)), lod_(lod), thread_([this] { load(); }) {}
 
 ScanLoadJob::~ScanLoadJob() {
     cancelled_.store(true, std::memory_order_relaxed);
@@ -34,7 +34,7 @@ void ScanLoadJob::load() {
     try {
         PreparedScan prepared;
         prepared.source = source_;
-        prepared.streamed = lod::openStreamed(source_, lod::LodMode::Auto);
+        prepared.streamed = lod::openStreamed(source_, lod_);
         if (prepared.streamed) {
             prepared.scan = lod::loadStreamedOverview(*prepared.streamed, &prepared.nodes);
         } else {

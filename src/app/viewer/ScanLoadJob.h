@@ -41,7 +41,8 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
 /// progress report and waits for the thread.
 class ScanLoadJob {
   public:
-    explicit ScanLoadJob(std::string source);
+    /// `lod`: whether a COPC file or EPT dataset is streamed (settings' streaming.lod).
+    ScanLoadJob(std::string source, lod::LodMode lod);
     ~ScanLoadJob();
     ScanLoadJob(const ScanLoadJob&) = delete;
     ScanLoadJob& operator=(const ScanLoadJob&) = delete;
@@ -58,6 +59,7 @@ class ScanLoadJob {
     void load();
 
     std::string source_;
+    lod::LodMode lod_;
     std::atomic<double> progress_{0.0};
     std::atomic<bool> finished_{false};
     std::atomic<bool> cancelled_{false};

@@ -387,7 +387,7 @@ void Viewer::flyWithKeys(double seconds) {
 
 void Viewer::startLoading(const std::string& source) {
     // Replacing a running job cancels it (its destructor waits for the thread).
-    loading_ = std::make_unique<ScanLoadJob>(source);
+    loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming.lod);
     status_.loadingSource = source;
 }
 
@@ -473,7 +473,8 @@ std::optional<Camera> Viewer::dueRefinement() const {
     }
     const glm::ivec2 size = viewportSize();
     const Camera camera = camera_.camera(std::max(size.x, 1), std::max(size.y, 1));
-    if (refinedCamera_ && sameCamera(*refinedCamera_, camera)) {
+    if (refinedCamera_ && sameCamera(*refinedCamera_, camera) &&
+        refinedBudget_ == settings_.streaming.pointBudget) {
         return std::nullopt;
     }
     return camera;
@@ -510,8 +511,9 @@ void Viewer::refineStreamedView() {
         return;
     }
     refinedCamera_ = camera;
+    refinedBudget_ = settings_.streaming.pointBudget;
     const std::uint64_t budget =
-        context_.capabilities().software ? lod::kSoftwarePointBudget : lod::kHardwarePointBudget;
+        lod::pointBudgetFor(settings_.streaming.pointBudget, context_.capabilities().software);
     refining_ = std::make_unique<StreamedViewJob>(streamed_, status_.scanSource, *camera, budget,
                                                   streamedNodes_);
     status_.streamingView = true;

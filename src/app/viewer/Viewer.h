@@ -179,6 +179,7 @@ class Viewer {
     std::optional<Camera> stillCamera_;
     double stillSince_ = 0.0;
     std::optional<Camera> refinedCamera_;
+    std::uint64_t refinedBudget_ = 0;  // the settings' point budget it was refined with
     bool initialScanShown_ = false;
     std::optional<std::string> pendingOpen_;
 

@@ -180,7 +180,7 @@ PanelRequests ViewerPanel::draw(RenderSettings& settings, Navigation& navigation
     bottomRight_ = {position.x + size.x, position.y + size.y};
     if (expanded) {
         ImGui::PushItemWidth(-150.0f);
-        drawScan(status, requests);
+        drawScan(status, settings.streaming, requests);
         drawPerformance(status, redrawEveryFrame);
         drawView(settings, navigation, status, requests);
         if (ImGui::CollapsingHeader("Surface reconstruction")) {
@@ -234,7 +234,8 @@ bool ViewerPanel::covers(const glm::dvec2& windowPosition) const {
            windowPosition.x < bottomRight_.x && windowPosition.y < bottomRight_.y;
 }
 
-void ViewerPanel::drawScan(const PanelStatus& status, PanelRequests& requests) {
+void ViewerPanel::drawScan(const PanelStatus& status, StreamingSettings& streaming,
+                           PanelRequests& requests) {
     if (!ImGui::CollapsingHeader("Scan", ImGuiTreeNodeFlags_DefaultOpen)) {
         return;
     }
@@ -247,6 +248,14 @@ void ViewerPanel::drawScan(const PanelStatus& status, PanelRequests& requests) {
                                status.streamedNodesInAll,
                                groupedThousands(status.streamedPointsInAll).c_str(),
                                status.streamingView ? "; loading the view's nodes" : "");
+            // Applied when Enter is pressed: every change reloads the view's nodes.
+            constexpr std::uint64_t kStep = 100'000, kFastStep = 1'000'000;
+            ImGui::InputScalar("point budget", ImGuiDataType_U64, &streaming.pointBudget, &kStep,
+                               &kFastStep, nullptr, ImGuiInputTextFlags_EnterReturnsTrue);
+            helpTooltip(
+                "The most points a view of this survey loads; 0: 1,000,000 on software "
+                "rendering, 10,000,000 on a GPU. The view's nodes load again once the camera "
+                "rests.");
         }
         ImGui::Text("loaded in %.0f ms", status.loadMilliseconds);
         constexpr Coloring kColorings[] = {Coloring::Auto,           Coloring::Rgb,

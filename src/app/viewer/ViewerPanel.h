@@ -95,7 +95,7 @@ class ViewerPanel {
     bool covers(const glm::dvec2& windowPosition) const;
 
   private:
-    void drawScan(const PanelStatus& status, PanelRequests& requests);
+    void drawScan(const PanelStatus& status, StreamingSettings& streaming, PanelRequests& requests);
     void drawPerformance(const PanelStatus& status, bool& redrawEveryFrame);
     void drawView(RenderSettings& settings, Navigation& navigation, const PanelStatus& status,
                   PanelRequests& requests);

@@ -5,6 +5,7 @@
 #include <glm/ext/matrix_transform.hpp>
 
 #include "core/Error.h"
+#include "lod/NodeSelection.h"
 #include "render/GpuPointCloud.h"
 #include "render/RenderSettings.h"
 #include "support/TestSupport.h"
@@ -48,6 +49,31 @@ TEST(RenderSettingsTest, TemporalSettingsRoundTripAndRefuseImpossibleValues) {
     EXPECT_THROW(read({{"max_frames", 4096}}), Error);       // beyond a half float's integers
     EXPECT_THROW(read({{"clip", 1.0}}), Error);              // unknown key
     EXPECT_FALSE(read(nlohmann::json::object()).temporal.enabled);
+}
+
+TEST(RenderSettingsTest, StreamingSettingsRoundTripAndRefuseImpossibleValues) {
+    RenderSettings settings;
+    EXPECT_EQ(settings.streaming.lod, lod::LodMode::Auto);
+    EXPECT_EQ(settings.streaming.pointBudget, 0u);  // the renderer's default
+    settings.streaming.lod = lod::LodMode::Off;
+    settings.streaming.pointBudget = 2'500'000;
+    const nlohmann::json json = settings;
+    EXPECT_EQ(json["streaming"]["lod"], "off");
+    EXPECT_EQ(json["streaming"]["point_budget"], 2'500'000);
+    EXPECT_EQ(json.get<RenderSettings>(), settings);
+    const auto refusal = [](const nlohmann::json& streaming) {
+        return test::errorMessage([&] {
+            (void)nlohmann::json{{"streaming", streaming}}.get<RenderSettings>();
+        });
+    };
+    EXPECT_THAT(refusal({{"lod", "sometimes"}}),
+                ::testing::HasSubstr("'sometimes' is not a level-of-detail"));
+    EXPECT_THAT(refusal({{"point_budget", -1}}), ::testing::HasSubstr("'point_budget'"));
+    EXPECT_THAT(refusal({{"point_budget", 2e12}}), ::testing::HasSubstr("'point_budget'"));
+    EXPECT_THAT(refusal({{"budget", 5}}), ::testing::HasSubstr("budget"));
+    EXPECT_EQ(lod::pointBudgetFor(0, true), lod::kSoftwarePointBudget);
+    EXPECT_EQ(lod::pointBudgetFor(0, false), lod::kHardwarePointBudget);
+    EXPECT_EQ(lod::pointBudgetFor(5, true), 5u);
 }
 
 TEST(RenderSettingsTest, WholeSettingsRoundTripThroughAFile) {
