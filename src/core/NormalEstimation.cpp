@@ -91,7 +91,8 @@ std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
     std::atomic<bool> stopped{false};
     // In the tree's own order, which keeps each thread's queries close together: its nodes stay
     // in the cache (10 % faster on the Happy Buddha than the file's order).
-    inParallel(positions.size(), [&](std::size_t query) {
+    constexpr std::size_t kQueriesPerBlock = 4096;  // neighbours in the tree's order share nodes
+    inParallelBlocks(positions.size(), kQueriesPerBlock, [&](std::size_t query) {
         constexpr std::size_t kCancelCheckEvery = 1 << 14;
         if (cancelled && (stopped.load(std::memory_order_relaxed) ||
                           (query % kCancelCheckEvery == 0 && cancelled()))) {

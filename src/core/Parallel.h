@@ -1,6 +1,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <thread>
 #include <vector>
@@ -23,6 +24,29 @@ void inParallel(std::size_t count, const Work& work) {
         workers.emplace_back(range, thread);
     }
     range(0);
+}
+
+/// Runs `work(i)` for every i < count, split across the machine's cores (at most 16) in blocks
+/// of `block` consecutive indices that each thread takes as it finishes the last: a thread the
+/// system slows down (another process on its core) delays one block, not half of the work.
+template <class Work>
+void inParallelBlocks(std::size_t count, std::size_t block, const Work& work) {
+    const std::size_t threads = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1, 16);
+    std::atomic<std::size_t> next{0};
+    const auto take = [&] {
+        for (std::size_t first = next.fetch_add(block); first < count;
+             first = next.fetch_add(block)) {
+            const std::size_t last = std::min(first + block, count);
+            for (std::size_t i = first; i < last; ++i) {
+                work(i);
+            }
+        }
+    };
+    std::vector<std::jthread> workers;
+    for (std::size_t thread = 1; thread < threads; ++thread) {
+        workers.emplace_back(take);
+    }
+    take();
 }
 
 }  // namespace subscan
