@@ -477,14 +477,10 @@ std::unique_ptr<NodeSource> openEpt(const std::filesystem::path& path) {
 }
 
 LodMode parseLodMode(std::string_view name) {
-    if (name == "auto") {
-        return LodMode::Auto;
-    }
-    if (name == "on") {
-        return LodMode::On;
-    }
-    if (name == "off") {
-        return LodMode::Off;
+    for (const auto& [mode, modeName] : kLodModeNames) {
+        if (name == modeName) {
+            return mode;
+        }
     }
     throw Error(fmt::format("unknown level-of-detail mode \"{}\" (auto, on or off)", name));
 }

@@ -7,6 +7,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/PointCloud.h"
@@ -102,6 +103,12 @@ bool isEpt(const std::filesystem::path& path);
 /// streams COPC files and EPT datasets and loads everything else whole, `on` refuses what
 /// cannot be streamed, `off` loads every file whole.
 enum class LodMode { Auto, On, Off };
+/// Each mode's name, as `--lod` and the settings file's streaming.lod spell it.
+inline constexpr std::pair<LodMode, std::string_view> kLodModeNames[] = {
+    {LodMode::Auto, "auto"},
+    {LodMode::On, "on"},
+    {LodMode::Off, "off"},
+};
 /// "auto", "on" or "off"; throws subscan::Error for anything else.
 LodMode parseLodMode(std::string_view name);
 

@@ -43,11 +43,6 @@ constexpr std::pair<Stage, std::string_view> kStages[] = {
     {Stage::Fill, "fill"},       {Stage::Normals, "normals"},
     {Stage::Shaded, "shaded"},
 };
-constexpr std::pair<lod::LodMode, std::string_view> kLodModes[] = {
-    {lod::LodMode::Auto, "auto"},
-    {lod::LodMode::On, "on"},
-    {lod::LodMode::Off, "off"},
-};
 constexpr std::pair<Resolution, std::string_view> kResolutions[] = {
     {Resolution::Full, "full"},
     {Resolution::Half, "half"},
@@ -159,14 +154,14 @@ void from_json(const nlohmann::json& json, TemporalSettings& settings) {
 
 void to_json(nlohmann::json& json, const StreamingSettings& settings) {
     json = {
-        {"lod", nameOf(kLodModes, settings.lod)},
+        {"lod", nameOf(lod::kLodModeNames, settings.lod)},
         {"point_budget", settings.pointBudget},
     };
 }
 
 void from_json(const nlohmann::json& json, StreamingSettings& settings) {
     rejectUnknownKeys(json, "streaming", {"lod", "point_budget"});
-    readEnum(json, "lod", settings.lod, kLodModes, "level-of-detail mode");
+    readEnum(json, "lod", settings.lod, lod::kLodModeNames, "level-of-detail mode");
     // 2^40 points: more than any survey a machine of today holds.
     readSetting(json, "point_budget", settings.pointBudget, std::uint64_t{0},
                 std::uint64_t{1} << 40);
