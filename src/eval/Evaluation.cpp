@@ -2,13 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
-#include <system_error>
 #include <tuple>
 #include <vector>
 
@@ -25,6 +23,7 @@
 #include "gpu/ShaderSources.h"
 #include "io/Image.h"
 #include "io/PointRecordSource.h"
+#include "io/TemporaryFolder.h"
 #include "lod/CopcWriter.h"
 #include "lod/NodeSelection.h"
 #include "lod/NodeSource.h"
@@ -231,33 +230,21 @@ std::vector<float> SpacingAtTruth::at(const Camera& camera, const GroundTruthIma
 /// of its own, removed with it.
 class StreamedPoints {
   public:
-    explicit StreamedPoints(const PointCloud& points) {
-        std::string pattern = (std::filesystem::temp_directory_path() / "subscan-eval-XXXXXX");
-        if (::mkdtemp(pattern.data()) == nullptr) {
-            throw Error(fmt::format("{}: cannot make a temporary folder for the indexed points",
-                                    std::filesystem::temp_directory_path().string()));
-        }
-        folder_ = pattern;
+    explicit StreamedPoints(const PointCloud& points)
+        : folder_(std::filesystem::temp_directory_path(), "subscan-eval") {
         const std::unique_ptr<PointRecordSource> records =
             cloudRecordSource(points, "the evaluated points");
         lod::IndexSettings index;
-        index.temporaryDirectory = folder_;
-        lod::writeCopc(*records, folder_ / "points.copc.laz", index);
-        source_ = lod::openCopc(folder_ / "points.copc.laz");
+        index.temporaryDirectory = folder_.path();
+        lod::writeCopc(*records, folder_.path() / "points.copc.laz", index);
+        source_ = lod::openCopc(folder_.path() / "points.copc.laz");
     }
-    ~StreamedPoints() {
-        source_.reset();
-        std::error_code ignored;
-        std::filesystem::remove_all(folder_, ignored);
-    }
-    StreamedPoints(const StreamedPoints&) = delete;
-    StreamedPoints& operator=(const StreamedPoints&) = delete;
 
     const lod::NodeSource& source() const { return *source_; }
 
   private:
-    std::filesystem::path folder_;
-    std::unique_ptr<lod::NodeSource> source_;
+    TemporaryFolder folder_;
+    std::unique_ptr<lod::NodeSource> source_;  // declared after the folder: closed before it goes
 };
 
 /// The nodes a view selects, with a renderer of their own prepared as `render` prepares a

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -23,6 +22,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/Error.h"
+#include "io/TemporaryFolder.h"
 
 namespace subscan::lod {
 
@@ -83,30 +83,6 @@ void report(const IndexSettings& settings, double fraction, std::string_view pha
         settings.progress(std::clamp(fraction, 0.0, 1.0), phase);
     }
 }
-
-/// A folder of temporary files, removed with everything in it when this goes away.
-class TemporaryFolder {
-  public:
-    explicit TemporaryFolder(const std::filesystem::path& parent) {
-        std::string pattern = (parent / "subscan-index-XXXXXX").string();
-        if (::mkdtemp(pattern.data()) == nullptr) {
-            throw Error(fmt::format("{}: cannot make a temporary folder there: {}", parent.string(),
-                                    std::strerror(errno)));
-        }
-        path_ = pattern;
-    }
-    ~TemporaryFolder() {
-        std::error_code ignored;
-        std::filesystem::remove_all(path_, ignored);
-    }
-    TemporaryFolder(const TemporaryFolder&) = delete;
-    TemporaryFolder& operator=(const TemporaryFolder&) = delete;
-
-    const std::filesystem::path& path() const { return path_; }
-
-  private:
-    std::filesystem::path path_;
-};
 
 void writeBytes(const std::filesystem::path& path, std::span<const std::byte> bytes, bool append) {
     std::FILE* file = std::fopen(path.c_str(), append ? "ab" : "wb");
@@ -707,7 +683,7 @@ class Indexer {
             indexChunks(chunking, store, 0.35);
             buildTop(chunking, store);
         } else {
-            TemporaryFolder folder(settings_.temporaryDirectory);
+            TemporaryFolder folder(settings_.temporaryDirectory, "subscan-index");
             std::vector<std::uint32_t> counts(std::size_t{1} << (3 * gridLevel), 0);
             std::vector<std::uint32_t> cells;
             readAll(0.0, 0.15, "counting", [&](const std::vector<std::byte>& piece, std::size_t) {
@@ -835,9 +811,9 @@ class Indexer {
     /// buffer of an equal share of a quarter of the budget (at least 1,024 records, which
     /// thousands of chunks under a small --memory would exceed it by), taken once and written
     /// out whenever it fills: memory does not grow with the order the pieces come in (a
-    /// survey's come region by region), and each page is touched once. Buffers that grew by appending
-    /// and were freed after every write-out spent 16.6 of 30.5 s indexing 44 M points here,
-    /// copying as they grew and faulting in fresh pages each round.
+    /// survey's come region by region), and each page is touched once. Buffers that grew by
+    /// appending and were freed after every write-out spent 16.6 of 30.5 s indexing 44 M points
+    /// here, copying as they grew and faulting in fresh pages each round.
     void distributeFromSource(const Chunking& chunking, ChunkStore& store) {
         const std::size_t chunks = chunking.chunks.size();
         const std::size_t share =
