@@ -4,11 +4,8 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <map>
 #include <set>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <glm/vector_relational.hpp>
@@ -36,17 +33,9 @@ std::uint64_t packedKey(const laz::VoxelKey& key) {
            static_cast<std::uint64_t>(key.z);
 }
 
-/// Reads a whole small file (JSON, an EPT tile).
-std::vector<std::byte> readWhole(const std::filesystem::path& path) {
-    std::ifstream stream(path, std::ios::binary);
-    if (!stream) {
-        throw Error("cannot be opened");
-    }
-    std::ostringstream text;
-    text << stream.rdbuf();
-    const std::string whole = std::move(text).str();
-    const auto* begin = reinterpret_cast<const std::byte*>(whole.data());
-    return {begin, begin + whole.size()};
+/// A mapped file's bytes as text (the JSON of ept.json and its hierarchy).
+std::string_view textOf(const MappedFile& file) {
+    return {reinterpret_cast<const char*>(file.bytes().data()), file.bytes().size()};
 }
 
 nlohmann::json parseJson(std::string_view text) {
@@ -201,8 +190,7 @@ class EptSource final : public NodeSource {
     explicit EptSource(const std::filesystem::path& json) : folder_(json.parent_path()) {
         EptDescription ept;
         try {
-            const std::vector<std::byte> bytes = readWhole(json);
-            ept = parseEptDescription({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+            ept = parseEptDescription(textOf(MappedFile(json)));
         } catch (const Error& error) {
             throw Error(fmt::format("{}: {}", json.string(), error.what()));
         }
@@ -288,9 +276,8 @@ class EptSource final : public NodeSource {
     /// units, up to a metre off on PDAL's lone star scan).
     static std::optional<Bounds> sourcesBounds(const std::filesystem::path& folder) {
         try {
-            const std::vector<std::byte> bytes = readWhole(folder / "ept-sources" / "list.json");
             const nlohmann::json list =
-                parseJson({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+                parseJson(textOf(MappedFile(folder / "ept-sources" / "list.json")));
             Bounds bounds;
             for (const nlohmann::json& source : list) {
                 const std::vector<double> b = source.at("bounds").get<std::vector<double>>();
@@ -314,9 +301,7 @@ class EptSource final : public NodeSource {
         }
         EptHierarchyPage page;
         try {
-            const std::vector<std::byte> bytes = readWhole(path);
-            page =
-                parseEptHierarchyPage({reinterpret_cast<const char*>(bytes.data()), bytes.size()});
+            page = parseEptHierarchyPage(textOf(MappedFile(path)));
         } catch (const Error& error) {
             const Error named(fmt::format("{}: {}", path.string(), error.what()));
             if (name == "0-0-0-0") {
