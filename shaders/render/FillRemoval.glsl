@@ -100,22 +100,30 @@ bool enclosesTowards(vec2 centre, ivec2 own, int k, uint onLevel, LevelLayout pl
     return dot(offset, direction) > kEnclosingConeCos * length(offset) * length(direction);
 }
 
+/// Whether `texel` of `onLevel` (>= 1, laid out as `place`) lies in the image and holds
+/// points; `offset`: their mean position (meanPointPosition) less `centre`.
+bool pointsOf(uint onLevel, LevelLayout place, ivec2 texel, vec2 centre, out vec2 offset) {
+    offset = vec2(0.0);
+    if (!insideLevel(place, texel)) {
+        return false;
+    }
+    uint index = texelIndex(place, texel);
+    if (isinf(texelFetch(minDepthTexels, int(index)).r)) {
+        return false;
+    }
+    offset = meanPointPosition(onLevel, texel, index) - centre;
+    return true;
+}
+
 /// Whether the 3x3 texels of `onLevel` (>= 1, laid out as `place`) around the one holding
 /// `centre` hold a point within `radius` pixels of it, judged by each texel's mean position.
 bool pointWithinOn(uint onLevel, LevelLayout place, vec2 centre, float radius) {
     ivec2 middle = ivec2(centre) >> onLevel;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
-            ivec2 texel = middle + ivec2(dx, dy);
-            if (!insideLevel(place, texel)) {
-                continue;
-            }
-            uint index = texelIndex(place, texel);
-            if (isinf(texelFetch(minDepthTexels, int(index)).r)) {
-                continue;
-            }
-            vec2 offset = meanPointPosition(onLevel, texel, index) - centre;
-            if (dot(offset, offset) <= radius * radius) {
+            vec2 offset;
+            if (pointsOf(onLevel, place, middle + ivec2(dx, dy), centre, offset) &&
+                dot(offset, offset) <= radius * radius) {
                 return true;
             }
         }
@@ -137,20 +145,53 @@ bool pointWithin(vec2 centre, float radius) {
            (coarse > fine && pointWithinOn(coarse, nextLevel(finePlace), centre, radius));
 }
 
+/// Whether a point lies within `radius` (>= 1) pixels of `centre` along the axis `across`
+/// (unit), and beside that axis by no more than the texels it is judged by: a surface seen as
+/// scan lines goes on beyond its outermost line across the lines, not along them past their
+/// ends (where a line ends, its own points show where the surface ends). The walk steps along
+/// both halves of the axis, in three lanes a texel apart, by texels of about a quarter of the
+/// radius but at least half the gap between the points along their lines (`alongGap`, in
+/// pixels), so that one of a line's points falls beside the axis within the tolerance.
+bool pointAcrossWithin(vec2 centre, float radius, vec2 across, float alongGap) {
+    float level = round(log2(max(radius * 0.25, alongGap * 0.5)));
+    uint onLevel = uint(clamp(level, 1.0, float(levelCount() - 1u)));
+    float step = float(1u << onLevel);
+    vec2 beside = vec2(-across.y, across.x);
+    LevelLayout place = levelLayout(onLevel);
+    // A step past the radius: the texel the walk's end lies in may hold points within it.
+    for (float t = 0.0; t <= radius + step; t += step) {
+        for (int lane = 0; lane < 6; ++lane) {
+            vec2 position = centre + float(lane % 2 * 2 - 1) * t * across +
+                            float(lane / 2 - 1) * step * beside;
+            vec2 offset;
+            if (!pointsOf(onLevel, place, ivec2(floor(position)) >> onLevel, centre, offset)) {
+                continue;
+            }
+            float along = dot(offset, across);
+            if (abs(along) <= radius && length(offset - along * across) <= 1.5 * step) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /// Beyond its outermost points a sparse surface is kept for this share of the expected gap,
 /// times 1 - 1 / (local spacing ratio). The surface a row of samples saw ends somewhere before
 /// the next row, which missed it: half a gap further on average, so stopping at the last row
 /// loses a band along every sparse outline (a far wall's top row below its roof, a station's
-/// last ring before the ground's edge). Measured on the virtual station at 1024x1024, 4 views
-/// (near it / from the orbit; coverage, leakage, PSNR): 0.5 gave 0.988, 0.002, 26.2 dB /
-/// 0.953, 0.017, 21.2 dB; 0.75 0.992, 0.004, 26.7 dB / 0.977, 0.044, 21.3 dB (the rule before,
-/// the pull weight's blocks: 0.995, 0.005, 26.6 dB / 0.973, 0.089, 21.2 dB). The rows' gap
-/// beside an outline is wider than the local spacing says, which a share above one half
-/// makes up for. Points as dense as the cloud's own spacing (ratio
-/// 1: every object scan) keep their outline where the sub-pixel rule puts it: a closed
-/// object's outermost points lie at its silhouette, foreshortened, not a gap before it (the
-/// share alone, unscaled, fattened the bunny's vertices at 512x512 from leakage 0.005 to 0.037).
-const float kBeyondOutermostPoints = 0.75;
+/// last ring before the ground's edge). Where the points lie on scan lines, only across them
+/// (pointAcrossWithin): reaching every way, past the lines' ends too, the fill ran in round
+/// blobs over the ground's edges where a station's rings cross them. Measured on the virtual
+/// station at 1024x1024, 4 views (near it / from the orbit; coverage, leakage, PSNR), the
+/// passes' region taking the reach in (MinDepthPyramidPass): across the lines 0.625 gave
+/// 0.955, 0.014 from the orbit; 0.75 0.992, 0.004, 27.7 dB / 0.979, 0.023, 21.5 dB; 0.875
+/// 0.986, 0.031 from the orbit; every way, 0.75 gave 0.987, 0.056 from the orbit (and 0.977,
+/// 0.044 while the region cut it). Points as dense as the cloud's own spacing (ratio 1: every
+/// object scan) keep their outline where the sub-pixel rule puts it: a closed object's
+/// outermost points lie at its silhouette, foreshortened, not a gap before it (the share
+/// alone, unscaled, fattened the bunny's vertices at 512x512 from leakage 0.005 to 0.037).
+const float kBeyondOutermostPoints = SUBSCAN_BEYOND_OUTERMOST_POINTS;
 
 /// What the level-1 texel `texel` (whose reach is `reach`) adds to its pixels' gap test
 /// (fillsGap), judged from its centre at its own complete depth and spacing ratio: bit k for
@@ -203,8 +244,21 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
     }
     // Under a pixel the sub-pixel outline rule places the outline.
     float beyond = kBeyondOutermostPoints * (1.0 - 1.0 / spacingRatio) * exp2(gapLevel);
-    if (beyond >= 1.0 && pointWithin(centre, beyond)) {
-        enclosure |= 1u << 8;
+    if (beyond >= 1.0) {
+        // Where the points' scan lines agree on an axis, only across them (pointAcrossWithin).
+        // Its length, 1 - w / |across| (RasterizePoints.comp), above one half: the lines lie
+        // more than twice as far apart as the points along them, which lie (1 - length) of
+        // the expected gap apart.
+        vec2 axis = acrossAxisFrom(1u, texel);
+        float anisotropy = length(axis);
+        float angle = 0.5 * atan(axis.y, axis.x);
+        bool near = anisotropy > 0.5
+                        ? pointAcrossWithin(centre, beyond, vec2(cos(angle), sin(angle)),
+                                            (1.0 - anisotropy) * exp2(gapLevel))
+                        : pointWithin(centre, beyond);
+        if (near) {
+            enclosure |= 1u << 8;
+        }
     }
     return enclosure;
 }

@@ -17,7 +17,10 @@
 // would otherwise search past the object's silhouette (measured: the table scene from its
 // sensor lost 0.3 % of its measured cells, a station's views 0.5 % coverage), while for a
 // point denser than h what lies in front of it is, for a station or a depth camera, nearer
-// and at least as dense.
+// and at least as dense. Seen from elsewhere it need not be (a station's sparse far wall in
+// front of its dense near ground, seen from above): with the local spacing, where a neighbour
+// on the walk's last level occludes x, the walk goes on until it spans two expected gaps of
+// that neighbour's surface ("frontSpacing", MinDepthPyramid.comp), at its depth.
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
 #include "shared/surface.glsl"
@@ -26,6 +29,7 @@ layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GRO
 layout(binding = SUBSCAN_TEXELS_PYRAMID) uniform samplerBuffer minDepthTexels;
 layout(binding = SUBSCAN_IMAGE_IN0, rgba16f) readonly uniform image2D inColor;
 layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outVisibility;
+layout(binding = SUBSCAN_TEXELS_FRONT_SPACING) uniform samplerBuffer frontSpacingTexels;
 
 // The pixels of this work group that hold a point, gathered so that the first invocations test
 // them together: llvmpipe runs 8 invocations in lock-step, and on close-ups, where points are
@@ -41,6 +45,7 @@ bool visibleAt(ivec2 pixel, float depth) {
                            float(levelCount() - 1u));
     uint levels = uint(maxLevel);
     float tau = surface.visibility.y;
+    bool localSpacing = surface.spacing.x > 0.5;
 
     // Level by level, the 8 directions inside: one loop whose length differs between lanes
     // instead of eight (on llvmpipe each such loop costs beyond its steps). Branch-free: lanes
@@ -54,6 +59,10 @@ bool visibleAt(ivec2 pixel, float depth) {
     }
     LevelLayout place = levelLayout(0u);
     for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
+        // With the local spacing, the walk's last level so far asks whether a nearer
+        // neighbour's surface is sparser than the radius spans (once per level reached: the
+        // coarsest texels hold the nearest points around).
+        bool askOccluders = localSpacing && level == levels;
         for (int k = 0; k < 8; ++k) {
             ivec2 texel = (pixel >> level) + kDirections[k];
             bool withinImage = all(greaterThanEqual(texel, ivec2(0))) &&
@@ -64,6 +73,14 @@ bool visibleAt(ivec2 pixel, float depth) {
             vec3 y = viewPositionAt(texelCentre(level, texel), neighbourDepth);
             float value = 1.0 - dot(normalize(y - x), toCamera);
             omega[k] = withinImage && !isinf(neighbourDepth) ? min(omega[k], value) : omega[k];
+            if (askOccluders && withinImage && !isinf(neighbourDepth) && value < tau) {
+                // The walk goes on until it spans two of the occluder's expected gaps.
+                uint index = texelIndex(place, texel);
+                float occluderSpacing = texelFetch(frontSpacingTexels, int(index)).r;
+                float occluderLevel =
+                    levelForRadius(2.0 * surface.fill.x * occluderSpacing, neighbourDepth);
+                levels = max(levels, uint(clamp(occluderLevel, 0.0, float(levelCount() - 1u))));
+            }
         }
     }
     bool complete[8];

@@ -12,6 +12,7 @@
 //                 max x, max y): a coarse level keeps the atomics few
 #include "shared/pyramid.glsl"
 #include "shared/region.glsl"
+#include "shared/surface.glsl"
 
 layout(local_size_x = SUBSCAN_IMAGE_GROUP_SIZE, local_size_y = SUBSCAN_IMAGE_GROUP_SIZE) in;
 layout(location = SUBSCAN_UNIFORM_LEVEL) uniform uint level;
@@ -23,8 +24,14 @@ layout(std430, binding = SUBSCAN_SSBO_POINT_CENTROIDS) writeonly buffer PointCen
     uint pointCentroid[];
 };
 layout(binding = SUBSCAN_TEXELS_POINT_CENTROIDS) uniform usamplerBuffer pointCentroidTexels;
+layout(std430, binding = SUBSCAN_SSBO_FRONT_SPACING) writeonly buffer FrontSpacing {
+    float frontSpacing[];
+};
+layout(binding = SUBSCAN_TEXELS_FRONT_SPACING) uniform samplerBuffer frontSpacingTexels;
+const float kFrontTolerance = 1.0e-4;
 #if STAGE_FIRST
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inDepth;
+layout(binding = SUBSCAN_IMAGE_IN1, rgba16f) readonly uniform image2D inColor;
 #endif
 #if STAGE_BOUNDS
 layout(std430, binding = SUBSCAN_SSBO_POINT_BOUNDS) buffer PointBounds {
@@ -53,6 +60,9 @@ void main() {
     }
 #else
     float nearest = kInfinity;
+    bool localSpacing = surface.spacing.x > 0.5;
+    float childDepths[4];
+    float childSpacings[4];
     vec2 centroidSum = vec2(0.0);  // in units of a texel of `level - 1`
     float occupiedChildren = 0.0;
     for (int dy = 0; dy < 2; ++dy) {
@@ -64,24 +74,46 @@ void main() {
                 float depth = imageLoad(inDepth, child).r;
                 minDepth[childIndex] = depth;
                 vec2 inChild = vec2(0.5);
+                float spacing = localSpacing ? imageLoad(inColor, child).a : 1.0;
+                if (localSpacing) {
+                    frontSpacing[childIndex] = spacing;
+                }
 #else
                 float depth = texelFetch(minDepthTexels, int(childIndex)).r;
+                float spacing =
+                    localSpacing ? texelFetch(frontSpacingTexels, int(childIndex)).r : 1.0;
                 vec2 inChild = isinf(depth)
                                    ? vec2(0.0)
                                    : unpackUnorm2x16(texelFetch(pointCentroidTexels,
                                                                 int(childIndex)).r);
 #endif
                 nearest = min(nearest, depth);
+                childDepths[2 * dy + dx] = depth;
+                childSpacings[2 * dy + dx] = spacing;
                 if (!isinf(depth)) {
                     centroidSum += vec2(child - 2 * texel) + inChild;
                     occupiedChildren += 1.0;
                 }
+            } else {
+                childDepths[2 * dy + dx] = kInfinity;
             }
         }
     }
     if (level < levelCount()) {
         uint index = texelIndex(level, texel);
         minDepth[index] = nearest;
+        if (localSpacing) {
+            // The sparsest of the children at the nearest depth, within a relative 1e-4: the
+            // same points about another origin differ by about 1e-7 of their depth, and the
+            // nearest of two such would pick either one's spacing.
+            float sparsest = 1.0;
+            for (int c = 0; c < 4; ++c) {
+                sparsest = childDepths[c] <= nearest * (1.0 + kFrontTolerance)
+                               ? max(sparsest, childSpacings[c])
+                               : sparsest;
+            }
+            frontSpacing[index] = sparsest;
+        }
         if (occupiedChildren > 0.0) {
             pointCentroid[index] = packUnorm2x16(centroidSum / (2.0 * occupiedChildren));
         }

@@ -6,6 +6,7 @@
 
 layout(binding = SUBSCAN_TEXELS_PULL_VALUES) uniform samplerBuffer pullValueTexels;
 layout(binding = SUBSCAN_TEXELS_PULL_WEIGHTS) uniform samplerBuffer pullWeightTexels;
+layout(binding = SUBSCAN_TEXELS_PULL_AXES) uniform samplerBuffer pullAxisTexels;
 layout(binding = SUBSCAN_TEXELS_PUSH_VALUES) uniform samplerBuffer pushValueTexels;
 layout(binding = SUBSCAN_TEXELS_NORMALS) uniform samplerBuffer normalTexels;
 
@@ -41,6 +42,23 @@ float spacingRatioFrom(uint first, ivec2 texel) {
     return 1.0;
 }
 float spacingRatioAt(ivec2 pixel) { return spacingRatioFrom(0u, pixel); }
+
+/// The mean across-lines axis (doubled angle, SUBSCAN_SSBO_ACROSS_LINES) of the visible points
+/// in the finest texel above `texel` on level `first` that covers any; its length is how much
+/// they agree and how much sparser their lines lie than the points along them (0 without local
+/// spacing, or where no scan lines lie apart).
+vec2 acrossAxisFrom(uint first, ivec2 texel) {
+    if (surface.spacing.x < 0.5) {
+        return vec2(0.0);
+    }
+    for (uint level = first; level < levelCount(); ++level) {
+        vec4 sums = texelFetch(pullAxisTexels, int(texelIndex(level, texel >> (level - first))));
+        if (sums.z > 0.0) {
+            return sums.xy / sums.z;
+        }
+    }
+    return vec2(0.0);
+}
 vec4 pushValueAt(uint index) { return texelFetch(pushValueTexels, int(index)); }
 
 /// The complete (depth, r, g, b) of `texel` on `level` from the complete level above: m is the

@@ -76,15 +76,19 @@ layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor
 layout(binding = SUBSCAN_IMAGE_OUT2, rgba16f) writeonly uniform image2D outNormal;
 layout(binding = SUBSCAN_TEXELS_LOCAL_SPACING) uniform samplerBuffer localSpacing;
 layout(binding = SUBSCAN_TEXELS_POINT_NORMALS) uniform usamplerBuffer pointNormals;
+layout(std430, binding = SUBSCAN_SSBO_ACROSS_LINES) writeonly buffer AcrossLines {
+    uint acrossLines[];
+};
 
-/// The local spacing (estimateLocalSpacing) of chunk point `local` on screen, over h's there:
-/// the larger of its spacing w and its vector across scan lines projected. The projection is
-/// to first order (window = f xy / d at distance d: the offset a moves it by f / d * (a.xy +
-/// xy * a.z / d)), which an across vector pointing behind the eye cannot break.
-float spacingRatio(uint local) {
-    if (surface.spacing.x < 0.5) {
-        return 1.0;
-    }
+/// The local spacing (estimateLocalSpacing) of chunk point `local` on screen, over h's there
+/// (x): the larger of its spacing w and its vector across scan lines projected; and (yz) that
+/// vector's axis as a doubled-angle vector where it is the larger (the direction a sparse
+/// surface goes on beyond its outermost line: FillRemoval.glsl's pointAcrossWithin), of
+/// length 1 - w / the vector's (how much sparser the lines lie than the points along them),
+/// else 0. The projection is to first order (window = f xy / d at distance d: the offset a
+/// moves it by f / d * (a.xy + xy * a.z / d)), which an across vector pointing behind the eye
+/// cannot break.
+vec3 spacingOnScreen(uint local) {
     vec3 viewPosition = viewPositionOfPoint(local);
     vec4 spacing = texelFetch(localSpacing, int(local));
     vec3 across = mat3(frame.viewFromCloud) * spacing.xyz;  // in units of h
@@ -93,7 +97,12 @@ float spacingRatio(uint local) {
                      ? across.xy
                      : across.xy + viewPosition.xy * (across.z / distance);
     // Both lengths in units of h times f / distance; the image holds half floats.
-    return min(max(spacing.w, length(moved)), 6.0e4);
+    float acrossLength = length(moved);
+    vec2 axis = acrossLength > spacing.w
+                    ? vec2(moved.x * moved.x - moved.y * moved.y, 2.0 * moved.x * moved.y) *
+                          ((1.0 - spacing.w / acrossLength) / (acrossLength * acrossLength))
+                    : vec2(0.0);
+    return vec3(min(max(spacing.w, acrossLength), 6.0e4), axis);
 }
 
 /// Chunk point `local`'s normal in view space, turned to face the eye: a normal's sign is
@@ -129,7 +138,14 @@ void main() {
 #else
     vec3 color = unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r);
 #endif
-    imageStore(outColor, pixel, vec4(color, spacingRatio(winner - raster.firstPoint)));
+    float spacingRatio = 1.0;
+    if (surface.spacing.x > 0.5) {
+        vec3 spacing = spacingOnScreen(winner - raster.firstPoint);
+        spacingRatio = spacing.x;
+        acrossLines[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)] =
+            packHalf2x16(spacing.yz);
+    }
+    imageStore(outColor, pixel, vec4(color, spacingRatio));
     if (surface.normals.z > 0.5) {
         imageStore(outNormal, pixel, vec4(viewNormal(winner - raster.firstPoint), 0.0));
     }

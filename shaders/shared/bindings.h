@@ -33,6 +33,11 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_DIVISOR 2  // int: output pixels per pipeline pixel and side (Present)
 #define SUBSCAN_UNIFORM_END 3      // ivec2: the texel past the region's last (shared/region.glsl)
 
+// Beyond its outermost points a sparse surface is kept for this share of the expected gap, times
+// 1 - 1 / (local spacing ratio) (FillRemoval.glsl's kBeyondOutermostPoints says why and how it
+// was measured); the passes' region (MinDepthPyramidPass) reaches that far beyond the points.
+#define SUBSCAN_BEYOND_OUTERMOST_POINTS 0.75
+
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index
 #define SUBSCAN_SSBO_PYRAMID 5        // float per texel, all levels: min depth
@@ -53,6 +58,17 @@ using mat4 = glm::mat4;
                                          // points lie on average (unorm16x2 of the texel)
 #define SUBSCAN_SSBO_FILL_SPARSE 16      // uint per level-1 texel: what it adds to its pixels'
                                          // gap test (FillRemoval.glsl's sparseEnclosure)
+#define SUBSCAN_SSBO_FRONT_SPACING 18     // float per texel, all levels, with the local
+                                         // spacing: the spacing ratio of the texel's nearest
+                                         // point (the min-depth pyramid's)
+#define SUBSCAN_SSBO_PULL_AXES 19         // vec4 per texel, all levels, with the local
+                                         // spacing: the sums of w * across-lines axis (xy) and
+                                         // of w (z) over the visible points the texel covers
+                                         // (SUBSCAN_SSBO_ACROSS_LINES), w unused
+#define SUBSCAN_SSBO_ACROSS_LINES 17     // uint per pixel, with the local spacing: the
+                                         // winning point's vector across its scan lines on
+                                         // screen as a doubled-angle unit axis (half2; 0 where
+                                         // its lines are no farther apart than its spacing)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID
@@ -62,7 +78,13 @@ using mat4 = glm::mat4;
 #define SUBSCAN_TEXELS_NORMALS 4       // rgba32f view of SUBSCAN_SSBO_NORMALS
 #define SUBSCAN_TEXELS_FILL_REACH 5    // r32ui view of SUBSCAN_SSBO_FILL_REACH
 #define SUBSCAN_TEXELS_POSITIONS 6     // r32f: x, y, z per point (cloud-relative), one chunk
+#define SUBSCAN_TEXELS_FRONT_SPACING 6  // r32f view of SUBSCAN_SSBO_FRONT_SPACING (shares its
+                                        // unit with the points, which the pyramid and hidden
+                                        // point removal never read)
 #define SUBSCAN_TEXELS_COLORS 7        // r32ui: RGBA8, sRGB-encoded, per point, one chunk
+#define SUBSCAN_TEXELS_PULL_AXES 7     // rgba32f view of SUBSCAN_SSBO_PULL_AXES (shares its unit
+                                       // with the points' colours, which only the rasterizer
+                                       // reads)
 #define SUBSCAN_TEXELS_ALBEDO_ROOTS 8  // r32f: sqrt(1 - reduced albedo) by total reflectance
 #define SUBSCAN_TEXELS_LOCAL_SPACING 9  // rgba16f per point, one chunk (estimateLocalSpacing)
 #define SUBSCAN_TEXELS_POINT_NORMALS 10    // r32ui per point, one chunk: octahedral snorm16x2

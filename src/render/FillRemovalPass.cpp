@@ -12,6 +12,9 @@ FillRemovalPass::FillRemovalPass(const ShaderSources& sources)
 
 std::vector<std::string_view> FillRemovalPass::inputs(const RenderSettings& settings) const {
     std::vector<std::string_view> names{"pullWeights", "pushValues", "pyramid", "pointCentroids"};
+    if (settings.surface.localSpacing) {
+        names.push_back("pullAxes");
+    }
     if (levelZero_ == LevelZero::Fused) {
         if (!followsNormalsToOutline(settings)) {
             return names;
@@ -41,6 +44,9 @@ void FillRemovalPass::execute(FrameContext& frame) {
     resources.buffer("pullWeights").bindTexels(SUBSCAN_TEXELS_PULL_WEIGHTS, TextureFormat::RG32F);
     resources.buffer("pushValues").bindTexels(SUBSCAN_TEXELS_PUSH_VALUES, TextureFormat::RGBA32F);
     resources.buffer("pyramid").bindTexels(SUBSCAN_TEXELS_PYRAMID, TextureFormat::R32F);
+    if (frame.settings.surface.localSpacing) {
+        resources.buffer("pullAxes").bindTexels(SUBSCAN_TEXELS_PULL_AXES, TextureFormat::RGBA32F);
+    }
     resources.buffer("pointCentroids")
         .bindTexels(SUBSCAN_TEXELS_POINT_CENTROIDS, TextureFormat::R32UI);
     Buffer& fillReach =

@@ -6,6 +6,7 @@
 #include <span>
 
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
 #include <glm/gtc/packing.hpp>
 #include <glm/packing.hpp>
 
@@ -157,6 +158,17 @@ void GpuPointCloud::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
             Buffer::fromSpan(std::span<const glm::u16vec4>(halves), "points.localSpacing");
     }
     hasLocalSpacing_ = true;
+    std::vector<float> ratios(spacing.size());
+    std::transform(spacing.begin(), spacing.end(), ratios.begin(), [](const glm::vec4& entry) {
+        return std::max(entry.w, glm::length(glm::vec3(entry)));
+    });
+    sparseSpacingRatio_ = 1.0f;
+    if (!ratios.empty()) {
+        const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
+                                                   0.999 * static_cast<double>(ratios.size() - 1));
+        std::nth_element(ratios.begin(), quantile, ratios.end());
+        sparseSpacingRatio_ = std::max(1.0f, *quantile);
+    }
 }
 
 void GpuPointCloud::setNormals(const std::vector<glm::vec3>& normals) {

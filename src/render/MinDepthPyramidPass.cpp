@@ -1,6 +1,7 @@
 #include "render/MinDepthPyramidPass.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -11,6 +12,31 @@ namespace subscan {
 namespace {
 
 constexpr std::uint32_t kInfinityBits = 0x7F800000u;
+
+/// How many pixels beyond its outermost points fill removal may keep a sparse surface, at
+/// most (FillRemoval.glsl's sparseEnclosure): SUBSCAN_BEYOND_OUTERMOST_POINTS of the expected
+/// gap, which is fillRadius h times a pixel's spacing ratio on screen, in pixels at the
+/// nearest point's depth `nearest`. The ratio on screen is at most the cloud's sparse one
+/// (GpuPointCloud::sparseSpacingRatio: the sparsest 0.1 % of the points may still reach past
+/// the region), its across-lines vector projected to first order grown by the view's widest
+/// |xy| / depth; without local spacing (ratio 1) nothing reaches beyond the points. Plus a
+/// pixel: the reach is measured from a level-1 texel's centre.
+int beyondReachPixels(const FrameContext& frame, float nearest) {
+    const float ratio = frame.cloud.sparseSpacingRatio();
+    if (!frame.settings.surface.localSpacing || !frame.cloud.hasLocalSpacing() || ratio <= 1.0f ||
+        !std::isfinite(nearest) || !(nearest > 0.0f)) {
+        return 0;
+    }
+    const Camera& camera = frame.camera;
+    const double focal = camera.focalLengthPixels();
+    const double offAxis =
+        camera.orthographic() ? 0.0 : 0.5 * std::hypot(camera.width, camera.height) / focal;
+    const double perUnit = camera.orthographic() ? focal : focal / nearest;
+    const double reach = SUBSCAN_BEYOND_OUTERMOST_POINTS * frame.settings.surface.fillRadius *
+                             frame.spacing * ratio * (1.0 + offAxis) * perUnit +
+                         1.0;
+    return static_cast<int>(std::min(std::ceil(reach), 1.0e6));
+}
 
 }  // namespace
 
@@ -29,6 +55,13 @@ void MinDepthPyramidPass::execute(FrameContext& frame) {
     centroids.bindStorage(SUBSCAN_SSBO_POINT_CENTROIDS);
     centroids.bindTexels(SUBSCAN_TEXELS_POINT_CENTROIDS, TextureFormat::R32UI);
     frame.resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+    if (frame.settings.surface.localSpacing) {
+        frame.resources.texture("color").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
+        Buffer& frontSpacing = frame.resources.ensureBuffer(
+            "frontSpacing", pyramidTexels(frame.pyramid) * sizeof(float));
+        frontSpacing.bindStorage(SUBSCAN_SSBO_FRONT_SPACING);
+        frontSpacing.bindTexels(SUBSCAN_TEXELS_FRONT_SPACING, TextureFormat::R32F);
+    }
     // Levels 0 and 1 are copied only where the cloud's bounding box projects: elsewhere the
     // depth is +inf, as the fill leaves it.
     frame.fill(pyramid, kInfinityBits);
@@ -66,9 +99,17 @@ glm::ivec4 MinDepthPyramidPass::measureBounds(const FrameContext& frame) {
     if (texels.z < 0) {
         return glm::ivec4(0);
     }
+    // The top level holds the nearest depth of all.
+    float nearest = 0.0f;
+    frame.resources.buffer("pyramid").download((pyramidTexels(frame.pyramid) - 1) * sizeof(float),
+                                               sizeof(float), &nearest);
+    const int reach = beyondReachPixels(frame, nearest);
     const int scale = 1 << level;
-    return {texels.x * scale, texels.y * scale, std::min((texels.z + 1) * scale, frame.width()),
-            std::min((texels.w + 1) * scale, frame.height())};
+    return {std::max(texels.x * scale - reach, 0), std::max(texels.y * scale - reach, 0),
+            static_cast<int>(
+                std::min<std::int64_t>(std::int64_t{texels.z + 1} * scale + reach, frame.width())),
+            static_cast<int>(std::min<std::int64_t>(std::int64_t{texels.w + 1} * scale + reach,
+                                                    frame.height()))};
 }
 
 }  // namespace subscan

@@ -8,14 +8,21 @@ PullPushPass::PullPushPass(const ShaderSources& sources)
     : stages_(sources, "render/PullPush.comp", {"PULL_INIT", "PULL", "PUSH_TOP", "PUSH"}) {}
 
 std::vector<std::string_view> PullPushPass::inputs(const RenderSettings& settings) const {
+    std::vector<std::string_view> names{"depth", "color", "visibility"};
     if (usesPointNormals(settings)) {
-        return {"depth", "color", "visibility", "pointNormals"};
+        names.push_back("pointNormals");
     }
-    return {"depth", "color", "visibility"};
+    if (settings.surface.localSpacing) {
+        names.push_back("acrossLines");
+    }
+    return names;
 }
 
 std::vector<std::string_view> PullPushPass::outputs(const RenderSettings& settings) const {
     std::vector<std::string_view> names{"pullValues", "pullWeights", "pushValues"};
+    if (settings.surface.localSpacing) {
+        names.push_back("pullAxes");
+    }
     if (levelZero_ == LevelZero::PerPass) {
         names.insert(names.end(), {"filledDepth", "filledColor"});
     }
@@ -44,6 +51,12 @@ void PullPushPass::execute(FrameContext& frame) {
     resources.texture("depth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
     resources.texture("color").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     resources.texture("visibility").bindImage(SUBSCAN_IMAGE_IN2, GL_READ_ONLY);
+    if (frame.settings.surface.localSpacing) {
+        resources.buffer("acrossLines").bindStorage(SUBSCAN_SSBO_ACROSS_LINES);
+        Buffer& pullAxes = resources.ensureBuffer("pullAxes", texels * 4 * sizeof(float));
+        pullAxes.bindStorage(SUBSCAN_SSBO_PULL_AXES);
+        pullAxes.bindTexels(SUBSCAN_TEXELS_PULL_AXES, TextureFormat::RGBA32F);
+    }
     if (usesPointNormals(frame.settings)) {
         // The points' normals are pulled and pushed beside the values (PullPush.comp).
         Buffer& normalPyramid = resources.ensureBuffer("normalPyramid", texels * 4 * sizeof(float));

@@ -122,6 +122,9 @@ std::vector<std::string_view> RasterizePointsPass::outputs(const RenderSettings&
     if (usesPointNormals(settings)) {
         names.push_back("pointNormals");
     }
+    if (settings.surface.localSpacing) {
+        names.push_back("acrossLines");
+    }
     return names;
 }
 
@@ -196,6 +199,14 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         // Read only where a point won its pixel, which the resolve writes: nothing to clear.
         frame.resources.ensureTexture("pointNormals", TextureFormat::RGBA16F, width, height)
             .bindImage(SUBSCAN_IMAGE_OUT2, GL_WRITE_ONLY);
+    }
+    if (frame.settings.surface.localSpacing) {
+        // Read only where a point won its pixel, which the resolve writes: nothing to clear.
+        frame.resources
+            .ensureBuffer("acrossLines", static_cast<std::size_t>(width) *
+                                             static_cast<std::size_t>(height) *
+                                             sizeof(std::uint32_t))
+            .bindStorage(SUBSCAN_SSBO_ACROSS_LINES);
     }
     runPerChunk(blend   ? blendPrograms(int64).resolve
                 : int64 ? resolve64_

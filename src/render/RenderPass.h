@@ -38,7 +38,8 @@ struct FrameContext {
     GpuClear& clears;
     const gpu::PyramidLayout& pyramid;
     double spacing;  // the point spacing h, scene units
-    /// Pixels [x, y, z, w) holding rasterized points, measured by MinDepthPyramidPass when
+    /// Pixels [x, y, z, w) holding rasterized points, and those beyond them a sparse surface's
+    /// fill may reach (MinDepthPyramidPass), measured when
     /// `surfaceBoundsAllowed(settings)`; unset, the passes after it work on the whole frame.
     std::optional<glm::ivec4> pointBounds;
     /// At reduced resolution (RasterSettings::resolution) `camera` is reducedCamera(the

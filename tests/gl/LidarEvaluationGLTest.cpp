@@ -170,11 +170,15 @@ TEST(LidarEvaluationGLTest, FromTheOrbitTheFillKeepsNearTheStationsPoints) {
     adaptToScanner(settings, *source.scene, source.scanner, ViewsFrom::Orbit);
     const EvaluationReport report =
         evaluate(test::glTestContext(), *source.scene, source.points, settings, RenderSettings{});
-    // Measured 2026-12-05: coverage 0.978, leakage 0.054; the fill in blocks (the pull weight
-    // as the gap test's evidence) gave 0.966 and 0.095. The leakage left is the reach beyond
-    // the outermost ring where the ground ends sooner (docs/eval.md).
-    EXPECT_GE(report.surface.coverage, 0.96);
-    EXPECT_LE(report.surface.leakage, 0.07);
+    // Measured 2026-12-06: coverage 0.946, leakage 0.046. The reach beyond the outermost
+    // points in every direction (the rule before the rings' axis) gave 0.980 and 0.071 once
+    // the passes' region took the reach in, and 0.978 and 0.054 while the region cut it; the
+    // fill in blocks (the pull weight as the gap test's evidence) 0.966 and 0.095. The
+    // leakage left is the reach across the outermost ring where the ground ends sooner; the
+    // coverage given up, at this low resolution, the ground between a ring's end and an edge
+    // the rings cross obliquely (docs/eval.md).
+    EXPECT_GE(report.surface.coverage, 0.93);
+    EXPECT_LE(report.surface.leakage, 0.06);
 }
 
 TEST(LidarEvaluationGLTest, OcclusionsAreJudgedByTheStationsSpacingWhereTheTruthIs) {

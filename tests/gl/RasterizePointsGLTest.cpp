@@ -14,6 +14,7 @@
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 #include <glm/matrix.hpp>
+#include <glm/packing.hpp>
 
 #include "core/Camera.h"
 #include "core/Error.h"
@@ -225,6 +226,10 @@ TEST_P(RasterPathGLTest, ColorAlphaIsTheWinnersLocalSpacingOnScreen) {
             settings.surface.localSpacing = local;
             renderer.render(camera, settings);
             const std::vector<float> color = renderer.resources().texture("color").readFloats();
+            std::vector<std::uint32_t> axes;
+            if (local) {
+                axes = renderer.resources().buffer("acrossLines").read<std::uint32_t>();
+            }
             const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
             int acrossWins = 0;
             for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
@@ -239,9 +244,22 @@ TEST_P(RasterPathGLTest, ColorAlphaIsTheWinnersLocalSpacingOnScreen) {
                                        glm::dvec4(glm::dvec3(cloud.positions[winner]), 1.0));
                     const glm::dvec3 a =
                         glm::dmat3(viewFromCloud) * glm::dvec3(glm::vec3(spacing[winner]));
-                    const double across = glm::length(glm::dvec2(a) + glm::dvec2(p) * (a.z / -p.z));
-                    expected = std::max<double>(spacing[winner].w, across);
-                    acrossWins += across > spacing[winner].w;
+                    const glm::dvec2 moved = glm::dvec2(a) + glm::dvec2(p) * (a.z / -p.z);
+                    const double across = glm::length(moved);
+                    const double w = spacing[winner].w;
+                    expected = std::max<double>(w, across);
+                    acrossWins += across > w;
+                    // "acrossLines": the doubled-angle axis of the projected vector, of length
+                    // 1 - w / |vector|, where it is longer than w.
+                    const glm::dvec2 axis = across > w
+                                                ? glm::dvec2(moved.x * moved.x - moved.y * moved.y,
+                                                             2.0 * moved.x * moved.y) *
+                                                      ((1.0 - w / across) / (across * across))
+                                                : glm::dvec2(0.0);
+                    const glm::vec2 stored = glm::unpackHalf2x16(axes[pixel]);
+                    // Half floats: 11 significant bits of values up to 1.
+                    EXPECT_NEAR(stored.x, axis.x, 1e-3) << pixel;
+                    EXPECT_NEAR(stored.y, axis.y, 1e-3) << pixel;
                 }
                 // RGBA16F: 11 significant bits; the float evaluation adds ~1e-6.
                 EXPECT_NEAR(color[4 * pixel + 3], expected, 1e-3 * expected) << pixel;

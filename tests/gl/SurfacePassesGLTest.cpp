@@ -98,18 +98,24 @@ PassHarness makeHarness(int stageLevel = 3, bool localSpacing = false,
     settings.surface.visibilityThreshold = 0.7f;
     // Fewer than 8 directions, so the count itself is tested, not only "all".
     settings.surface.fillDirections = 7;
-    return PassHarness(kWidth, kHeight, settings, kSpacing, 50.0, localSpacing);
+    PassHarness harness(kWidth, kHeight, settings, kSpacing, 50.0, localSpacing);
+    if (localSpacing) {
+        harness.setSparseSpacingRatio(4.5f);  // the largest ratio these tests upload
+    }
+    return harness;
 }
 
 /// Depth: a curved surface at 4..6 with holes (+inf) and a few far "back" points showing
 /// through; colour random; alpha (the local spacing ratio) 1, or with `spacingRatios` random
-/// in 0.5..4.5 (sparser points search farther).
+/// in 0.5..4.5 (sparser points search farther) and for half the pixels a random across-lines
+/// axis of random length (1 - w / |across|).
 void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<float>& color,
                   bool spacingRatios = false) {
     std::mt19937 random(5);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     depth.assign(kWidth * kHeight, 0.0f);
     color.assign(kWidth * kHeight * 4, 1.0f);
+    std::vector<glm::vec2> axes(kWidth * kHeight, glm::vec2(0.0f));
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
@@ -127,8 +133,15 @@ void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<f
             }
             if (spacingRatios) {
                 color[4 * i + 3] = 0.5f + 4.0f * unit(random) * unit(random);
+                if (unit(random) < 0.5f) {
+                    const float doubled = 4.0f * glm::pi<float>() * unit(random);
+                    axes[i] = unit(random) * glm::vec2(std::cos(doubled), std::sin(doubled));
+                }
             }
         }
+    }
+    if (spacingRatios) {
+        harness.uploadAcrossAxes(axes);
     }
     FrameResources& resources = harness.resources();
     resources.ensureTexture("depth", TextureFormat::R32F, kWidth, kHeight).uploadFloats(depth);
@@ -244,10 +257,47 @@ TEST(SurfacePassesGLTest, MinDepthPyramidIsExact) {
     EXPECT_GT(compared, 200);
 }
 
+/// The CPU twin of MinDepthPyramid.comp's "frontSpacing": per texel the spacing ratio (the
+/// colour's alpha) of its nearest point, the largest (and at least 1) of the children within a
+/// relative 1e-4 of the nearest depth.
+std::vector<double> cpuFrontSpacing(const std::vector<double>& pyramid,
+                                    const std::vector<float>& color) {
+    const auto all = levels();
+    std::vector<double> spacing(pyramid.size(), 1.0);
+    for (int i = 0; i < kWidth * kHeight; ++i) {
+        spacing[i] = color[4 * i + 3];
+    }
+    for (std::size_t l = 1; l < all.size(); ++l) {
+        const Level& fine = all[l - 1];
+        const Level& coarse = all[l];
+        for (int y = 0; y < coarse.height; ++y) {
+            for (int x = 0; x < coarse.width; ++x) {
+                const double nearest = pyramid[coarse.offset + y * coarse.width + x];
+                double sparsest = 1.0;
+                for (int dy = 0; dy < 2; ++dy) {
+                    for (int dx = 0; dx < 2; ++dx) {
+                        const int cx = 2 * x + dx, cy = 2 * y + dy;
+                        const int child = fine.offset + cy * fine.width + cx;
+                        if (cx < fine.width && cy < fine.height &&
+                            pyramid[child] <= nearest * (1.0 + 1e-4)) {
+                            sparsest = std::max(sparsest, spacing[child]);
+                        }
+                    }
+                }
+                spacing[coarse.offset + y * coarse.width + x] = sparsest;
+            }
+        }
+    }
+    return spacing;
+}
+
 /// The CPU twin of HiddenPointRemoval.comp. Returns nullopt where a quantity lies within
 /// rounding distance of a decision boundary (the flag may then legitimately differ).
+/// `frontSpacing` (cpuFrontSpacing), with the local spacing: the walk's last level so far goes
+/// on to span two expected gaps of each occluding neighbour.
 std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<double>& pyramid,
-                               int px, int py, double spacingRatio) {
+                               int px, int py, double spacingRatio,
+                               const std::vector<double>* frontSpacing = nullptr) {
     const auto all = levels();
     const double depth = pyramid[py * kWidth + px];
     if (std::isinf(depth)) {
@@ -265,42 +315,57 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     if (std::abs(levelValue - std::round(levelValue)) < kTie) {
         return std::nullopt;
     }
-    const int maxLevel = static_cast<int>(levelValue);
+    int maxLevel = static_cast<int>(levelValue);
     const int directions[8][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
                                   {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
     std::array<double, 8> omega{};
-    std::array<bool, 8> complete{};
-    double weightedSum = 0.0, weightSum = 0.0;
+    std::array<bool, 8> found{};
+    std::array<int, 8> seen{};
+    omega.fill(1.0);
     bool tie = false;
-    for (int k = 0; k < 8; ++k) {
-        double smallest = 1.0;
-        bool found = false;
-        int seen = 0;
-        for (int l = 0; l <= maxLevel; ++l) {
-            const Level& level = all[l];
+    for (int l = 0; l <= maxLevel; ++l) {
+        const Level& level = all[l];
+        const bool askOccluders = frontSpacing && l == maxLevel;
+        for (int k = 0; k < 8; ++k) {
             const int qx = (px >> l) + directions[k][0], qy = (py >> l) + directions[k][1];
             // The walk sees only texels wholly inside the image (odd sizes: not the last one).
             if (qx < 0 || qy < 0 || (qx + 1) << l > kWidth || (qy + 1) << l > kHeight) {
                 continue;
             }
-            ++seen;
-            const double d = pyramid[level.offset + qy * level.width + qx];
+            ++seen[k];
+            const int texel = level.offset + qy * level.width + qx;
+            const double d = pyramid[texel];
             if (std::isinf(d)) {
                 continue;
             }
             const double scale = 1 << l;
             const glm::dvec3 y = harness.viewPosition((qx + 0.5) * scale, (qy + 0.5) * scale, d);
             const double value = 1.0 - glm::dot(glm::normalize(y - x), toCamera);
-            smallest = found ? std::min(smallest, value) : value;
-            found = true;
+            omega[k] = found[k] ? std::min(omega[k], value) : value;
+            found[k] = true;
+            if (askOccluders) {
+                tie = tie || std::abs(value - tau) < kTie;
+                if (value < tau) {
+                    // Two of the occluder's expected gaps, at its depth.
+                    const double occluderLevel =
+                        std::clamp(std::log2(2.0 * surface.fillRadius * kSpacing *
+                                             (*frontSpacing)[texel] * harness.focal() / d),
+                                   0.0, static_cast<double>(all.size() - 1));
+                    tie = tie || std::abs(occluderLevel - std::round(occluderLevel)) < kTie;
+                    maxLevel = std::max(maxLevel, static_cast<int>(occluderLevel));
+                }
+            }
         }
+    }
+    std::array<bool, 8> complete{};
+    double weightedSum = 0.0, weightSum = 0.0;
+    for (int k = 0; k < 8; ++k) {
         // A walk cut short by the image's border weighs by the share of levels it saw.
-        omega[k] = smallest;
-        complete[k] = seen == maxLevel + 1;
-        const double weight = static_cast<double>(seen) / (maxLevel + 1);
-        weightedSum += weight * smallest;
+        complete[k] = seen[k] == maxLevel + 1;
+        const double weight = static_cast<double>(seen[k]) / (maxLevel + 1);
+        weightedSum += weight * omega[k];
         weightSum += weight;
-        tie = tie || std::abs(smallest - tau) < kTie;
+        tie = tie || std::abs(omega[k] - tau) < kTie;
     }
     const double mean = weightSum > 0.0 ? weightedSum / weightSum : 1.0;
     if (std::abs(mean - tau) < kTie || (tie && surface.edgeRule)) {
@@ -340,11 +405,13 @@ TEST_P(SurfacePassesSpacingGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
     // The ratios as the GPU read them (RGBA16F).
     const std::vector<float> color16 = harness.resources().texture("color").readFloats();
     const std::vector<double> pyramid = cpuPyramid(depth);
+    const std::vector<double> frontSpacing = cpuFrontSpacing(pyramid, color16);
     int ties = 0, visible = 0, hidden = 0;
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const std::optional<bool> expected =
-                cpuVisible(harness, pyramid, x, y, color16[4 * (y * kWidth + x) + 3]);
+                cpuVisible(harness, pyramid, x, y, color16[4 * (y * kWidth + x) + 3],
+                           GetParam() ? &frontSpacing : nullptr);
             if (!expected) {
                 ++ties;
                 continue;
@@ -383,6 +450,8 @@ struct PullPush {
     std::vector<double> pullWeight;
     std::vector<glm::dvec4> push;
     std::vector<double> pullSpacing;  // w * local spacing ratio
+    // Across-lines sums over the visible points a texel covers: of the axis (xy), of 1 (z).
+    std::vector<glm::dvec4> pullAxis;
     // With the points' normals: the normal pyramid, pulled (w_n * n, w_n); from the coarsest
     // level down to level 1 overwritten by the complete sum (PullPush.glsl's pushedNormal).
     std::vector<glm::dvec4> normals;
@@ -393,11 +462,14 @@ struct PullPush {
 PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth,
                      const std::vector<float>& color, const std::vector<float>& visibility,
                      const std::vector<float>* pointNormals = nullptr) {
+    const std::vector<glm::vec2> axes = harness.settings().surface.localSpacing
+                                            ? harness.acrossAxes()
+                                            : std::vector<glm::vec2>(kWidth * kHeight);
     const auto all = levels();
     const std::size_t texels = all.back().offset + 1;
     PullPush result{std::vector<glm::dvec4>(texels), std::vector<double>(texels),
                     std::vector<glm::dvec4>(texels), std::vector<double>(texels),
-                    std::vector<glm::dvec4>(texels)};
+                    std::vector<glm::dvec4>(texels), std::vector<glm::dvec4>(texels)};
     for (int i = 0; i < kWidth * kHeight; ++i) {
         const bool visible = visibility[i] > 0.5f;
         if (pointNormals) {
@@ -408,6 +480,7 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
         }
         result.pullWeight[i] = visible ? 1.0 : 0.0;
         result.pullSpacing[i] = visible ? color[4 * i + 3] : 0.0;
+        result.pullAxis[i] = visible ? glm::dvec4(axes[i], 1.0, 0.0) : glm::dvec4(0.0);
         result.pullValue[i] =
             visible ? glm::dvec4(depth[i], color[4 * i], color[4 * i + 1], color[4 * i + 2])
                     : glm::dvec4(0.0);
@@ -438,6 +511,7 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
                 const double tolerance = slope * (1 << l) * front / harness.focal();
                 double weight = 0.0;
                 double spacing = 0.0;
+                glm::dvec4 axis(0.0);  // over the 2x2 children the texel covers
                 glm::dvec4 value(0.0);
                 glm::dvec4 normal(0.0);
                 for (int j = 0; j < 4; ++j) {
@@ -450,6 +524,9 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
                         }
                         weight += kernel[i] * kernel[j] * result.pullWeight[child];
                         spacing += kernel[i] * kernel[j] * result.pullSpacing[child];
+                        if ((i == 1 || i == 2) && (j == 1 || j == 2)) {
+                            axis += result.pullAxis[child];
+                        }
                         value += kernel[i] * kernel[j] * result.pullValue[child];
                         normal += kernel[i] * kernel[j] * result.normals[child];
                     }
@@ -460,6 +537,7 @@ PullPush cpuPullPush(const PassHarness& harness, const std::vector<float>& depth
                 result.pullValue[index] =
                     weight > 0.0 ? value * (clamped / weight) : glm::dvec4(0.0);
                 result.pullSpacing[index] = weight > 0.0 ? spacing * (clamped / weight) : 0.0;
+                result.pullAxis[index] = axis;
                 result.normals[index] = normal.w > 0.0
                                             ? normal * (std::min(1.0, normal.w) / normal.w)
                                             : glm::dvec4(0.0);
@@ -539,6 +617,7 @@ TEST_P(SurfacePassesSpacingGLTest, PullPushMatchesToFloatPrecision) {
         cpuPullPush(harness, depth, color16, resources.texture("visibility").readFloats());
     const auto values = resources.buffer("pullValues").read<glm::vec4>();
     const auto weights = resources.buffer("pullWeights").read<glm::vec2>();
+    const auto axes = resources.buffer("pullAxes").read<glm::vec4>();
     const auto push = resources.buffer("pushValues").read<glm::vec4>();
     ASSERT_EQ(weights.size(), cpu.pullWeight.size());
     for (std::size_t i = 0; i < weights.size(); ++i) {
@@ -548,6 +627,14 @@ TEST_P(SurfacePassesSpacingGLTest, PullPushMatchesToFloatPrecision) {
         EXPECT_NEAR(weights[i].x, cpu.pullWeight[i], 1e-5) << "texel " << i;
         EXPECT_NEAR(weights[i].y, cpu.pullSpacing[i], 1e-4 * (1.0 + cpu.pullSpacing[i]))
             << "texel " << i;
+        if (GetParam()) {
+            // Sums of up to 4^level axes of length 1 at most, and of as many ones: relative
+            // 1e-6 in float.
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(axes[i][c], cpu.pullAxis[i][c], 1e-5 * (1.0 + cpu.pullAxis[i].z))
+                    << "texel " << i;
+            }
+        }
         for (int c = 0; c < 4; ++c) {
             EXPECT_NEAR(values[i][c], cpu.pullValue[i][c],
                         1e-4 * (1.0 + std::abs(cpu.pullValue[i][c])))
@@ -594,6 +681,21 @@ double cpuSpacingRatioFrom(const std::vector<glm::vec2>& pulled, bool local, std
     return 1.0;
 }
 
+/// The CPU twin of PullPush.glsl's acrossAxisFrom(1, texel) on the GPU's "pullAxes": the mean
+/// across-lines axis of the finest texel above the level-1 texel (x, y) that covers visible
+/// points.
+glm::dvec2 cpuAcrossAxisFromLevelOne(const std::vector<glm::vec4>& sums, int x, int y) {
+    const auto all = levels();
+    for (std::size_t l = 1; l < all.size(); ++l) {
+        const int shift = static_cast<int>(l - 1);
+        const glm::vec4 texel = sums[all[l].offset + (y >> shift) * all[l].width + (x >> shift)];
+        if (texel.z > 0.0f) {
+            return glm::dvec2(texel.x, texel.y) / static_cast<double>(texel.z);
+        }
+    }
+    return glm::dvec2(0.0);
+}
+
 /// spacingRatioAt: from the pixel (x, y) up.
 double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, int y) {
     return cpuSpacingRatioFrom(pulled, local, 0, x, y);
@@ -609,6 +711,7 @@ struct FillInputs {
     std::vector<glm::dvec2> centroids;
     std::vector<double> levelOneDepth;
     std::vector<double> levelOneRatio;
+    std::vector<glm::dvec2> levelOneAxis;
 };
 
 /// The CPU twin of FillRemoval.glsl's fillsGap (with its level-1 texel's sparseEnclosure):
@@ -724,32 +827,73 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
     if (enclosed >= surface.fillDirections) {
         return tie ? std::nullopt : std::optional<bool>(true);
     }
-    // Or within 0.75 (1 - 1/ratio) of the gap of a point, as judged by the mean positions of
+    // Or within SUBSCAN_BEYOND_OUTERMOST_POINTS (1 - 1/ratio) of the gap of a point: where the
+    // points' scan lines agree on an axis (its length, 1 - w / |across|, above one half), along
+    // that axis and beside it by 1.5 texels of about a quarter of the radius or half the gap
+    // along the lines, whichever is larger, stepped along both halves of the axis in three
+    // lanes and a step past the radius; else in any direction, judged by the mean positions of
     // the 3x3 texels around the centre's on the level spanning that radius and the level
     // below (levels 1 and up).
-    const double beyond = 0.75 * (1.0 - 1.0 / ratio) * std::exp2(raw);
+    const double beyond = SUBSCAN_BEYOND_OUTERMOST_POINTS * (1.0 - 1.0 / ratio) * std::exp2(raw);
     if (std::abs(beyond - 1.0) < 1e-4) {
         return std::nullopt;
     }
     if (beyond < 1.0) {
         return tie ? std::nullopt : std::optional<bool>(false);
     }
-    const double radiusLevel = std::log2(beyond);
-    tie = tie || std::abs(radiusLevel - std::round(radiusLevel)) < 1e-4;
-    const int coarse = std::clamp(static_cast<int>(std::ceil(radiusLevel)), 1, top);
-    const int fine = std::max(coarse - 1, 1);
+    const glm::dvec2 axis = inputs.levelOneAxis[ty * all[1].width + tx];
+    tie = tie || std::abs(glm::length(axis) - 0.5) < 1e-4;
     bool near = false;
-    for (int l = fine; l <= coarse; ++l) {
-        for (int dy = -1; dy <= 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-                const int qx = (static_cast<int>(centre.x) >> l) + dx;
-                const int qy = (static_cast<int>(centre.y) >> l) + dy;
+    if (glm::length(axis) > 0.5) {
+        const double angle = 0.5 * std::atan2(axis.y, axis.x);
+        const glm::dvec2 across(std::cos(angle), std::sin(angle));
+        const glm::dvec2 beside(-across.y, across.x);
+        const double alongGap = (1.0 - glm::length(axis)) * std::exp2(raw);
+        const double rawLevel = std::log2(std::max(beyond * 0.25, alongGap * 0.5));
+        tie = tie || std::abs(rawLevel - std::floor(rawLevel) - 0.5) < 1e-4;
+        const int l = std::clamp(static_cast<int>(std::round(rawLevel)), 1, top);
+        const double step = std::exp2(l);
+        for (double t = 0.0; t <= beyond + step && !near; t += step) {
+            for (int lane = 0; lane < 6; ++lane) {
+                const glm::dvec2 position =
+                    centre + (lane % 2 * 2 - 1) * t * across + (lane / 2 - 1) * step * beside;
+                // float positions on the GPU: one this close to a texel's edge may fall in
+                // either texel.
+                for (int c = 0; c < 2; ++c) {
+                    const double inTexel = position[c] / step - std::floor(position[c] / step);
+                    tie = tie || std::min(inTexel, 1.0 - inTexel) < 1e-4;
+                }
+                const int qx = static_cast<int>(std::floor(position.x)) >> l;
+                const int qy = static_cast<int>(std::floor(position.y)) >> l;
                 if (!inside(l, qx, qy) || !std::isfinite(inputs.minDepth[texelAt(l, qx, qy)])) {
                     continue;
                 }
-                const double distance = glm::length(inputs.centroids[texelAt(l, qx, qy)] - centre);
-                tie = tie || std::abs(distance - beyond) < 1e-3 * beyond;
-                near = near || distance <= beyond;
+                const glm::dvec2 offset = inputs.centroids[texelAt(l, qx, qy)] - centre;
+                const double along = glm::dot(offset, across);
+                const double side = glm::length(offset - along * across);
+                tie = tie || std::abs(std::abs(along) - beyond) < 1e-3 * beyond ||
+                      std::abs(side - 1.5 * step) < 1e-3 * step;
+                near = near || (std::abs(along) <= beyond && side <= 1.5 * step);
+            }
+        }
+    } else {
+        const double radiusLevel = std::log2(beyond);
+        tie = tie || std::abs(radiusLevel - std::round(radiusLevel)) < 1e-4;
+        const int coarse = std::clamp(static_cast<int>(std::ceil(radiusLevel)), 1, top);
+        const int fine = std::max(coarse - 1, 1);
+        for (int l = fine; l <= coarse; ++l) {
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int qx = (static_cast<int>(centre.x) >> l) + dx;
+                    const int qy = (static_cast<int>(centre.y) >> l) + dy;
+                    if (!inside(l, qx, qy) || !std::isfinite(inputs.minDepth[texelAt(l, qx, qy)])) {
+                        continue;
+                    }
+                    const double distance =
+                        glm::length(inputs.centroids[texelAt(l, qx, qy)] - centre);
+                    tie = tie || std::abs(distance - beyond) < 1e-3 * beyond;
+                    near = near || distance <= beyond;
+                }
             }
         }
     }
@@ -765,8 +909,10 @@ FillInputs fillInputsOf(const std::vector<glm::vec2>& pulled, const FrameResourc
                         bool local) {
     const std::vector<float> pyramid = resources.buffer("pyramid").read<float>();
     const auto pushed = resources.buffer("pushValues").read<glm::vec4>();
+    const auto axisSums = resources.buffer("pullAxes").read<glm::vec4>();
     FillInputs inputs{std::vector<float>(pulled.size()),
                       std::vector<double>(pyramid.begin(), pyramid.end()),
+                      {},
                       {},
                       {},
                       {}};
@@ -778,6 +924,8 @@ FillInputs fillInputsOf(const std::vector<glm::vec2>& pulled, const FrameResourc
         for (int x = 0; x < levelOne.width; ++x) {
             inputs.levelOneDepth.push_back(pushed[levelOne.offset + y * levelOne.width + x].x);
             inputs.levelOneRatio.push_back(cpuSpacingRatioFrom(pulled, local, 1, x, y));
+            inputs.levelOneAxis.push_back(local ? cpuAcrossAxisFromLevelOne(axisSums, x, y)
+                                                : glm::dvec2(0.0));
         }
     }
     return inputs;
@@ -812,7 +960,11 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
         return x >= region.origin.x && y >= region.origin.y &&
                x < region.origin.x + region.size.x && y < region.origin.y + region.size.y;
     };
-    ASSERT_LT(region.size.x, kWidth);  // the lattice's bounds end before the image's
+    // The lattice's bounds end before the image's; with the local spacing the region also
+    // takes in how far beyond its points the sparse lattice may reach, here all of it.
+    if (!GetParam()) {
+        ASSERT_LT(region.size.x, kWidth);
+    }
     const FrameResources& resources = harness.resources();
     const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
     const FillInputs inputs = fillInputsOf(pulled, resources, GetParam());
@@ -848,7 +1000,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
     EXPECT_GT(kept, 80);  // all outcomes occur in this frame
     EXPECT_GT(filledGaps, 20);
     EXPECT_GT(removed, 100);  // measured 2026-12-05: 259 with the global spacing, 227 local
-    EXPECT_GT(outsideRegion, 0);
+    EXPECT_EQ(outsideRegion > 0, !GetParam());
     // Only sparser points than h reach beyond their outermost ones.
     std::printf("pixels beyond the outermost points: %d; removed %d; outside the region %d\n",
                 beyond, removed, outsideRegion);
@@ -1037,6 +1189,91 @@ TEST(SurfacePassesGLTest, NothingBeyondTheHullOfSparsePointsIsFilled) {
         std::printf("radius %.0f: %d pixels beyond, %d gaps filled\n", radius, beyond, filledGaps);
         EXPECT_EQ(beyond, 0) << "radius " << radius;
         EXPECT_GT(filledGaps, 200) << "radius " << radius;  // the gaps between them do fill
+    }
+}
+
+TEST(SurfacePassesGLTest, ScanLinesReachOnAcrossThemNotPastTheirEnds) {
+    // Five scan lines of a sparse surface (a station's far ground): rows 8 pixels apart, a
+    // point in every pixel along them, local spacing ratio 3, their across-lines axis
+    // vertical, in the middle of 512x512 at a depth where the expected gap is 24 pixels (the
+    // gap test counts the image's border as surface going on within twice the gap). Beyond
+    // the outermost rows the surface goes on across the lines for
+    // SUBSCAN_BEYOND_OUTERMOST_POINTS (1 - 1/3) of the gap, 12 pixels; past the rows' ends,
+    // where the rows themselves show that the surface stops, by no more than the walk's 1.5
+    // texels beside its axis (6 pixels). A reach in every direction (the rule before the
+    // axis) fills 12 pixels past the ends too.
+    constexpr int kSize = 512;
+    constexpr int kFirstRow = 240, kLastRow = 272, kRowGap = 8, kFirstColumn = 236;
+    constexpr int kLastColumn = 276;
+    constexpr float kRatio = 3.0f;
+    constexpr double kGap = 24.0;
+    RenderSettings settings = makeHarness().settings();
+    PassHarness harness(kSize, kSize, settings, kSpacing, 50.0, true);
+    harness.setSparseSpacingRatio(kRatio);
+    std::vector<float> depth(kSize * kSize, std::numeric_limits<float>::infinity());
+    std::vector<float> color(4 * kSize * kSize, 1.0f);
+    std::vector<glm::vec2> axes(kSize * kSize, glm::vec2(0.0f));
+    const auto rowDepth = static_cast<float>(kSpacing * kRatio * harness.focal() / kGap);
+    for (int y = kFirstRow; y <= kLastRow; y += kRowGap) {
+        for (int x = kFirstColumn; x <= kLastColumn; ++x) {
+            depth[y * kSize + x] = rowDepth;
+            color[4 * (y * kSize + x) + 3] = kRatio;
+            // The doubled angle of (0, 1), of length 1 - w / |across| = 1 - 1/8.
+            axes[y * kSize + x] = glm::vec2(-0.875f, 0.0f);
+        }
+    }
+    FrameResources& resources = harness.resources();
+    resources.ensureTexture("depth", TextureFormat::R32F, kSize, kSize).uploadFloats(depth);
+    resources.ensureTexture("color", TextureFormat::RGBA16F, kSize, kSize).uploadFloats(color);
+    harness.uploadAcrossAxes(axes);
+    FrameContext frame = runPullPushPasses(harness);
+    FillRemovalPass(harness.sources()).execute(frame);
+    const std::vector<float> mask = resources.texture("mask").readFloats();
+    const auto surface = [&](int x, int y) { return mask[y * kSize + x] > 0.5f; };
+    // The share of the expected gap beyond the outermost rows.
+    const double reach =
+        SUBSCAN_BEYOND_OUTERMOST_POINTS * (1.0 - 1.0 / kRatio) * settings.surface.fillRadius * kGap;
+    std::printf("reach beyond the outermost rows %.1f pixels\n", reach);
+    ASSERT_GT(reach, 10.0);  // beyond the 7 pixels past the ends that count as too far
+    int acrossKept = 0, acrossMissed = 0, pastEnds = 0, pastReach = 0, betweenRows = 0;
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            const bool alongRows = x >= kFirstColumn + 2 && x <= kLastColumn - 2;
+            const double outside = std::max(kFirstRow - (y + 0.5), (y + 0.5) - (kLastRow + 1));
+            if (alongRows && outside > 0.0 && outside < reach - 3.0) {
+                // 3 pixels short of the reach: the texels' mean positions place it.
+                (surface(x, y) ? acrossKept : acrossMissed)++;
+            }
+            pastReach += alongRows && outside > reach + 3.0 && surface(x, y) ? 1 : 0;
+            pastEnds += (x < kFirstColumn - 7 || x > kLastColumn + 7) && surface(x, y) ? 1 : 0;
+            betweenRows += alongRows && outside < 0.0 && surface(x, y) ? 1 : 0;
+        }
+    }
+    std::printf("across: %d kept, %d missed; past the reach %d, past the ends %d\n", acrossKept,
+                acrossMissed, pastReach, pastEnds);
+    EXPECT_EQ(acrossMissed, 0);
+    EXPECT_GT(acrossKept, 2 * 30 * 9);  // both sides, 37 columns, at least 9 rows of pixels
+    EXPECT_EQ(pastReach, 0);
+    EXPECT_EQ(pastEnds, 0);
+    EXPECT_EQ(betweenRows, 37 * (kLastRow - kFirstRow + 1));  // the gaps between rows close
+}
+
+// The rasterizer's across-lines axes pass to pull-push in the "acrossLines" buffer: declared
+// wherever the settings use the local spacing, so that PassRunner refuses a frame that would
+// read an earlier frame's.
+TEST(SurfacePassesGLTest, TheAcrossLinesAxesAreDeclaredWhereTheyAreUsed) {
+    PassHarness harness = makeHarness();
+    const RasterizePointsPass raster(harness.sources(), test::glTestContext().capabilities());
+    const PullPushPass pullPush(harness.sources());
+    const auto declares = [](const std::vector<std::string_view>& names) {
+        return std::ranges::find(names, "acrossLines") != names.end();
+    };
+    for (const bool local : {true, false}) {
+        RenderSettings settings;
+        settings.raster.mode = RenderMode::Surface;
+        settings.surface.localSpacing = local;
+        EXPECT_EQ(declares(raster.outputs(settings)), local);
+        EXPECT_EQ(declares(pullPush.inputs(settings)), local);
     }
 }
 

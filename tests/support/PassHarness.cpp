@@ -3,6 +3,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/packing.hpp>
+
 #include "support/GlTestSupport.h"
 
 namespace subscan::test {
@@ -33,6 +35,32 @@ PassHarness::PassHarness(int width, int height, const RenderSettings& settings, 
         cloud_.setLocalSpacing({glm::vec4(0.0f, 0.0f, 0.0f, 1.0f)});
     }
     layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_);
+    if (settings_.surface.localSpacing) {
+        uploadAcrossAxes(std::vector<glm::vec2>(static_cast<std::size_t>(width) * height));
+    }
+}
+
+void PassHarness::setSparseSpacingRatio(float ratio) {
+    cloud_.setLocalSpacing({glm::vec4(0.0f, 0.0f, 0.0f, ratio)});
+}
+
+void PassHarness::uploadAcrossAxes(const std::vector<glm::vec2>& axes) {
+    std::vector<std::uint32_t> packed(axes.size());
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+        packed[i] = glm::packHalf2x16(axes[i]);
+    }
+    resources_.ensureBuffer("acrossLines", packed.size() * sizeof(std::uint32_t))
+        .upload(0, packed.size() * sizeof(std::uint32_t), packed.data());
+}
+
+std::vector<glm::vec2> PassHarness::acrossAxes() const {
+    const std::vector<std::uint32_t> packed =
+        resources_.buffer("acrossLines").read<std::uint32_t>();
+    std::vector<glm::vec2> axes(packed.size());
+    for (std::size_t i = 0; i < packed.size(); ++i) {
+        axes[i] = glm::unpackHalf2x16(packed[i]);
+    }
+    return axes;
 }
 
 FrameContext PassHarness::context() {

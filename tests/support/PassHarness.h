@@ -1,5 +1,8 @@
 #pragma once
 
+#include <vector>
+
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/Camera.h"
@@ -23,6 +26,16 @@ class PassHarness {
                 double fovyDegrees = 50.0, bool localSpacing = false);
 
     FrameContext context();
+    /// With the local spacing: the spacing ratio the cloud declares (its sparse one, 1 until
+    /// set), which sets how far beyond the points the passes' region reaches; a test that
+    /// uploads ratios above 1 declares its largest.
+    void setSparseSpacingRatio(float ratio);
+    /// Per pixel, the across-lines axis the rasterizer would leave (its "acrossLines": a
+    /// doubled-angle unit vector, 0 where no scan lines lie apart), with the local spacing
+    /// setting; until set, 0 everywhere.
+    void uploadAcrossAxes(const std::vector<glm::vec2>& axes);
+    /// The axes as the passes read them (half floats).
+    std::vector<glm::vec2> acrossAxes() const;
     /// Another camera (its size must stay) for the passes run after this; uniforms updated.
     void setCamera(const Camera& camera);
     FrameResources& resources() { return resources_; }
