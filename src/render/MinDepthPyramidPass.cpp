@@ -14,9 +14,9 @@ namespace {
 constexpr std::uint32_t kInfinityBits = 0x7F800000u;
 
 /// How many pixels beyond its outermost points fill removal may keep a sparse surface, at
-/// most (FillRemoval.glsl's sparseEnclosure): SUBSCAN_BEYOND_OUTERMOST_POINTS of the expected
-/// gap, which is fillRadius h times a pixel's spacing ratio on screen, in pixels at the
-/// nearest point's depth `nearest`. The ratio on screen is at most the cloud's sparse one
+/// most (FillRemoval.glsl's sparseEnclosure): SUBSCAN_BEYOND_OUTERMOST_POINTS times 1 - 1/R of
+/// the expected gap fillRadius h R, R a pixel's spacing ratio on screen, so fillRadius h (R - 1),
+/// in pixels at the nearest point's depth `nearest`. R is at most the cloud's sparse ratio
 /// (GpuPointCloud::sparseSpacingRatio: the sparsest 0.1 % of the points may still reach past
 /// the region), its across-lines vector projected to first order grown by the view's widest
 /// |xy| / depth; without local spacing (ratio 1) nothing reaches beyond the points. Plus a
@@ -33,7 +33,7 @@ int beyondReachPixels(const FrameContext& frame, float nearest) {
         camera.orthographic() ? 0.0 : 0.5 * std::hypot(camera.width, camera.height) / focal;
     const double perUnit = camera.orthographic() ? focal : focal / nearest;
     const double reach = SUBSCAN_BEYOND_OUTERMOST_POINTS * frame.settings.surface.fillRadius *
-                             frame.spacing * ratio * (1.0 + offAxis) * perUnit +
+                             frame.spacing * (ratio * (1.0 + offAxis) - 1.0) * perUnit +
                          1.0;
     return static_cast<int>(std::min(std::ceil(reach), 1.0e6));
 }
