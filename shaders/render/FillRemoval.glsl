@@ -159,7 +159,9 @@ bool pointAcrossWithin(vec2 centre, float radius, vec2 across, float alongGap) {
     vec2 beside = vec2(-across.y, across.x);
     LevelLayout place = levelLayout(onLevel);
     // A step past the radius: the texel the walk's end lies in may hold points within it.
-    for (float t = 0.0; t <= radius + step; t += step) {
+    // No farther than the image's diagonal (ratios reach 6e4 near the eye).
+    float end = min(radius, length(vec2(pyramid.levels[0].yz))) + step;
+    for (float t = 0.0; t <= end; t += step) {
         for (int lane = 0; lane < 6; ++lane) {
             vec2 position = centre + float(lane % 2 * 2 - 1) * t * across +
                             float(lane / 2 - 1) * step * beside;
@@ -251,11 +253,14 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
         // the expected gap apart.
         vec2 axis = acrossAxisFrom(1u, texel);
         float anisotropy = length(axis);
-        float angle = 0.5 * atan(axis.y, axis.x);
-        bool near = anisotropy > 0.5
-                        ? pointAcrossWithin(centre, beyond, vec2(cos(angle), sin(angle)),
-                                            (1.0 - anisotropy) * exp2(gapLevel))
-                        : pointWithin(centre, beyond);
+        bool near;
+        if (anisotropy > 0.5) {
+            float angle = 0.5 * atan(axis.y, axis.x);
+            near = pointAcrossWithin(centre, beyond, vec2(cos(angle), sin(angle)),
+                                     (1.0 - anisotropy) * exp2(gapLevel));
+        } else {
+            near = pointWithin(centre, beyond);
+        }
         if (near) {
             enclosure |= 1u << 8;
         }

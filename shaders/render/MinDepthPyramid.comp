@@ -4,7 +4,9 @@
 // Levels from 1 on also record where in a texel its points lie ("pointCentroids": the mean of
 // the children's that hold points; on level 1 the pixels' centres), for fill removal's
 // outline (FillRemoval.glsl's enclosesTowards). Children count alike, not by their points:
-// any such mean lies inside the points' convex hull, which is all the outline needs.
+// any such mean lies inside the points' convex hull, which is all the outline needs. With the
+// local spacing, every level also records the spacing ratio of its nearest points
+// ("frontSpacing", level 0 from the "color" image's alpha), for hidden point removal.
 //   STAGE_FIRST   levels 0 (a copy of the "depth" image) and 1 at once, one invocation per
 //                 level-1 texel: a quarter of the invocations of a separate copy
 //   STAGE_REDUCE  level `level` from level `level` - 1
@@ -96,6 +98,7 @@ void main() {
                 }
             } else {
                 childDepths[2 * dy + dx] = kInfinity;
+                childSpacings[2 * dy + dx] = 1.0;
             }
         }
     }

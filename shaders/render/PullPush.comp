@@ -4,8 +4,8 @@
 //                    beside w, w * the point's local spacing ratio ("color"'s alpha), pulled
 //                    like the values but not pushed (PullPush.glsl's spacingRatioAt); and into
 //                    "pullAxes" its across-lines axis ("acrossLines") and 1, summed on each
-//                    level over the 2x2 children a texel covers (FillRemoval.glsl's
-//                    pointAcrossWithin)
+//                    level over the 2x2 children a texel covers that are on the front
+//                    surface (FillRemoval.glsl's pointAcrossWithin)
 //   STAGE_PULL       level R from R-1: W and A summed over the 4x4 children with the kernel
 //                    h = {1/3, 1, 1, 1/3} per axis; w = min(1, W), a = A * w / W. Beyond
 //                    Kraus: only children on the front-most surface take part (see below).

@@ -62,13 +62,15 @@ using mat4 = glm::mat4;
                                          // spacing: the spacing ratio of the texel's nearest
                                          // point (the min-depth pyramid's)
 #define SUBSCAN_SSBO_PULL_AXES 19         // vec4 per texel, all levels, with the local
-                                         // spacing: the sums of w * across-lines axis (xy) and
-                                         // of w (z) over the visible points the texel covers
-                                         // (SUBSCAN_SSBO_ACROSS_LINES), w unused
+                                         // spacing: over the visible pixels the texel covers
+                                         // on the front surface (as the pull chooses it), the
+                                         // sum of their across-lines axes (xy,
+                                         // SUBSCAN_SSBO_ACROSS_LINES) and their count (z)
 #define SUBSCAN_SSBO_ACROSS_LINES 17     // uint per pixel, with the local spacing: the
                                          // winning point's vector across its scan lines on
-                                         // screen as a doubled-angle unit axis (half2; 0 where
-                                         // its lines are no farther apart than its spacing)
+                                         // screen as a doubled-angle axis of length
+                                         // 1 - w / |vector| (half2; 0 where its lines are no
+                                         // farther apart than its spacing w)
 
 // ---- buffer textures, read with texelFetch (Buffer::bindTexels) ----
 #define SUBSCAN_TEXELS_PYRAMID 0       // r32f view of SUBSCAN_SSBO_PYRAMID

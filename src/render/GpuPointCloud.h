@@ -56,7 +56,6 @@ class GpuPointCloud {
     /// 3.7, the largest 21.6), whose reach widened the passes' region so much that frames
     /// took 5 % longer.
     float sparseSpacingRatio() const { return sparseSpacingRatio_; }
-    static constexpr double kSpacingRatioQuantile = 0.999;
     /// Uploads one normal per point (unit length, or 0 where none is known); the constructor
     /// uploads the cloud's own.
     void setNormals(const std::vector<glm::vec3>& normals);

@@ -16,7 +16,10 @@ constexpr std::uint32_t kInfinityBits = 0x7F800000u;
 /// How many pixels beyond its outermost points fill removal may keep a sparse surface, at
 /// most (FillRemoval.glsl's sparseEnclosure): SUBSCAN_BEYOND_OUTERMOST_POINTS times 1 - 1/R of
 /// the expected gap fillRadius h R, R a pixel's spacing ratio on screen, so fillRadius h (R - 1),
-/// in pixels at the nearest point's depth `nearest`. R is at most the cloud's sparse ratio
+/// in pixels at the nearest point's depth `nearest`, and beside the lines' axis by the walk's
+/// 1.5 texels (pointAcrossWithin: texels of at most sqrt 2 times a quarter of the reach or of
+/// the gap, the gap along the lines being below half the gap). R is at most the cloud's
+/// sparse ratio
 /// (GpuPointCloud::sparseSpacingRatio: the sparsest 0.1 % of the points may still reach past
 /// the region), its across-lines vector projected to first order grown by the view's widest
 /// |xy| / depth; without local spacing (ratio 1) nothing reaches beyond the points. Plus a
@@ -32,10 +35,11 @@ int beyondReachPixels(const FrameContext& frame, float nearest) {
     const double offAxis =
         camera.orthographic() ? 0.0 : 0.5 * std::hypot(camera.width, camera.height) / focal;
     const double perUnit = camera.orthographic() ? focal : focal / nearest;
-    const double reach = SUBSCAN_BEYOND_OUTERMOST_POINTS * frame.settings.surface.fillRadius *
-                             frame.spacing * (ratio * (1.0 + offAxis) - 1.0) * perUnit +
-                         1.0;
-    return static_cast<int>(std::min(std::ceil(reach), 1.0e6));
+    const double screenRatio = ratio * (1.0 + offAxis);
+    const double gap = frame.settings.surface.fillRadius * frame.spacing * screenRatio * perUnit;
+    const double reach = SUBSCAN_BEYOND_OUTERMOST_POINTS * gap * (1.0 - 1.0 / screenRatio);
+    const double beside = 1.5 * std::sqrt(2.0) * 0.25 * std::max(reach, gap);
+    return static_cast<int>(std::min(std::ceil(std::hypot(reach, beside) + 1.0), 1.0e6));
 }
 
 }  // namespace

@@ -88,6 +88,8 @@ RenderSettings Renderer::resolvedSettings(const RenderSettings& settings) const 
     if (normals != NormalSource::Screen) {
         normals = cloud_.hasNormals() ? NormalSource::Points : NormalSource::Screen;
     }
+    // Without a local spacing the passes allocate none of its buffers.
+    resolved.surface.localSpacing = settings.surface.localSpacing && cloud_.hasLocalSpacing();
     return resolved;
 }
 

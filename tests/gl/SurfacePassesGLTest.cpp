@@ -1258,22 +1258,30 @@ TEST(SurfacePassesGLTest, ScanLinesReachOnAcrossThemNotPastTheirEnds) {
     EXPECT_EQ(betweenRows, 37 * (kLastRow - kFirstRow + 1));  // the gaps between rows close
 }
 
-// The rasterizer's across-lines axes pass to pull-push in the "acrossLines" buffer: declared
-// wherever the settings use the local spacing, so that PassRunner refuses a frame that would
-// read an earlier frame's.
-TEST(SurfacePassesGLTest, TheAcrossLinesAxesAreDeclaredWhereTheyAreUsed) {
+// The local spacing's buffers pass between the passes by name: the rasterizer's across-lines
+// axes ("acrossLines") to pull-push, its sums ("pullAxes") to fill removal, the nearest
+// points' spacing ("frontSpacing") to hidden point removal; declared wherever the settings
+// use the local spacing, so that PassRunner refuses a frame that would read an earlier one's.
+TEST(SurfacePassesGLTest, TheLocalSpacingsBuffersAreDeclaredWhereTheyAreUsed) {
     PassHarness harness = makeHarness();
     const RasterizePointsPass raster(harness.sources(), test::glTestContext().capabilities());
+    const MinDepthPyramidPass pyramid(harness.sources());
+    const HiddenPointRemovalPass hidden(harness.sources());
     const PullPushPass pullPush(harness.sources());
-    const auto declares = [](const std::vector<std::string_view>& names) {
-        return std::ranges::find(names, "acrossLines") != names.end();
+    const FillRemovalPass fill(harness.sources());
+    const auto declares = [](const std::vector<std::string_view>& names, std::string_view name) {
+        return std::ranges::find(names, name) != names.end();
     };
     for (const bool local : {true, false}) {
         RenderSettings settings;
         settings.raster.mode = RenderMode::Surface;
         settings.surface.localSpacing = local;
-        EXPECT_EQ(declares(raster.outputs(settings)), local);
-        EXPECT_EQ(declares(pullPush.inputs(settings)), local);
+        EXPECT_EQ(declares(raster.outputs(settings), "acrossLines"), local);
+        EXPECT_EQ(declares(pullPush.inputs(settings), "acrossLines"), local);
+        EXPECT_EQ(declares(pullPush.outputs(settings), "pullAxes"), local);
+        EXPECT_EQ(declares(fill.inputs(settings), "pullAxes"), local);
+        EXPECT_EQ(declares(pyramid.outputs(settings), "frontSpacing"), local);
+        EXPECT_EQ(declares(hidden.inputs(settings), "frontSpacing"), local);
     }
 }
 

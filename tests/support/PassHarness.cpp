@@ -42,6 +42,7 @@ PassHarness::PassHarness(int width, int height, const RenderSettings& settings, 
 
 void PassHarness::setSparseSpacingRatio(float ratio) {
     cloud_.setLocalSpacing({glm::vec4(0.0f, 0.0f, 0.0f, ratio)});
+    layout_ = uniforms_.update(camera_, settings_, spacing_, cloud_);
 }
 
 void PassHarness::uploadAcrossAxes(const std::vector<glm::vec2>& axes) {

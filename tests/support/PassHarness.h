@@ -31,8 +31,8 @@ class PassHarness {
     /// uploads ratios above 1 declares its largest.
     void setSparseSpacingRatio(float ratio);
     /// Per pixel, the across-lines axis the rasterizer would leave (its "acrossLines": a
-    /// doubled-angle unit vector, 0 where no scan lines lie apart), with the local spacing
-    /// setting; until set, 0 everywhere.
+    /// doubled-angle vector of length 1 - w / |across|, 0 where no scan lines lie apart), with
+    /// the local spacing setting; until set, 0 everywhere.
     void uploadAcrossAxes(const std::vector<glm::vec2>& axes);
     /// The axes as the passes read them (half floats).
     std::vector<glm::vec2> acrossAxes() const;
