@@ -17,16 +17,13 @@ struct LoadCancelled {};
 }  // namespace
 
 ScanLoadJob::ScanLoadJob(std::string source, lod::LodMode lod)
-    : source_(std::move(source)), lod_(lod), thread_([this] { load(); }) {}
+    : source_(std::move(source)),
+      lod_(lod),
+      job_(source_, [this](const std::function<bool()>& cancelled) { return load(cancelled); }) {}
 
-ScanLoadJob::~ScanLoadJob() {
-    cancelled_.store(true, std::memory_order_relaxed);
-    thread_.join();
-}
-
-void ScanLoadJob::load() {
-    const auto reportProgress = [this](double fraction) {
-        if (cancelled_.load(std::memory_order_relaxed)) {
+PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
+    const auto reportProgress = [this, &cancelled](double fraction) {
+        if (cancelled()) {
             throw LoadCancelled{};
         }
         progress_.store(fraction, std::memory_order_relaxed);
@@ -40,20 +37,15 @@ void ScanLoadJob::load() {
         } else {
             prepared.scan = loadScan(source_, reportProgress);
         }
-        if (!prepareForRenderer(prepared,
-                                [this] { return cancelled_.load(std::memory_order_relaxed); })) {
+        if (!prepareForRenderer(prepared, cancelled)) {
             throw LoadCancelled{};
         }
-        result_ = std::move(prepared);
+        return prepared;
     } catch (const LoadCancelled&) {
-        error_ = std::make_exception_ptr(Error(source_ + ": loading was cancelled"));
+        throw Error(source_ + ": loading was cancelled");
     } catch (const std::bad_alloc&) {
-        error_ = std::make_exception_ptr(
-            Error(source_ + ": out of memory (the scan is too large for this machine)"));
-    } catch (...) {
-        error_ = std::current_exception();
+        throw Error(source_ + ": out of memory (the scan is too large for this machine)");
     }
-    finished_.store(true, std::memory_order_release);
 }
 
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {
@@ -62,18 +54,6 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
         prepared.scan.cloud,
         prepared.streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto, cancelled);
     return !cancelled();
-}
-
-PreparedScan ScanLoadJob::take() {
-    if (error_) {
-        std::rethrow_exception(std::exchange(error_, nullptr));
-    }
-    if (!result_) {
-        throw Error(source_ + ": the scan was already taken");
-    }
-    PreparedScan prepared = std::move(*result_);
-    result_.reset();
-    return prepared;
 }
 
 }  // namespace subscan::viewer

@@ -1,16 +1,14 @@
 #pragma once
 
 #include <atomic>
-#include <exception>
 #include <functional>
 #include <memory>
-#include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "app/viewer/BackgroundJob.h"
 #include "core/LocalSpacing.h"
 #include "io/ScanLoader.h"
 #include "lod/NodeSource.h"
@@ -43,29 +41,22 @@ class ScanLoadJob {
   public:
     /// `lod`: whether a COPC file or EPT dataset is streamed (settings' streaming.lod).
     ScanLoadJob(std::string source, lod::LodMode lod);
-    ~ScanLoadJob();
-    ScanLoadJob(const ScanLoadJob&) = delete;
-    ScanLoadJob& operator=(const ScanLoadJob&) = delete;
 
     const std::string& source() const { return source_; }
     /// 0..1 while the file is decoded; readers of small files and synthetic scenes report
     /// nothing until they are done.
     double progress() const { return progress_.load(std::memory_order_relaxed); }
-    bool finished() const { return finished_.load(std::memory_order_acquire); }
+    bool finished() const { return job_.finished(); }
     /// The result once finished(); rethrows the load's subscan::Error. Call at most once.
-    PreparedScan take();
+    PreparedScan take() { return job_.take(); }
 
   private:
-    void load();
+    PreparedScan load(const std::function<bool()>& cancelled);
 
     std::string source_;
     lod::LodMode lod_;
     std::atomic<double> progress_{0.0};
-    std::atomic<bool> finished_{false};
-    std::atomic<bool> cancelled_{false};
-    std::optional<PreparedScan> result_;
-    std::exception_ptr error_;
-    std::thread thread_;  // last: starts once everything it touches exists
+    BackgroundJob<PreparedScan> job_;  // last: starts once everything it touches exists
 };
 
 }  // namespace subscan::viewer

@@ -16,45 +16,30 @@ StreamedViewJob::StreamedViewJob(std::shared_ptr<const lod::NodeSource> source,
       camera_(camera),
       pointBudget_(pointBudget),
       shown_(std::move(shown)),
-      thread_([this] { load(); }) {}
+      job_(sourceName_,
+           [this](const std::function<bool()>& cancelled) { return load(cancelled); }) {}
 
-StreamedViewJob::~StreamedViewJob() {
-    cancelled_.store(true, std::memory_order_relaxed);
-    thread_.join();
-}
-
-void StreamedViewJob::load() {
+std::optional<PreparedScan> StreamedViewJob::load(const std::function<bool()>& cancelled) {
     try {
         std::vector<std::size_t> nodes = lod::selectNodes(*source_, camera_, pointBudget_);
-        if (nodes != shown_) {
-            PreparedScan prepared;
-            prepared.source = sourceName_;
-            prepared.streamed = source_;
-            // The source's own warnings were said when it opened.
-            prepared.scan = lod::loadStreamedScan(*source_, nodes, false, [this] {
-                return cancelled_.load(std::memory_order_relaxed);
-            });
-            prepared.nodes = std::move(nodes);
-            if (prepareForRenderer(prepared,
-                                   [this] { return cancelled_.load(std::memory_order_relaxed); })) {
-                result_ = std::move(prepared);
-            }
+        if (nodes == shown_) {
+            return std::nullopt;
         }
+        PreparedScan prepared;
+        prepared.source = sourceName_;
+        prepared.streamed = source_;
+        // The source's own warnings were said when it opened.
+        prepared.scan = lod::loadStreamedScan(*source_, nodes, false, cancelled);
+        prepared.nodes = std::move(nodes);
+        if (!prepareForRenderer(prepared, cancelled)) {
+            return std::nullopt;
+        }
+        return prepared;
     } catch (const std::bad_alloc&) {
-        error_ = std::make_exception_ptr(
-            Error(sourceName_ + ": out of memory for the view's points (try a smaller "
-                                "point budget)"));
-    } catch (...) {
-        error_ = std::current_exception();
+        throw Error(sourceName_ +
+                    ": out of memory for the view's points (try a smaller "
+                    "point budget)");
     }
-    finished_.store(true, std::memory_order_release);
-}
-
-std::optional<PreparedScan> StreamedViewJob::take() {
-    if (error_) {
-        std::rethrow_exception(std::exchange(error_, nullptr));
-    }
-    return std::exchange(result_, std::nullopt);
 }
 
 }  // namespace subscan::viewer

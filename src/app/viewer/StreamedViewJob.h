@@ -1,14 +1,14 @@
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <exception>
+#include <functional>
 #include <memory>
 #include <optional>
-#include <thread>
+#include <string>
 #include <vector>
 
+#include "app/viewer/BackgroundJob.h"
 #include "app/viewer/ScanLoadJob.h"
 #include "core/Camera.h"
 #include "lod/NodeSource.h"
@@ -25,28 +25,22 @@ class StreamedViewJob {
     StreamedViewJob(std::shared_ptr<const lod::NodeSource> source, std::string sourceName,
                     const Camera& camera, std::uint64_t pointBudget,
                     std::vector<std::size_t> shown);
-    ~StreamedViewJob();
-    StreamedViewJob(const StreamedViewJob&) = delete;
-    StreamedViewJob& operator=(const StreamedViewJob&) = delete;
 
-    bool finished() const { return finished_.load(std::memory_order_acquire); }
+    bool finished() const { return job_.finished(); }
     /// Once finished(): the view's nodes prepared, or nullopt where they are the ones shown.
     /// Rethrows a subscan::Error of the load. Call at most once.
-    std::optional<PreparedScan> take();
+    std::optional<PreparedScan> take() { return job_.take(); }
 
   private:
-    void load();
+    std::optional<PreparedScan> load(const std::function<bool()>& cancelled);
 
     std::shared_ptr<const lod::NodeSource> source_;
     std::string sourceName_;
     Camera camera_;
     std::uint64_t pointBudget_;
     std::vector<std::size_t> shown_;
-    std::atomic<bool> finished_{false};
-    std::atomic<bool> cancelled_{false};
-    std::optional<PreparedScan> result_;
-    std::exception_ptr error_;
-    std::thread thread_;  // last: starts once everything it touches exists
+    // Last: starts once everything it touches exists.
+    BackgroundJob<std::optional<PreparedScan>> job_;
 };
 
 }  // namespace subscan::viewer
