@@ -1,6 +1,7 @@
 #include "eval/GroundTruth.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <thread>
 
@@ -8,6 +9,32 @@
 #include <glm/matrix.hpp>
 
 namespace subscan {
+
+namespace {
+
+/// GroundTruthImages::depthWithinPixel of the pixel whose centre's view direction (z = -1) is
+/// `centre`, whose surface lies at linear depth `depth` with view-space normal `normal`: the
+/// tangent plane n . p = n . (depth * centre) meets the ray through a corner, direction w with
+/// w.z = -1, at linear depth (n . centre) * depth / (n . w).
+double depthWithinPixel(const glm::dvec3& centre, double depth, const glm::dvec3& normal,
+                        double focal) {
+    const double cap = kSteepestDepthWithinPixel * depth / focal;
+    const double facing = glm::dot(normal, centre);
+    double farthest = 0.0;
+    for (const double dx : {-0.5, 0.5}) {
+        for (const double dy : {-0.5, 0.5}) {
+            const double across = glm::dot(normal, centre + glm::dvec3(dx, dy, 0.0) / focal);
+            // The plane turns away from (or runs along) the corner's ray: it reaches any depth.
+            if (across * facing <= 0.0) {
+                return cap;
+            }
+            farthest = std::max(farthest, std::abs(facing * depth / across - depth));
+        }
+    }
+    return std::min(farthest, cap);
+}
+
+}  // namespace
 
 GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera,
                                     const SampledTest& sampled) {
@@ -19,7 +46,10 @@ GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera,
                              std::vector<float>(pixels, std::numeric_limits<float>::infinity()),
                              std::vector<glm::vec3>(pixels, glm::vec3(0.0f)),
                              std::vector<glm::vec3>(pixels, glm::vec3(0.0f)),
-                             std::vector<std::uint8_t>(sampled ? pixels : 0, 0)};
+                             std::vector<std::uint8_t>(sampled ? pixels : 0, 0),
+                             {},
+                             std::vector<float>(pixels, 0.0f)};
+    const double focal = camera.focalLengthPixels();
     const glm::dmat4 toFile = glm::inverse(camera.view);
     const glm::dvec3 eye = camera.eye();
     const glm::dmat3 rotation(camera.view);
@@ -39,7 +69,10 @@ GroundTruthImages renderGroundTruth(const Scene& scene, const Camera& camera,
                 const std::size_t i = static_cast<std::size_t>(y) * width + x;
                 // Linear depth is the distance along -Z of view space.
                 images.depth[i] = static_cast<float>(hit->distance / glm::length(viewDirection));
-                images.normals[i] = glm::vec3(glm::normalize(rotation * hit->normal));
+                const glm::dvec3 normal = glm::normalize(rotation * hit->normal);
+                images.normals[i] = glm::vec3(normal);
+                images.depthWithinPixel[i] = static_cast<float>(
+                    depthWithinPixel(viewDirection, images.depth[i], normal, focal));
                 images.albedo[i] = hit->albedo;
                 if (sampled) {
                     images.sampled[i] =

@@ -29,7 +29,9 @@ double percentile(std::vector<double>& values, double fraction) {
 bool showsThrough(const GroundTruthImages& truth, std::size_t i, float reconstructedDepth,
                   double h) {
     const double scale = truth.spacing.empty() ? h : std::max(h, double{truth.spacing[i]});
-    return static_cast<double>(reconstructedDepth) - truth.depth[i] > 3.0 * scale;
+    const double withinPixel =
+        truth.depthWithinPixel.empty() ? 0.0 : double{truth.depthWithinPixel[i]};
+    return static_cast<double>(reconstructedDepth) - truth.depth[i] > 3.0 * scale + withinPixel;
 }
 
 QualityMetrics compareToGroundTruth(const ReconstructionImages& reconstruction,

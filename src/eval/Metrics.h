@@ -23,8 +23,8 @@ struct QualityMetrics {
     double leakage = 0.0;             // |rec \ gt| / |rec|
     double depthErrorMedianH = 0.0;   // median |z_rec - z_gt| / h over rec ∩ gt
     double depthBiasH = 0.0;          // median (z_rec - z_gt) / h over rec ∩ gt: < 0 in front
-    double occlusionErrorRate = 0.0;  // share of rec ∩ gt with z_rec - z_gt > 3 h (or 3 times
-                                      // GroundTruthImages::spacing, where given)
+    double occlusionErrorRate = 0.0;  // share of rec ∩ gt that showsThrough: z_rec - z_gt > 3 h
+                                      // (see there for the spacing and the pixel's depths)
     std::optional<double> normalErrorMeanDeg;
     std::optional<double> normalErrorP95Deg;
     double psnrDb = 0.0;  // shaded image against the shaded ground truth, 8-bit sRGB
@@ -32,7 +32,9 @@ struct QualityMetrics {
 
 /// Whether a reconstructed depth at pixel `i` of `truth` lies so far behind the true surface
 /// that a surface behind it shows through: more than 3 h behind, or 3 times the scan's spacing
-/// there where `truth` gives it (GroundTruthImages::spacing), and never less than 3 h.
+/// there where `truth` gives it (GroundTruthImages::spacing), and never less than 3 h, beyond
+/// the depths the true surface takes within the pixel (GroundTruthImages::depthWithinPixel,
+/// where given): the truth is the pixel centre's, a point anywhere in the pixel.
 bool showsThrough(const GroundTruthImages& truth, std::size_t i, float reconstructedDepth,
                   double h);
 

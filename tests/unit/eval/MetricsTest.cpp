@@ -58,6 +58,21 @@ TEST(MetricsTest, OcclusionsScaleWithTheScansSpacingWhereGiven) {
     EXPECT_DOUBLE_EQ(compareToGroundTruth(reconstruction, truth, h).occlusionErrorRate, 1.0);
 }
 
+TEST(MetricsTest, OcclusionsLeaveTheDepthsTheTrueSurfaceTakesWithinThePixel) {
+    // 3 pixels, each reconstructed 4 h behind the truth (more than 3 h); within them the true
+    // surface reaches 0, 0.5 h and 1.5 h from the centre's depth. Only the last takes the
+    // reconstruction in (4 h < 3 h + 1.5 h).
+    const float h = 0.01f;
+    GroundTruthImages truth{3, 1, std::vector<float>(3, 1.0f), std::vector<glm::vec3>(3, {0, 0, 1}),
+                            std::vector<glm::vec3>(3)};
+    truth.depthWithinPixel = {0.0f, 0.5f * h, 1.5f * h};
+    const ReconstructionImages reconstruction{std::vector<float>(3, 1.0f + 4 * h), {}};
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(showsThrough(truth, i, reconstruction.depth[i], h), i < 2) << i;
+    }
+    EXPECT_DOUBLE_EQ(compareToGroundTruth(reconstruction, truth, h).occlusionErrorRate, 2.0 / 3.0);
+}
+
 TEST(MetricsTest, UnsampledTruthCountsNeitherForCoverageNorForLeakage) {
     // 8 pixels of truth, 0..7; the scan could sample only 0..3. The reconstruction covers 0..2
     // and 4..5 (true surface it could not know about) and 9 (nothing there).
