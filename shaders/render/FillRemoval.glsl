@@ -76,9 +76,10 @@ const float kEnclosingConeCos = 0.38268343;
 /// either side of the direction, so without this a pixel beyond a sparse cloud's outline
 /// found points "around" it in texels that hold them only on the cloud's side, and the fill
 /// ran past the outline in the coarse texels' blocks. Beyond the image the surface goes on,
-/// but counts only where the border lies within `borderReach` pixels: a coarse level's texel
-/// beside the border reaches far into the picture (once the fill looked a level beyond the
-/// gap's, the corners between a sphere's silhouette and the border filled).
+/// but counts only where the border lies within `borderReach` pixels, or where `own`'s points
+/// lie in the direction: a coarse level's texel beside the border reaches far into the picture
+/// (once the fill looked a level beyond the gap's, the corners between a sphere's silhouette
+/// and the border filled).
 bool enclosesTowards(vec2 centre, ivec2 own, int k, uint onLevel, LevelLayout place,
                      float borderReach) {
     ivec2 texel = own + kDirections[k];
@@ -89,7 +90,15 @@ bool enclosesTowards(vec2 centre, ivec2 own, int k, uint onLevel, LevelLayout pl
         vec2 toBorder = mix(centre, size - centre, greaterThan(direction, vec2(0.0)));
         float distance = min(direction.x != 0.0 ? toBorder.x : kInfinity,
                              direction.y != 0.0 ? toBorder.y : kInfinity);
-        return distance * length(direction) <= borderReach;
+        if (distance * length(direction) <= borderReach) {
+            return true;
+        }
+        // Farther, where the points of the pixel's own texel on this level, which the border
+        // cuts, lie towards it: the surface reaches the border there. A sparse ground seen at
+        // a slant left bands of background beside the border where its gap's next row lay
+        // beyond twice the gap (StreamedSurfaceGLTest), while between an object's outline and
+        // the border, this texel's points lie on the object's side.
+        texel = own;
     }
     uint index = texelIndex(place, texel);
     // A texel of the walk above the finest weighted one may hold no points.

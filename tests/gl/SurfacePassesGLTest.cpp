@@ -796,8 +796,10 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
             if (!reached) {
                 continue;
             }
+            int px = qx, py = qy;  // the texel whose points count
             if (!inside(l, qx, qy)) {
-                // The surface goes on beyond the image: it counts within twice the gap.
+                // The surface goes on beyond the image: it counts within twice the gap, and
+                // farther where the pixel's own texel's points lie towards the border.
                 const double toX = d.x > 0 ? kWidth - centre.x : centre.x;
                 const double toY = d.y > 0 ? kHeight - centre.y : centre.y;
                 const double distance =
@@ -808,12 +810,13 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
                     ++enclosed;
                     break;
                 }
+                px = tx >> (l - 1);
+                py = ty >> (l - 1);
+            }
+            if (!std::isfinite(inputs.minDepth[texelAt(l, px, py)])) {
                 continue;
             }
-            if (!std::isfinite(inputs.minDepth[texelAt(l, qx, qy)])) {
-                continue;
-            }
-            const glm::dvec2 offset = inputs.centroids[texelAt(l, qx, qy)] - centre;
+            const glm::dvec2 offset = inputs.centroids[texelAt(l, px, py)] - centre;
             const double along = glm::dot(offset, d);
             const double limit = coneCos * glm::length(offset) * glm::length(d);
             // 16-bit positions in the texel and float arithmetic on the GPU.
