@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
 
@@ -191,6 +193,43 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, std::optional<double>
 
 PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample) {
     return withLocalSpacing(cloud, sample.h, [&] { return sample.nearest; });
+}
+
+PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float> levelSpacing) {
+    PointSpacing spacing = estimatePointSpacing(cloud);
+    if (levelSpacing.empty()) {
+        return spacing;
+    }
+    if (levelSpacing.size() != cloud.size()) {
+        throw std::invalid_argument("estimatePointSpacing: one level spacing per point");
+    }
+    // Per level, the spacing its points' own estimates give (their median: most lie away
+    // from a border); without them, the level's spacing over that of the level most points
+    // lie on, which sets h.
+    std::map<float, std::vector<float>> estimates;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        estimates[levelSpacing[i]].push_back(spacing.local.empty() ? 0.0f : spacing.local[i].w);
+    }
+    if (estimates.size() < 2) {
+        return spacing;  // one level: the estimate stands
+    }
+    const float dominant =
+        std::max_element(estimates.begin(), estimates.end(), [](const auto& a, const auto& b) {
+            return a.second.size() < b.second.size();
+        })->first;
+    std::map<float, float> onLevel;
+    for (auto& [level, values] : estimates) {
+        const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+        std::nth_element(values.begin(), middle, values.end());
+        onLevel[level] = spacing.local.empty() ? std::max(1.0f, level / dominant) : *middle;
+    }
+    if (spacing.local.empty()) {
+        spacing.local.assign(cloud.size(), glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
+    }
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        spacing.local[i].w = std::max(spacing.local[i].w, onLevel[levelSpacing[i]]);
+    }
+    return spacing;
 }
 
 bool spacingVaries(std::vector<float> sampledNearest) {

@@ -252,13 +252,13 @@ class StreamedPoints {
 struct StreamedView {
     StreamedView(GlContext& context, const StreamedPoints& points, const Camera& camera,
                  std::uint64_t budget, NormalSource normals)
-        : cloud(lod::loadStreamedScan(points.source(),
-                                      lod::selectNodes(points.source(), camera, budget))
-                    .cloud),
-          renderer(std::make_unique<Renderer>(context, cloud, estimatePointSpacing(cloud))) {
-        renderer->prepareNormals(cloud, streamedNormals(normals));
+        : scan(lod::loadStreamedScan(points.source(),
+                                     lod::selectNodes(points.source(), camera, budget))),
+          renderer(std::make_unique<Renderer>(
+              context, scan.cloud, estimatePointSpacing(scan.cloud, scan.levelSpacing))) {
+        renderer->prepareNormals(scan.cloud, streamedNormals(normals));
     }
-    PointCloud cloud;
+    LoadedScan scan;
     std::unique_ptr<Renderer> renderer;
 };
 
@@ -326,7 +326,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         if (streamed) {
             streamedView.emplace(context, *streamed, camera, *settings.pointBudget,
                                  render.surface.normals);
-            report.surfacePoints += static_cast<double>(streamedView->cloud.size()) / views;
+            report.surfacePoints += static_cast<double>(streamedView->scan.cloud.size()) / views;
         }
         Renderer& surfaceRenderer = streamedView ? *streamedView->renderer : renderer;
         const int divisor =

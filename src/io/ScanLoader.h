@@ -27,6 +27,10 @@ struct LoadedScan {
     double loadMilliseconds = 0.0;     // reading and decoding, nothing after
     std::optional<SensorPose> sensor;  // where the file says the sensor stood
     OrganisedGrid grid;                // an organised cloud's grid (empty when unorganised)
+    /// A streamed view's points (lod::loadStreamedScan): per point, the spacing of the finest
+    /// level of detail the view loaded where it lies (scene units), which its local spacing
+    /// is at least (estimatePointSpacing); empty for a scan loaded whole.
+    std::vector<float> levelSpacing;
 };
 
 /// Loads a scan file, or scans a built-in scene for "synthetic:NAME[?points=N][&noise=X]"

@@ -18,6 +18,7 @@
 #include <glm/matrix.hpp>
 
 #include "core/Error.h"
+#include "core/Parallel.h"
 
 namespace subscan::lod {
 
@@ -238,6 +239,93 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
     return cloud;
 }
 
+namespace {
+
+/// A part of the survey next to a loaded node where the view loaded only coarser levels: the
+/// neighbouring cube on the node's level, and the spacing there.
+struct CoarserBeside {
+    glm::dvec3 min{0.0}, max{0.0};
+    double spacing = 0.0;
+};
+
+/// LoadedScan::levelSpacing of `cloud`, loaded from `nodes`. The view takes nodes from the root
+/// down (a parent before its children), so the finest node it loaded around a point is found
+/// by going down from the root while the child that holds the point is one of them; its level
+/// gives the spacing. Where a part of the view with a coarser spacing lies within that spacing
+/// of the point, that spacing: the gap between the finer points' last row and the coarser
+/// ones' first is the coarser spacing, which the finer points beside the border must bridge.
+/// (A node that could not be read still counts as loaded: beside it the spacing is too fine.)
+std::vector<float> levelSpacingOf(const NodeSource& source, std::span<const std::size_t> nodes,
+                                  const PointCloud& cloud) {
+    const std::span<const StreamedNode> all = source.nodes();
+    std::vector<bool> loaded(all.size(), false);
+    for (const std::size_t node : nodes) {
+        loaded[node] = true;
+    }
+    const OctreeCube& cube = source.info().cube;
+    const glm::dvec3 corner = cube.center - cube.halfSize;
+    const auto isLoaded = [&](const laz::VoxelKey& key) {
+        const std::size_t node = source.find(key);
+        return node < all.size() && loaded[node];
+    };
+    // Per loaded node, its neighbours on its level that hold points the view did not load,
+    // with the spacing of their finest loaded ancestor.
+    std::vector<std::vector<CoarserBeside>> coarser(all.size());
+    for (const std::size_t node : nodes) {
+        const laz::VoxelKey& key = all[node].key;
+        const std::int32_t cells = std::int32_t{1} << key.level;
+        const double side = 2.0 * cube.halfSize / cells;
+        for (int dz = -1; dz <= 1; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const laz::VoxelKey beside{key.level, key.x + dx, key.y + dy, key.z + dz};
+                    if (beside.x < 0 || beside.y < 0 || beside.z < 0 || beside.x >= cells ||
+                        beside.y >= cells || beside.z >= cells ||
+                        source.find(beside) >= all.size() || isLoaded(beside)) {
+                        continue;  // outside the octree, empty, or as fine
+                    }
+                    int level = key.level - 1;
+                    while (level > 0 && !isLoaded({level, beside.x >> (key.level - level),
+                                                   beside.y >> (key.level - level),
+                                                   beside.z >> (key.level - level)})) {
+                        --level;
+                    }
+                    const glm::dvec3 min = corner + side * glm::dvec3(beside.x, beside.y, beside.z);
+                    coarser[node].push_back(
+                        {min, min + side, std::ldexp(cube.rootSpacing, -level)});
+                }
+            }
+        }
+    }
+    std::vector<float> spacing(cloud.size());
+    inParallel(cloud.size(), [&](std::size_t i) {
+        const glm::dvec3 position = cloud.fileCoordinates(i);
+        std::size_t finest = source.find(nodeKeyAt(cube, position, 0));
+        for (int level = 1;; ++level) {
+            const std::size_t child = source.find(nodeKeyAt(cube, position, level));
+            if (child >= all.size() || !loaded[child]) {
+                break;
+            }
+            finest = child;
+        }
+        double own =
+            std::ldexp(cube.rootSpacing, -(finest < all.size() ? all[finest].key.level : 0));
+        if (finest < all.size()) {
+            for (const CoarserBeside& part : coarser[finest]) {
+                const glm::dvec3 outside =
+                    glm::max(glm::max(part.min - position, position - part.max), 0.0);
+                if (part.spacing > own && glm::length(outside) <= part.spacing) {
+                    own = part.spacing;
+                }
+            }
+        }
+        spacing[i] = static_cast<float>(own);
+    });
+    return spacing;
+}
+
+}  // namespace
+
 LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_t> nodes,
                             bool withSourceWarnings, const std::function<bool()>& cancelled) {
     const auto start = std::chrono::steady_clock::now();
@@ -251,6 +339,7 @@ LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_
                                 source.info().name, nodes.size(),
                                 scan.warnings.empty() ? "?" : scan.warnings.back()));
     }
+    scan.levelSpacing = levelSpacingOf(source, nodes, scan.cloud);
     scan.cloud.bounds.add(source.info().bounds.min);
     scan.cloud.bounds.add(source.info().bounds.max);
     scan.format = source.info().format;

@@ -48,17 +48,15 @@ std::vector<std::size_t> topLevels(const NodeSource& source, std::uint64_t point
 inline constexpr std::uint64_t kOverviewPoints = 200'000;
 
 /// `nodes` of `source` as a loaded scan (loadNodes on every core), with the whole survey's
-/// bounds (a view is framed, and coloured by height, alike whatever its nodes), the source's
-/// format, and warnings: the source's own (`withSourceWarnings`: once per opening) and those of
-/// the nodes left out. Throws subscan::Error naming the source where none of `nodes` could be
-/// read (an empty picture would pass for an empty view).
+/// bounds (a view is framed, and coloured by height, alike whatever its nodes), each point's
+/// LoadedScan::levelSpacing, the source's format, and warnings: the source's own
+/// (`withSourceWarnings`: once per opening) and those of the nodes left out. Throws
+/// subscan::Error naming the source where none of `nodes` could be read (an empty picture
+/// would pass for an empty view).
 LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_t> nodes,
                             bool withSourceWarnings = true,
                             const std::function<bool()>& cancelled = {});
 
-/// Loads `nodes` on `threads` threads (0: every core) into one cloud, in the order given, its
-/// positions about the middle of the source's bounds. A node that cannot be read is left out
-/// with one warning that names the node (the caller names the source); the rest still shows.
 /// The overview a streamed source opens with: its top levels (topLevels, kOverviewPoints),
 /// with the source's warnings. Where none of them can be read (a missing root tile), the next
 /// level down joins them, and so on: only a source none of whose nodes can be read is an error.
@@ -66,6 +64,9 @@ LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_
 LoadedScan loadStreamedOverview(const NodeSource& source,
                                 std::vector<std::size_t>* nodes = nullptr);
 
+/// Loads `nodes` on `threads` threads (0: every core) into one cloud, in the order given, its
+/// positions about the middle of the source's bounds. A node that cannot be read is left out
+/// with one warning that names the node (the caller names the source); the rest still shows.
 /// `cancelled` (may be empty) is asked before each node: once true, the rest are left out.
 PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> nodes,
                      std::vector<std::string>& warnings, unsigned threads = 0,

@@ -153,7 +153,7 @@ int runRender(const RenderOptions& options) {
     }
     frame.applyColoring(scan);
     // `scan` outlives the renderer unchanged: the GPU may read its points in place.
-    Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud), 0,
+    Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud, scan.levelSpacing), 0,
                       PointMemory::Borrow);
     renderer.prepareNormals(scan.cloud, streamed ? streamedNormals(settings.surface.normals)
                                                  : settings.surface.normals);

@@ -49,7 +49,7 @@ PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
 }
 
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {
-    prepared.spacing = estimatePointSpacing(prepared.scan.cloud);
+    prepared.spacing = estimatePointSpacing(prepared.scan.cloud, prepared.scan.levelSpacing);
     prepared.normals = normalsFor(
         prepared.scan.cloud,
         prepared.streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto, cancelled);

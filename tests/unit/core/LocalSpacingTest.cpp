@@ -2,6 +2,8 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -245,6 +247,48 @@ TEST(LocalSpacingTest, SpacingWithinAFactorOneAndAHalfOfHCountsAsH) {
     const PointCloud uneven = twoPatches(0.016);  // float positions: ~1e-6 relative below
     EXPECT_NEAR(estimateLocalSpacing(uneven, estimateSpacing(uneven))[1600 + 10 * 20 + 10].w, 1.6f,
                 2e-4f);
+}
+
+TEST(LocalSpacingTest, AStreamedLevelsPointsTakeAtLeastItsSpacing) {
+    // Two levels of a streamed view side by side: points 0.01 apart for x < 0.6, 0.02 apart
+    // beyond (a coarser level). The coarse points at the border find fine neighbours and
+    // estimate a smaller spacing than the coarse level's 2 h; with their level given they
+    // take at least the level's median estimate.
+    PointCloudBuilder builder({}, 60 * 60 + 30 * 30);
+    std::vector<float> levelSpacing;
+    for (const double step : {0.01, 0.02}) {
+        const int count = static_cast<int>(0.6 / step + 0.5);
+        for (int i = 0; i < count; ++i) {
+            for (int j = 0; j < count; ++j) {
+                PointRecord record;
+                record.position = {(step == 0.01 ? 0.0 : 0.6) + i * step, j * step, 0.0};
+                builder.add(record);
+                levelSpacing.push_back(static_cast<float>(step));
+            }
+        }
+    }
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    const PointSpacing alone = estimatePointSpacing(cloud);
+    const PointSpacing byLevel = estimatePointSpacing(cloud, levelSpacing);
+    ASSERT_EQ(alone.local.size(), cloud.size());
+    ASSERT_EQ(byLevel.local.size(), cloud.size());
+    EXPECT_EQ(byLevel.global, alone.global);
+    const std::size_t coarseMiddle = 3600 + 15 * 30 + 15, coarseAtBorder = 3600 + 15;
+    // Float positions: w within 1e-4 of the steps' ratio.
+    EXPECT_NEAR(alone.local[coarseMiddle].w, 2.0f, 2e-4f);
+    EXPECT_LT(alone.local[coarseAtBorder].w, 1.9f) << "the border's coarse points look denser";
+    EXPECT_NEAR(byLevel.local[coarseAtBorder].w, 2.0f, 2e-4f);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        EXPECT_GE(byLevel.local[i].w, alone.local[i].w) << i;  // never below the estimate
+        EXPECT_EQ(glm::vec3(byLevel.local[i]), glm::vec3(alone.local[i])) << i;  // lines kept
+    }
+    // One level, or none given: the estimate alone.
+    const std::vector<float> one(cloud.size(), 0.01f);
+    EXPECT_EQ(estimatePointSpacing(cloud, one).local, alone.local);
+    EXPECT_EQ(estimatePointSpacing(cloud, std::span<const float>{}).local, alone.local);
+    EXPECT_THROW(estimatePointSpacing(cloud, std::span(levelSpacing).first(10)),
+                 std::invalid_argument);
 }
 
 TEST(LocalSpacingTest, DegenerateCloudsKeepTheGlobalSpacing) {
