@@ -203,31 +203,42 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float
     if (levelSpacing.size() != cloud.size()) {
         throw std::invalid_argument("estimatePointSpacing: one level spacing per point");
     }
-    // Per level, the spacing its points' own estimates give (their median: most lie away
-    // from a border); without them, the level's spacing over that of the level most points
-    // lie on, which sets h.
-    std::map<float, std::vector<float>> estimates;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        estimates[levelSpacing[i]].push_back(spacing.local.empty() ? 0.0f : spacing.local[i].w);
+    // The level most points lie on calibrates: a level's points lie its spacing over that
+    // level's times as far apart as that level's do, whose estimate there is taken as their
+    // lower quartile (its points beside a finer level estimate less, those where the scan is
+    // sparser than the level more; without estimates, 1). Level spacing 0 (points at the
+    // scan's own spacing) sets no minimum.
+    std::map<float, std::size_t> pointsOn;
+    for (const float level : levelSpacing) {
+        if (level > 0.0f) {
+            ++pointsOn[level];
+        }
     }
-    if (estimates.size() < 2) {
-        return spacing;  // one level: the estimate stands
+    if (pointsOn.empty() ||
+        (pointsOn.size() == 1 && pointsOn.begin()->second == levelSpacing.size())) {
+        return spacing;  // no level, or one throughout: the estimate stands
     }
     const float dominant =
-        std::max_element(estimates.begin(), estimates.end(), [](const auto& a, const auto& b) {
-            return a.second.size() < b.second.size();
+        std::max_element(pointsOn.begin(), pointsOn.end(), [](const auto& a, const auto& b) {
+            return a.second < b.second;
         })->first;
-    std::map<float, float> onLevel;
-    for (auto& [level, values] : estimates) {
-        const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-        std::nth_element(values.begin(), middle, values.end());
-        onLevel[level] = spacing.local.empty() ? std::max(1.0f, level / dominant) : *middle;
-    }
-    if (spacing.local.empty()) {
-        spacing.local.assign(cloud.size(), glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
+    float calibration = 1.0f;
+    if (!spacing.local.empty()) {
+        std::vector<float> estimates;
+        for (std::size_t i = 0; i < cloud.size(); ++i) {
+            if (levelSpacing[i] == dominant) {
+                estimates.push_back(spacing.local[i].w);
+            }
+        }
+        const auto quartile = estimates.begin() + static_cast<std::ptrdiff_t>(estimates.size() / 4);
+        std::nth_element(estimates.begin(), quartile, estimates.end());
+        calibration = *quartile;
+    } else {
+        // No scan lines, spacing h (estimateLocalSpacing's form: the across vector, then w).
+        spacing.local.assign(cloud.size(), glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     }
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-        spacing.local[i].w = std::max(spacing.local[i].w, onLevel[levelSpacing[i]]);
+        spacing.local[i].w = std::max(spacing.local[i].w, calibration * levelSpacing[i] / dominant);
     }
     return spacing;
 }

@@ -56,13 +56,13 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud,
 /// spacing varies, so that no second search is needed.
 PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample);
 /// A streamed view's (LoadedScan::levelSpacing, one per point, or empty: the same as above):
-/// each point's w is at least its level's, the median of the estimates of the points on that
-/// level (without estimates, a cloud above kAlwaysLocalSpacingPoints of even spacing: the
-/// level's spacing over that of the level most points lie on). A coarse level's points lie
-/// that much farther apart whatever their nearest neighbours say: where a finer level's nodes
-/// border on it, its points near the border find neighbours of the finer level, and the
-/// fill's expected gap there was the finer level's (holes along the border,
-/// StreamedSurfaceGLTest). The local spacing is given wherever levels differ.
+/// each point's w is at least its level's spacing over that of the level most points lie on,
+/// times the lower quartile of those points' estimates (1 without estimates, for clouds above
+/// kAlwaysLocalSpacingPoints of even spacing, which then get a local spacing). A coarse level's
+/// points lie that much farther apart whatever their nearest neighbours say: where a finer
+/// level's nodes border on it, its points near the border find neighbours of the finer level,
+/// and the fill's expected gap there was the finer level's (holes along the border,
+/// StreamedSurfaceGLTest). Level spacing 0 sets no minimum.
 PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float> levelSpacing);
 
 }  // namespace subscan

@@ -29,7 +29,8 @@ struct LoadedScan {
     OrganisedGrid grid;                // an organised cloud's grid (empty when unorganised)
     /// A streamed view's points (lod::loadStreamedScan): per point, the spacing of the finest
     /// level of detail the view loaded where it lies (scene units), which its local spacing
-    /// is at least (estimatePointSpacing); empty for a scan loaded whole.
+    /// is at least (estimatePointSpacing); 0 where the survey holds nothing deeper there (the
+    /// scan's own spacing); empty for a scan loaded whole.
     std::vector<float> levelSpacing;
 };
 

@@ -254,7 +254,12 @@ struct CoarserBeside {
 /// gives the spacing. Where a part of the view with a coarser spacing lies within that spacing
 /// of the point, that spacing: the gap between the finer points' last row and the coarser
 /// ones' first is the coarser spacing, which the finer points beside the border must bridge.
-/// (A node that could not be read still counts as loaded: beside it the spacing is too fine.)
+/// Only where the view left out the next level down does the level's spacing hold: where the
+/// survey holds nothing deeper (a node holding every point of its cube, as the indexer leaves
+/// a cube of few points), the points lie at the scan's own spacing, which their estimate
+/// gives, so they get 0 (none) unless a coarser part lies beside them; at a budget that takes
+/// every point, every point. (A node that could not be read still counts as loaded: beside
+/// it the spacing is too fine.)
 std::vector<float> levelSpacingOf(const NodeSource& source, std::span<const std::size_t> nodes,
                                   const PointCloud& cloud) {
     const std::span<const StreamedNode> all = source.nodes();
@@ -301,16 +306,18 @@ std::vector<float> levelSpacingOf(const NodeSource& source, std::span<const std:
     inParallel(cloud.size(), [&](std::size_t i) {
         const glm::dvec3 position = cloud.fileCoordinates(i);
         std::size_t finest = source.find(nodeKeyAt(cube, position, 0));
+        bool cut = false;  // the view left out the next level down here
         for (int level = 1;; ++level) {
             const std::size_t child = source.find(nodeKeyAt(cube, position, level));
             if (child >= all.size() || !loaded[child]) {
+                cut = child < all.size();
                 break;
             }
             finest = child;
         }
-        double own =
-            std::ldexp(cube.rootSpacing, -(finest < all.size() ? all[finest].key.level : 0));
+        double own = 0.0;
         if (finest < all.size()) {
+            own = cut ? std::ldexp(cube.rootSpacing, -all[finest].key.level) : 0.0;
             for (const CoarserBeside& part : coarser[finest]) {
                 const glm::dvec3 outside =
                     glm::max(glm::max(part.min - position, position - part.max), 0.0);

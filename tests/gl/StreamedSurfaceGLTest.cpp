@@ -137,17 +137,14 @@ void checkGrazingView(const lod::NodeSource& source, const GrazingView& view) {
             }
         }
     }
-    constexpr int kBorderMargin = 2;
-    // Checked: the image's border lies more than 4 pixels away (beside it the fill guesses at
-    // the points beyond, which a view does not load: not what this test is about); the truth
-    // covers every pixel within 2 or twice the points' spacing there, whichever is more (a
+    // Checked: the truth covers every pixel within 2 or twice the points' spacing there,
+    // whichever is more, and these lie in the picture (a
     // level keeps a point of each of its cells, anywhere in it, so its outermost points lie up
     // to a spacing inside the true outline, and the outline between them cuts in further);
     // and the plane is no steeper there than the reconstruction keeps.
     const auto checked = [&](int x, int y) {
         const std::size_t i = at(x, y);
-        if (x < kBorderMargin || y < kBorderMargin || x >= width - kBorderMargin ||
-            y >= height - kBorderMargin || levels[i] < 0) {
+        if (levels[i] < 0) {
             return false;
         }
         const int margin = std::max(
@@ -188,14 +185,13 @@ void checkGrazingView(const lod::NodeSource& source, const GrazingView& view) {
                 }
                 ++pairs;
                 // Neighbours may differ by the plane's depths within each pixel (a point's own
-                // depth stands for its pixel, the truth is the centre's) and by the spacing of
-                // the points there, the coarser side's at a node border: the fill between
-                // points lies off the plane by a share of their gap. A seam between levels
-                // (points of one level misplaced, or a level's surface not meeting the next's)
-                // would be a step beyond that.
-                const int coarser = std::min(levels[at(x, y)], levels[at(nx, ny)]);
+                // depth stands for its pixel, the truth is the centre's) and by h, the scan's
+                // spacing (every point lies on the plane; the fill between them, interpolated
+                // in the picture, bends off it by a little). A seam between levels (a level's
+                // points misplaced, or its surface not meeting the next's) would be a step
+                // beyond that.
                 const double step = std::abs(offPlane(x, y) - offPlane(nx, ny));
-                const double allowed = spacingOn(coarser) + truth.depthWithinPixel[at(x, y)] +
+                const double allowed = kGridSpacing + truth.depthWithinPixel[at(x, y)] +
                                        truth.depthWithinPixel[at(nx, ny)];
                 const bool border = levels[at(x, y)] != levels[at(nx, ny)];
                 borders += border;

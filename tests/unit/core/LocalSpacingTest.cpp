@@ -283,12 +283,46 @@ TEST(LocalSpacingTest, AStreamedLevelsPointsTakeAtLeastItsSpacing) {
         EXPECT_GE(byLevel.local[i].w, alone.local[i].w) << i;  // never below the estimate
         EXPECT_EQ(glm::vec3(byLevel.local[i]), glm::vec3(alone.local[i])) << i;  // lines kept
     }
+    // Points at the scan's own spacing (a node holding its whole cube: level spacing 0) keep
+    // their estimate.
+    std::vector<float> withWhole = levelSpacing;
+    withWhole[coarseAtBorder] = 0.0f;
+    EXPECT_EQ(estimatePointSpacing(cloud, withWhole).local[coarseAtBorder],
+              alone.local[coarseAtBorder]);
     // One level, or none given: the estimate alone.
     const std::vector<float> one(cloud.size(), 0.01f);
     EXPECT_EQ(estimatePointSpacing(cloud, one).local, alone.local);
     EXPECT_EQ(estimatePointSpacing(cloud, std::span<const float>{}).local, alone.local);
     EXPECT_THROW(estimatePointSpacing(cloud, std::span(levelSpacing).first(10)),
                  std::invalid_argument);
+}
+
+TEST(LocalSpacingTest, ALargeEvenStreamedViewGetsItsLevelsSpacingWithoutEstimates) {
+    // Above kAlwaysLocalSpacingPoints an even cloud gets no local estimate; a streamed view of
+    // it still needs its levels' spacings: w = the level's spacing over the dominant level's,
+    // no scan lines.
+    constexpr int kSide = 1500;  // 2.25 M points
+    static_assert(kSide * kSide > kAlwaysLocalSpacingPoints);
+    PointCloud cloud;
+    cloud.positions.reserve(kSide * kSide);
+    std::vector<float> levelSpacing;
+    for (int i = 0; i < kSide; ++i) {
+        for (int j = 0; j < kSide; ++j) {
+            cloud.positions.emplace_back(i * 0.01f, j * 0.01f, 0.0f);
+            cloud.bounds.add(glm::dvec3(cloud.positions.back()));
+            levelSpacing.push_back(i < kSide / 2 ? 0.01f : i < kSide - 10 ? 0.04f : 0.0f);
+        }
+    }
+    ASSERT_TRUE(estimatePointSpacing(cloud).local.empty());
+    const PointSpacing spacing = estimatePointSpacing(cloud, levelSpacing);
+    ASSERT_EQ(spacing.local.size(), cloud.size());
+    for (const std::size_t i :
+         {std::size_t{0}, std::size_t{kSide} * (kSide / 2) + 3, cloud.size() - 1}) {
+        EXPECT_EQ(glm::vec3(spacing.local[i]), glm::vec3(0.0f)) << i;
+    }
+    EXPECT_EQ(spacing.local[0].w, 1.0f);                                     // the dominant level
+    EXPECT_EQ(spacing.local[std::size_t{kSide} * (kSide / 2) + 3].w, 4.0f);  // 4 times sparser
+    EXPECT_EQ(spacing.local.back().w, 1.0f);  // the scan's own spacing: no minimum
 }
 
 TEST(LocalSpacingTest, DegenerateCloudsKeepTheGlobalSpacing) {
