@@ -49,6 +49,11 @@ class CloudData {
     /// Camera.sensor; empty for clouds made from arrays.
     std::optional<SensorPose> sensor;
     OrganisedGrid grid;
+    /// A streamed survey's view or overview (subscan.load with lod): each point's
+    /// LoadedScan::levelSpacing, which the local spacing takes (set before any Renderer), and
+    /// normals as `render` gives a streamed view (streamedNormals).
+    bool streamed = false;
+    std::vector<float> levelSpacing;
 
   private:
     PointCloud cloud_;

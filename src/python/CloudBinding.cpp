@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -18,6 +19,8 @@
 #include "core/NormalEstimation.h"
 #include "core/Spacing.h"
 #include "io/ScanLoader.h"
+#include "lod/NodeSelection.h"
+#include "lod/NodeSource.h"
 #include "python/Bindings.h"
 #include "render/Renderer.h"
 
@@ -33,14 +36,17 @@ double CloudData::spacing() const {
 const PointSpacing& CloudData::pointSpacing() const {
     std::call_once(pointSpacingOnce_, [this] {
         spacing();
-        pointSpacing_ = estimatePointSpacing(cloud_, sample_);
+        pointSpacing_ = levelSpacing.empty() ? estimatePointSpacing(cloud_, sample_)
+                                             : estimatePointSpacing(cloud_, levelSpacing);
     });
     return pointSpacing_;
 }
 
 const std::vector<glm::vec3>& CloudData::estimatedNormals() const {
-    std::call_once(normalsOnce_,
-                   [this] { estimatedNormals_ = normalsFor(cloud_, NormalSource::Auto); });
+    std::call_once(normalsOnce_, [this] {
+        estimatedNormals_ =
+            normalsFor(cloud_, streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto);
+    });
     return estimatedNormals_;
 }
 
@@ -651,17 +657,36 @@ py::object toOpen3d(const CloudHandle& data, const py::object& self) {
     return pcd;
 }
 
-CloudHandle load(const py::handle& pathObject) {
+CloudHandle load(const py::handle& pathObject, const std::string& lod,
+                 const std::optional<Camera>& camera, std::uint64_t pointBudget) {
     const std::string source = pathArgument(pathObject);
+    lod::LodMode mode;
+    try {
+        mode = lod::parseLodMode(lod);
+    } catch (const Error& error) {
+        throw py::value_error(error.what());
+    }
     LoadedScan scan;
+    bool streamed = false;
     {
         const py::gil_scoped_release release;
-        scan = loadScan(source);
+        const std::unique_ptr<lod::NodeSource> survey = lod::openStreamed(source, mode);
+        if (survey) {
+            streamed = true;
+            scan = camera ? lod::loadStreamedScan(
+                                *survey, lod::selectNodes(*survey, *camera,
+                                                          lod::pointBudgetFor(pointBudget, true)))
+                          : lod::loadStreamedOverview(*survey);
+        } else {
+            scan = loadScan(source);
+        }
     }
     warnAll(source, scan.warnings);
     auto cloud = std::make_shared<CloudData>(std::move(scan.cloud), scan.format);
     cloud->sensor = std::move(scan.sensor);
     cloud->grid = std::move(scan.grid);
+    cloud->streamed = streamed;
+    cloud->levelSpacing = std::move(scan.levelSpacing);
     return cloud;
 }
 
@@ -829,11 +854,18 @@ cloud = cloud.estimate_normals().)doc")
                                attributes);
         });
 
-    module.def("load", &load, py::arg("path"), R"doc(
+    module.def("load", &load, py::arg("path"), py::arg("lod") = "off",
+               py::arg("camera") = py::none(), py::arg("point_budget") = 0, R"doc(
 Loads a scan: a file in any format subscan reads (PLY, LAS, LAZ, COPC, E57, PCD, XYZ/PTS/CSV,
 OFF), or 'synthetic:NAME[?points=N][&noise=X]' (sphere, torus, box-with-hole, sculpture).
 The reader's warnings (e.g. dropped NaN points) become Python warnings. Raises subscan.Error
 with the CLI's sentence when the file cannot be read. Runs without the GIL.
+
+lod="auto" or "on" streams a COPC file or an EPT dataset (an ept.json or its folder) as
+`subscan render` does: with `camera`, the octree nodes that view shows within `point_budget`
+points (0: 1,000,000, the software renderer's default); without, the survey's top levels
+(about 200,000 points, to frame a Camera by). "auto" loads other files whole, "on" refuses
+them; "off" (the default) loads every file whole.
 )doc");
 }
 

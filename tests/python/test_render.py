@@ -353,3 +353,32 @@ def test_bad_colourings_raise(torus, keywords, message):
 def test_a_colouring_the_cloud_cannot_give_raises(torus, scans_of_each_kind):
     with pytest.raises(subscan.Error, match="the scan has no intensities to show"):
         subscan.Renderer(subscan.load(scans_of_each_kind["plain"]), color="intensity")
+
+
+def test_a_streamed_view_is_the_one_render_streams(cli, tmp_path, data_dir):
+    """subscan.load(..., lod="auto", camera=...) loads the octree nodes `subscan render`
+    streams for that view within the budget, with their levels' spacing: the same picture."""
+    path = data_dir / "lone_star.copc.laz"
+    whole = len(subscan.load(path))  # lod="off", the default: every point
+    overview = subscan.load(path, lod="auto")
+    assert 0 < len(overview) < whole
+    camera = subscan.Camera.orbit(overview, yaw=30, pitch=35, width=160, height=120)
+    view = subscan.load(path, lod="auto", camera=camera, point_budget=100_000)
+    assert 10_000 < len(view) <= 100_000
+    camera.save(tmp_path / "camera.json")
+    cli("render", path, "-o", tmp_path / "cli.png", "--camera", tmp_path / "camera.json",
+        "--mode", "surface", "--point-budget", 100_000)
+    with subscan.Renderer(view) as renderer:
+        image = renderer.render(camera, mode="surface")
+    np.testing.assert_array_equal(image, read_png(tmp_path / "cli.png")[:, :, :3])
+    assert (image != image[0, 0]).any(axis=2).mean() > 0.1  # a picture, not a blank
+    # A larger budget loads more of the nodes the view shows (not all: at 160x120 the deepest
+    # add no detail).
+    assert len(view) < len(subscan.load(path, lod="on", camera=camera, point_budget=whole)) < whole
+    # What cannot be streamed: "on" refuses it, "auto" loads it whole; a bad mode is refused.
+    ply = data_dir / "bun_zipper_res4.ply"
+    with pytest.raises(subscan.Error):
+        subscan.load(ply, lod="on")
+    assert len(subscan.load(ply, lod="auto")) == len(subscan.load(ply))
+    with pytest.raises(ValueError):
+        subscan.load(path, lod="sometimes")
