@@ -71,10 +71,17 @@ double pixelsPerUnit(const Camera& camera, double distance) {
 
 std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& camera,
                                      std::uint64_t pointBudget) {
+    return selectNodes(source, std::span(&camera, 1), pointBudget);
+}
+
+std::vector<std::size_t> selectNodes(const NodeSource& source, std::span<const Camera> cameras,
+                                     std::uint64_t pointBudget) {
     const OctreeCube& cube = source.info().cube;
     const std::span<const StreamedNode> nodes = source.nodes();
-    const std::array<glm::dvec4, 6> planes = viewPlanes(camera);
-    const glm::dvec3 eye = camera.eye();
+    std::vector<std::array<glm::dvec4, 6>> planes;
+    for (const Camera& camera : cameras) {
+        planes.push_back(viewPlanes(camera));
+    }
     struct Candidate {
         double pixels;
         std::size_t index;
@@ -84,16 +91,24 @@ std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& cam
             return pixels != other.pixels ? pixels < other.pixels : index > other.index;
         }
     };
+    // A node's size is the largest any view shows it at.
     const auto candidate = [&](std::size_t index) -> std::optional<Candidate> {
         const Sphere sphere = boundingSphere(cube, nodes[index].key);
-        if (!inView(planes, sphere)) {
-            return std::nullopt;
+        std::optional<Candidate> largest;
+        for (std::size_t view = 0; view < cameras.size(); ++view) {
+            const Camera& camera = cameras[view];
+            if (!inView(planes[view], sphere)) {
+                continue;
+            }
+            const bool holdsEye = glm::length(sphere.centre - camera.eye()) <= sphere.radius;
+            const double pixels =
+                holdsEye ? std::numeric_limits<double>::infinity()
+                         : sphere.radius * pixelsPerUnit(camera, nearestDistance(camera, sphere));
+            if (!largest || pixels > largest->pixels) {
+                largest = Candidate{pixels, index};
+            }
         }
-        const bool holdsEye = glm::length(sphere.centre - eye) <= sphere.radius;
-        const double pixels =
-            holdsEye ? std::numeric_limits<double>::infinity()
-                     : sphere.radius * pixelsPerUnit(camera, nearestDistance(camera, sphere));
-        return Candidate{pixels, index};
+        return largest;
     };
 
     std::vector<std::size_t> selected{0};  // the root, whatever the budget
@@ -111,8 +126,10 @@ std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& cam
                 continue;
             }
             const Sphere sphere = boundingSphere(cube, child);
-            if (spacing * pixelsPerUnit(camera, nearestDistance(camera, sphere)) <
-                kFinestParentSpacingPixels) {
+            if (std::none_of(cameras.begin(), cameras.end(), [&](const Camera& camera) {
+                    return spacing * pixelsPerUnit(camera, nearestDistance(camera, sphere)) >=
+                           kFinestParentSpacingPixels;
+                })) {
                 continue;
             }
             if (const std::optional<Candidate> next = candidate(index)) {

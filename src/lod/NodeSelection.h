@@ -39,6 +39,11 @@ inline std::uint64_t pointBudgetFor(std::uint64_t requested, bool software) {
 /// Indices into source.nodes().
 std::vector<std::size_t> selectNodes(const NodeSource& source, const Camera& camera,
                                      std::uint64_t pointBudget);
+/// The same for several views at once (a turntable's frames): a node is in view where any
+/// view shows it, as large as the largest view shows it, and its children add detail where
+/// they do in any view. One set for every view, so that nothing pops from frame to frame.
+std::vector<std::size_t> selectNodes(const NodeSource& source, std::span<const Camera> cameras,
+                                     std::uint64_t pointBudget);
 
 /// The nodes of the levels from the root down, while they hold at most `points` in all (at
 /// least the root): a view-independent sample of the whole survey, to frame it by.

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -53,6 +54,18 @@ PointCloud planePoints() {
     return cloud;
 }
 
+/// A 320x240 camera at `eye` looking along `direction`, Y up.
+Camera lookingFrom(const glm::dvec3& eye, const glm::dvec3& direction, double fovyDegrees) {
+    Camera camera;
+    camera.width = 320;
+    camera.height = 240;
+    camera.fovyDegrees = fovyDegrees;
+    camera.nearPlane = 0.1;
+    camera.farPlane = 500.0;
+    camera.view = glm::lookAt(eye, eye + direction, glm::dvec3(0.0, 1.0, 0.0));
+    return camera;
+}
+
 /// A view from above the plane's near edge along it, and the budget that makes its levels.
 struct GrazingView {
     const char* what;
@@ -74,16 +87,10 @@ constexpr GrazingView kViews[] = {
 /// Renders `view` of the plane streamed from `source` within its budget and checks that the
 /// surface has no hole and no step where the levels meet.
 void checkGrazingView(const lod::NodeSource& source, const GrazingView& view) {
-    Camera camera;
-    camera.width = 320;
-    camera.height = 240;
-    camera.fovyDegrees = view.fovyDegrees;
-    camera.nearPlane = 0.1;
-    camera.farPlane = 500.0;
-    const glm::dvec3 eye(0.0, view.heightMetres, kHalfExtent - 1.0);
     const double pitch = view.pitchDegrees * std::numbers::pi / 180.0;
-    camera.view = glm::lookAt(eye, eye + glm::dvec3(0.0, -std::sin(pitch), -std::cos(pitch)),
-                              glm::dvec3(0.0, 1.0, 0.0));
+    const Camera camera =
+        lookingFrom(glm::dvec3(0.0, view.heightMetres, kHalfExtent - 1.0),
+                    glm::dvec3(0.0, -std::sin(pitch), -std::cos(pitch)), view.fovyDegrees);
 
     const std::vector<std::size_t> nodes = lod::selectNodes(source, camera, view.budget);
     const LoadedScan scan = lod::loadStreamedScan(source, nodes);
@@ -220,19 +227,62 @@ void checkGrazingView(const lod::NodeSource& source, const GrazingView& view) {
                         << " of what is allowed";
 }
 
-TEST(StreamedSurfaceGLTest, AGrazingPlaneIsOneSurfaceAcrossItsLevelsOfDetail) {
-    const PointCloud points = planePoints();
-    const TemporaryFolder folder(std::filesystem::temp_directory_path(), "subscan-test");
-    lod::IndexSettings index;
-    index.temporaryDirectory = folder.path();
-    lod::writeCopc(*cloudRecordSource(points, "the plane"), folder.path() / "plane.copc.laz",
-                   index);
-    const std::unique_ptr<lod::NodeSource> source = lod::openCopc(folder.path() / "plane.copc.laz");
+/// The plane indexed into a COPC file once for the tests of this file (gtest's suite set-up:
+/// a second of indexing, not two).
+class StreamedSurfaceGLTest : public ::testing::Test {
+  protected:
+    static void SetUpTestSuite() {
+        folder_ = std::make_unique<TemporaryFolder>(std::filesystem::temp_directory_path(),
+                                                    "subscan-test");
+        lod::IndexSettings index;
+        index.temporaryDirectory = folder_->path();
+        lod::writeCopc(*cloudRecordSource(planePoints(), "the plane"),
+                       folder_->path() / "plane.copc.laz", index);
+        source_ = lod::openCopc(folder_->path() / "plane.copc.laz");
+    }
+    static void TearDownTestSuite() {
+        source_.reset();  // closed before its folder goes
+        folder_.reset();
+    }
+    static inline std::unique_ptr<TemporaryFolder> folder_;
+    static inline std::unique_ptr<lod::NodeSource> source_;
+};
 
+TEST_F(StreamedSurfaceGLTest, AGrazingPlaneIsOneSurfaceAcrossItsLevelsOfDetail) {
     for (const GrazingView& view : kViews) {
         SCOPED_TRACE(view.what);
-        checkGrazingView(*source, view);
+        checkGrazingView(*source_, view);
     }
+}
+
+TEST_F(StreamedSurfaceGLTest, SeveralViewsTakeEveryNodeEachOfThemTakes) {
+    // A turntable's selection (no GL): from the plane's middle, 6 m up, looking out four ways.
+    // One set for all the views holds each view's own nodes where the budget allows, and
+    // keeps to the budget where it does not.
+    std::vector<Camera> cameras;
+    for (int turn = 0; turn < 4; ++turn) {
+        const double yaw = turn * std::numbers::pi / 2.0;
+        cameras.push_back(lookingFrom(glm::dvec3(0.0, 6.0, 0.0),
+                                      glm::dvec3(std::sin(yaw), -0.4, std::cos(yaw)), 60.0));
+    }
+    const std::uint64_t every = source_->info().points;
+    const std::vector<std::size_t> all = lod::selectNodes(*source_, cameras, every);
+    std::size_t largestSingle = 0;
+    for (const Camera& camera : cameras) {
+        const std::vector<std::size_t> single = lod::selectNodes(*source_, camera, every);
+        largestSingle = std::max(largestSingle, single.size());
+        for (const std::size_t node : single) {
+            EXPECT_NE(std::find(all.begin(), all.end(), node), all.end()) << "node " << node;
+        }
+    }
+    EXPECT_GT(all.size(), largestSingle);  // the views differ: the union is larger
+    EXPECT_EQ(lod::selectNodes(*source_, std::span(cameras).first(1), 70'000),
+              lod::selectNodes(*source_, cameras[0], 70'000));
+    std::uint64_t taken = 0;
+    for (const std::size_t node : lod::selectNodes(*source_, cameras, 70'000)) {
+        taken += source_->nodes()[node].pointCount;
+    }
+    EXPECT_LE(taken, 70'000u);
 }
 
 }  // namespace

@@ -5,11 +5,14 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <vector>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "io/Image.h"
 #include "support/TestSupport.h"
 
 namespace subscan {
@@ -114,6 +117,55 @@ TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
         ++entries;
     }
     EXPECT_EQ(entries, 1);
+}
+
+TEST(TurntableCommandGLTest, TurnsAStreamedSurveyWithinItsBudget) {
+    // The lone star's COPC file streamed: one set of nodes for every frame within the budget;
+    // each frame shows the survey. --lod off loads it whole instead, and what cannot be
+    // streamed is refused under --lod on.
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const test::TempDir folder;
+    const std::string copc = (data / "lone_star.copc.laz").string();
+    const auto turn = [&](const std::string& name, const std::vector<std::string>& extra) {
+        std::vector<std::string> arguments{"turntable", copc,
+                                           "--mode",    "surface",
+                                           "--frames",  "3",
+                                           "--width",   "96",
+                                           "--height",  "72",
+                                           "--warmup",  "1",
+                                           "-o",        (folder / name).string()};
+        arguments.insert(arguments.end(), extra.begin(), extra.end());
+        const test::CommandResult result = runSubscan(arguments);
+        EXPECT_EQ(result.exitCode, 0) << result.err;
+        std::vector<Image8> frames;
+        for (int index = 0; index < 3; ++index) {
+            frames.push_back(readPng(folder / name / fmt::format("{:04}.png", index)));
+        }
+        return frames;
+    };
+    const std::vector<Image8> streamed = turn("streamed", {"--point-budget", "50000"});
+    const std::vector<Image8> whole = turn("whole", {"--lod", "off"});
+    for (int index = 0; index < 3; ++index) {
+        const Image8& frame = streamed[static_cast<std::size_t>(index)];
+        const Image8& reference = whole[static_cast<std::size_t>(index)];
+        std::size_t covered = 0, coveredWhole = 0;
+        for (std::size_t i = 0; i < frame.pixels.size(); i += 4) {
+            covered += frame.pixels[i] != frame.pixels[0] || frame.pixels[i + 1] != frame.pixels[1];
+            coveredWhole += reference.pixels[i] != reference.pixels[0] ||
+                            reference.pixels[i + 1] != reference.pixels[1];
+        }
+        // The same survey from the same cameras (it covers 9 % of these small frames): a
+        // surface as large as the whole file's, a tenth of the points closing into it.
+        EXPECT_GT(coveredWhole, frame.pixels.size() / 4 / 20) << index;
+        EXPECT_NEAR(static_cast<double>(covered), static_cast<double>(coveredWhole),
+                    0.1 * static_cast<double>(coveredWhole))
+            << index;
+    }
+    const test::CommandResult refused =
+        runSubscan({"turntable", (data / "bun_zipper_res4.ply").string(), "--lod", "on", "--frames",
+                    "2", "-o", (folder / "refused").string()});
+    EXPECT_NE(refused.exitCode, 0);
+    EXPECT_THAT(refused.err, ::testing::HasSubstr("bun_zipper_res4.ply"));
 }
 
 TEST(TurntableCommandGLTest, RefusesWhatItCannotDoWithOneSentence) {

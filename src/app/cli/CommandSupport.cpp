@@ -29,9 +29,9 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
-LoadedScan loadStreamedView(const lod::NodeSource& source, const Camera& camera,
+LoadedScan loadStreamedView(const lod::NodeSource& source, std::span<const Camera> cameras,
                             std::uint64_t pointBudget) {
-    LoadedScan scan = lod::loadStreamedScan(source, lod::selectNodes(source, camera, pointBudget));
+    LoadedScan scan = lod::loadStreamedScan(source, lod::selectNodes(source, cameras, pointBudget));
     for (const std::string& warning : scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", source.info().name, warning);
     }

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -23,10 +24,10 @@ LoadedScan loadScanForCommand(std::string_view source);
 /// loadScanForCommand prints a reader's.
 void printSourceWarnings(const PointRecordSourceInfo& info);
 
-/// The nodes `camera` shows within `pointBudget` (lod::selectNodes), loaded on every core, with
+/// The nodes `cameras` show within `pointBudget` (lod::selectNodes), loaded on every core, with
 /// the whole survey's bounds (so that colouring by height does not depend on the budget).
 /// Prints a warning for each node left out.
-LoadedScan loadStreamedView(const lod::NodeSource& source, const Camera& camera,
+LoadedScan loadStreamedView(const lod::NodeSource& source, std::span<const Camera> cameras,
                             std::uint64_t pointBudget);
 
 /// Whether `a` and `b` are the same existing file, also through another spelling of the path or

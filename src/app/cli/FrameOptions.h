@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -42,6 +43,8 @@ struct FrameOptions {
     std::string color = "auto";  // Coloring
     bool verbose = false;
     bool software = false;
+    std::optional<std::string> lod;               // unset: the settings' (streaming.lod)
+    std::optional<std::uint64_t> pointBudget;     // unset: the settings' (streaming.point_budget)
     RenderMode defaultMode = RenderMode::Points;  // set by add()
 
     /// The options on `command`; `modeByDefault` is the mode where neither --mode nor the

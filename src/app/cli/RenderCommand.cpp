@@ -35,8 +35,6 @@ struct RenderOptions {
     std::string exportDirectory;
     std::optional<int> samples;  // unset: 1, or kTemporalRestFrames with the filter on
     bool timings = false;
-    std::optional<std::string> lod;            // unset: the settings' (streaming.lod)
-    std::optional<std::uint64_t> pointBudget;  // unset: the settings' (streaming.point_budget)
 };
 
 /// Per-pass median over `timed` frames after one warm-up (llvmpipe compiles shaders lazily and
@@ -111,12 +109,6 @@ int runRender(const RenderOptions& options) {
             std::filesystem::path(options.exportDirectory) / "camera.json", "the camera");
     }
     RenderSettings settings = frame.settings();
-    if (options.lod) {
-        settings.streaming.lod = lod::parseLodMode(*options.lod);
-    }
-    if (options.pointBudget) {
-        settings.streaming.pointBudget = *options.pointBudget;
-    }
     const RasterSettings& raster = settings.raster;
     // The filter on without --samples: its picture at rest, as the viewer shows it.
     const int samples =
@@ -146,7 +138,7 @@ int runRender(const RenderOptions& options) {
         camera = frame.camera(lod::loadStreamedOverview(*streamed));
         const std::uint64_t budget =
             lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software);
-        scan = loadStreamedView(*streamed, camera, budget);
+        scan = loadStreamedView(*streamed, std::span(&camera, 1), budget);
     } else {
         scan = loadScanForCommand(frame.source);
         camera = frame.camera(scan);
@@ -218,17 +210,6 @@ Command addRenderCommand(CLI::App& parent) {
                      "settings turn the filter on)")
         ->check(CLI::Range(1, 2048));
     render->add_flag("--timings", options->timings, "Print per-pass milliseconds");
-    render
-        ->add_option("--lod", options->lod,
-                     "Levels of detail: auto (stream COPC files and EPT datasets, load the rest "
-                     "whole), on (stream, or refuse), off (load every file whole)")
-        ->check(CLI::IsMember({"auto", "on", "off"}));
-    render
-        ->add_option("--point-budget", options->pointBudget,
-                     fmt::format("Most points a streamed view loads (default {} on software "
-                                 "rendering, {} on a GPU)",
-                                 lod::kSoftwarePointBudget, lod::kHardwarePointBudget))
-        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
     return {render, [options] { return runRender(*options); }};
 }
 

@@ -20,6 +20,7 @@
 #include "app/cli/FrameOptions.h"
 #include "core/Error.h"
 #include "io/Image.h"
+#include "lod/NodeSelection.h"
 #include "render/Renderer.h"
 
 extern char** environ;
@@ -138,8 +139,13 @@ int runTurntable(const TurntableOptions& options) {
     settings.temporal.enabled = true;
     const bool filtered = filtersTemporally(settings);
 
-    LoadedScan scan = loadScanForCommand(frame.source);
-    frame.applyColoring(scan);
+    const std::unique_ptr<GlContext> context = frame.context();
+    // A streamed survey is framed by its top levels; then one set of nodes for every frame
+    // (the ones any frame shows, within the budget), so that nothing pops as it turns.
+    const std::unique_ptr<lod::NodeSource> streamed =
+        lod::openStreamed(frame.source, settings.streaming.lod);
+    LoadedScan scan =
+        streamed ? lod::loadStreamedOverview(*streamed) : loadScanForCommand(frame.source);
     // The bounding sphere frames every yaw alike; the box's fit holds for the first one only.
     const Camera first = frame.camera(scan, Framing::Sphere);
     // Each frame turns the scene about the up axis through the bounds' middle: the eye's yaw
@@ -156,11 +162,21 @@ int runTurntable(const TurntableOptions& options) {
         return camera;
     };
 
-    const std::unique_ptr<GlContext> context = frame.context();
+    if (streamed) {
+        std::vector<Camera> cameras;
+        for (int index = 0; index < options.frames; ++index) {
+            cameras.push_back(cameraAt(index));
+        }
+        scan = loadStreamedView(
+            *streamed, cameras,
+            lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software));
+    }
+    frame.applyColoring(scan);
     // `scan` outlives the renderer unchanged: the GPU may read its points in place.
-    Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud), 0,
+    Renderer renderer(*context, scan.cloud, estimatePointSpacing(scan.cloud, scan.levelSpacing), 0,
                       PointMemory::Borrow);
-    renderer.prepareNormals(scan.cloud, settings.surface.normals);
+    renderer.prepareNormals(scan.cloud, streamed ? streamedNormals(settings.surface.normals)
+                                                 : settings.surface.normals);
     std::optional<FrameFolder> temporary;
     std::filesystem::path folder = output;
     if (video) {
