@@ -1,7 +1,9 @@
 // `subscan bench` on llvmpipe: a smoke test of its JSON with few frames at a small size.
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -226,6 +228,28 @@ TEST(BenchCommandGLTest, RunsWithLightMapsReportWhatBuildingThemCosts) {
     // Memory counts the maps and the images they are built in.
     EXPECT_GT(shadowed["gpu_memory_mb"].get<double>(),
               report["modes"]["surface:no-shadows"]["gpu_memory_mb"].get<double>());
+}
+
+TEST(BenchCommandGLTest, BenchesAStreamedSurveyWithinItsBudget) {
+    // The lone star's COPC file streamed: one set of nodes for the whole path, within the
+    // budget (--point-budget), the rest of the survey left out; --lod off loads every point.
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    const std::string copc = (data / "lone_star.copc.laz").string();
+    const auto points = [&](const std::vector<std::string>& extra) {
+        std::vector<std::string> arguments{"bench",   copc,      "--frames", "3",        "--warmup",
+                                           "0",       "--width", "96",       "--height", "72",
+                                           "--modes", "surface", "--json"};
+        arguments.insert(arguments.end(), extra.begin(), extra.end());
+        const test::CommandResult result = runSubscan(arguments);
+        EXPECT_EQ(result.exitCode, 0) << result.err;
+        const nlohmann::json report = nlohmann::json::parse(result.out);
+        EXPECT_GT(report["modes"]["surface"]["avg_fps"].get<double>(), 0.0);
+        return report["points"].get<std::uint64_t>();
+    };
+    const std::uint64_t streamed = points({"--point-budget", "150000"});
+    EXPECT_GT(streamed, 50'000u);
+    EXPECT_LE(streamed, 150'000u);
+    EXPECT_EQ(points({"--lod", "off"}), 518'862u);  // every point of the file
 }
 
 TEST(BenchCommandGLTest, UnknownModeIsOneSentence) {

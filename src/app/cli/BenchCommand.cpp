@@ -7,6 +7,7 @@
 #include <numeric>
 #include <optional>
 #include <set>
+#include <span>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -22,6 +23,8 @@
 #include "core/CameraPath.h"
 #include "core/Error.h"
 #include "gpu/GlContext.h"
+#include "lod/NodeSelection.h"
+#include "lod/NodeSource.h"
 #include "render/Renderer.h"
 
 namespace subscan::cli {
@@ -44,6 +47,7 @@ struct BenchOptions {
     CLI::Option* heightOption = nullptr;
     bool json = false;
     bool software = false;
+    StreamingOptions streaming;
 };
 
 /// One entry of --modes: a render mode, then optional suffixes after ':' — `sss:METHOD` the
@@ -227,6 +231,12 @@ nlohmann::json summary(const ModeRun& run, std::size_t points) {
     return result;
 }
 
+/// Frame `frame` of the benchmark's camera path around `bounds`.
+Camera pathCamera(const Bounds& bounds, const BenchOptions& options, UpAxis up, int frame) {
+    const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
+    return cameraForPose(bounds, benchmarkPose(t), up, options.width, options.height, 45.0);
+}
+
 /// Every mode along the same camera path, frame by frame in turn (frame 0 of each mode, then
 /// frame 1, ...): a machine whose speed drifts over minutes (a shared virtual machine, a GPU
 /// warming up) then slows every mode alike instead of whichever ran last.
@@ -236,17 +246,15 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
                                        const BenchOptions& options, UpAxis up,
                                        const std::optional<Camera>& still) {
     auto cameraAt = [&](int frame) {
-        if (still) {
-            return *still;
-        }
-        const double t = options.frames > 1 ? double(frame) / (options.frames - 1) : 0.0;
-        return cameraForPose(scan.cloud.bounds, benchmarkPose(t), up, options.width, options.height,
-                             45.0);
+        return still ? *still : pathCamera(scan.cloud.bounds, options, up, frame);
     };
     std::vector<std::unique_ptr<ModeRun>> runs;
-    // Once for every mode's renderer.
-    const PointSpacing spacing = estimatePointSpacing(scan.cloud);
-    const std::vector<glm::vec3> normals = normalsFor(scan.cloud, settings.surface.normals);
+    // Once for every mode's renderer; a streamed survey's as `render` makes them.
+    const bool streamed = !scan.levelSpacing.empty();
+    const PointSpacing spacing = estimatePointSpacing(scan.cloud, scan.levelSpacing);
+    const std::vector<glm::vec3> normals =
+        normalsFor(scan.cloud,
+                   streamed ? streamedNormals(settings.surface.normals) : settings.surface.normals);
     for (const BenchMode& mode : modes) {
         runs.push_back(
             std::make_unique<ModeRun>(context, scan.cloud, spacing, normals, settings, mode));
@@ -295,11 +303,27 @@ int runBench(const BenchOptions& options) {
     if (!options.resolution.empty()) {
         settings.raster.resolution = parseResolution(options.resolution);
     }
-    const LoadedScan scan = loadScanForCommand(options.source);
-    const UpAxis up = upAxisFor(options.up, scan.format);
+    options.streaming.apply(settings.streaming);
     HeadlessContextOptions contextOptions;
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();
+    const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
+    // A streamed survey: its top levels give the path's bounds (the whole survey's), then one
+    // set of nodes for every frame of the path within the budget, as turntable loads them.
+    const std::unique_ptr<lod::NodeSource> streamed =
+        lod::openStreamed(options.source, settings.streaming.lod);
+    LoadedScan scan =
+        streamed ? lod::loadStreamedOverview(*streamed) : loadScanForCommand(options.source);
+    const UpAxis up = upAxisFor(options.up, scan.format);
+    if (streamed && !options.sensorView.wanted()) {
+        std::vector<Camera> cameras;
+        for (int frame = 0; frame < options.frames; ++frame) {
+            cameras.push_back(pathCamera(scan.cloud.bounds, options, up, frame));
+        }
+        scan = loadStreamedView(
+            *streamed, cameras,
+            lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software));
+    }
     // --view sensor: every frame from the sensor, a still camera instead of the path.
     std::optional<Camera> still;
     if (options.sensorView.wanted()) {
@@ -307,9 +331,13 @@ int runBench(const BenchOptions& options) {
             scan, options.source, up, options.width, options.height,
             options.widthOption->count() > 0 || options.heightOption->count() > 0, 45.0);
     }
+    if (streamed && still) {
+        scan = loadStreamedView(
+            *streamed, std::span(&*still, 1),
+            lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software));
+    }
     const int width = still ? still->width : options.width;
     const int height = still ? still->height : options.height;
-    const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
 
     nlohmann::json report = {
         {"renderer", context->capabilities().renderer},
@@ -387,6 +415,7 @@ Command addBenchCommand(CLI::App& parent) {
     options->sensorView.add(*bench);
     options->scattering.add(*bench);
     bench->add_flag("--json", options->json, "Print the results as JSON");
+    options->streaming.add(*bench);
     bench->add_flag("--software", options->software,
                     "Use Mesa's software rasterizer even when a GPU exists");
     return {bench, [options] { return runBench(*options); }};

@@ -29,6 +29,29 @@ LoadedScan loadScanForCommand(std::string_view source) {
     return scan;
 }
 
+void StreamingOptions::add(CLI::App& command) {
+    command
+        .add_option("--lod", lod,
+                    "Levels of detail: auto (stream COPC files and EPT datasets, load the rest "
+                    "whole), on (stream, or refuse), off (load every file whole)")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
+    command
+        .add_option("--point-budget", pointBudget,
+                    fmt::format("Most points a streamed view loads (default {} on software "
+                                "rendering, {} on a GPU)",
+                                lod::kSoftwarePointBudget, lod::kHardwarePointBudget))
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
+}
+
+void StreamingOptions::apply(StreamingSettings& settings) const {
+    if (lod) {
+        settings.lod = lod::parseLodMode(*lod);
+    }
+    if (pointBudget) {
+        settings.pointBudget = *pointBudget;
+    }
+}
+
 LoadedScan loadStreamedView(const lod::NodeSource& source, std::span<const Camera> cameras,
                             std::uint64_t pointBudget) {
     LoadedScan scan = lod::loadStreamedScan(source, lod::selectNodes(source, cameras, pointBudget));

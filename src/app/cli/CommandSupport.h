@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <span>
@@ -12,6 +13,7 @@
 #include "io/PointRecordSource.h"
 #include "io/ScanLoader.h"
 #include "lod/NodeSource.h"
+#include "render/RenderSettings.h"
 #include "render/ScatteringSettings.h"
 
 namespace subscan::cli {
@@ -23,6 +25,16 @@ LoadedScan loadScanForCommand(std::string_view source);
 /// A record source's warnings (io/PointRecordSource.h) as "subscan: warning: ..." lines, as
 /// loadScanForCommand prints a reader's.
 void printSourceWarnings(const PointRecordSourceInfo& info);
+
+/// --lod and --point-budget, as render, turntable and bench take them.
+struct StreamingOptions {
+    std::optional<std::string> lod;            // unset: the settings' (streaming.lod)
+    std::optional<std::uint64_t> pointBudget;  // unset: the settings' (streaming.point_budget)
+
+    void add(CLI::App& command);
+    /// The options given, written over `settings`; throws subscan::Error for a bad mode.
+    void apply(StreamingSettings& settings) const;
+};
 
 /// The nodes `cameras` show within `pointBudget` (lod::selectNodes), loaded on every core, with
 /// the whole survey's bounds (so that colouring by height does not depend on the budget).

@@ -6,7 +6,6 @@
 #include "core/Coloring.h"
 #include "core/Error.h"
 #include "io/CameraJson.h"
-#include "lod/NodeSelection.h"
 
 namespace subscan::cli {
 
@@ -85,17 +84,7 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
     command.add_flag("-v,--verbose", verbose, "Print the OpenGL renderer");
     command.add_flag("--software", software,
                      "Use Mesa's software rasterizer even when a GPU exists");
-    command
-        .add_option("--lod", lod,
-                    "Levels of detail: auto (stream COPC files and EPT datasets, load the rest "
-                    "whole), on (stream, or refuse), off (load every file whole)")
-        ->check(CLI::IsMember({"auto", "on", "off"}));
-    command
-        .add_option("--point-budget", pointBudget,
-                    fmt::format("Most points a streamed view loads (default {} on software "
-                                "rendering, {} on a GPU)",
-                                lod::kSoftwarePointBudget, lod::kHardwarePointBudget))
-        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
+    streaming.add(command);
 }
 
 RenderSettings FrameOptions::settings() const {
@@ -125,12 +114,7 @@ RenderSettings FrameOptions::settings() const {
         rasterSettings.backgroundSrgb = parseBackground(background);
     }
     scattering.apply(settings.scattering);
-    if (lod) {
-        settings.streaming.lod = lod::parseLodMode(*lod);
-    }
-    if (pointBudget) {
-        settings.streaming.pointBudget = *pointBudget;
-    }
+    streaming.apply(settings.streaming);
     return settings;
 }
 

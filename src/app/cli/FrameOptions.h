@@ -1,6 +1,5 @@
 #pragma once
 
-#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -43,8 +42,7 @@ struct FrameOptions {
     std::string color = "auto";  // Coloring
     bool verbose = false;
     bool software = false;
-    std::optional<std::string> lod;               // unset: the settings' (streaming.lod)
-    std::optional<std::uint64_t> pointBudget;     // unset: the settings' (streaming.point_budget)
+    StreamingOptions streaming;
     RenderMode defaultMode = RenderMode::Points;  // set by add()
 
     /// The options on `command`; `modeByDefault` is the mode where neither --mode nor the
