@@ -196,12 +196,15 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& 
 }
 
 PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float> levelSpacing) {
-    PointSpacing spacing = estimatePointSpacing(cloud);
+    return withLevelSpacing(estimatePointSpacing(cloud), levelSpacing);
+}
+
+PointSpacing withLevelSpacing(PointSpacing spacing, std::span<const float> levelSpacing) {
     if (levelSpacing.empty()) {
         return spacing;
     }
-    if (levelSpacing.size() != cloud.size()) {
-        throw std::invalid_argument("estimatePointSpacing: one level spacing per point");
+    if (!spacing.local.empty() && levelSpacing.size() != spacing.local.size()) {
+        throw std::invalid_argument("withLevelSpacing: one level spacing per point");
     }
     // The level most points lie on calibrates: a level's points lie its spacing over that
     // level's times as far apart as that level's do, whose estimate there is taken as their
@@ -225,7 +228,7 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float
     float calibration = 1.0f;
     if (!spacing.local.empty()) {
         std::vector<float> estimates;
-        for (std::size_t i = 0; i < cloud.size(); ++i) {
+        for (std::size_t i = 0; i < levelSpacing.size(); ++i) {
             if (levelSpacing[i] == dominant) {
                 estimates.push_back(spacing.local[i].w);
             }
@@ -235,9 +238,9 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float
         calibration = *quartile;
     } else {
         // No scan lines, spacing h (estimateLocalSpacing's form: the across vector, then w).
-        spacing.local.assign(cloud.size(), glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+        spacing.local.assign(levelSpacing.size(), glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     }
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
+    for (std::size_t i = 0; i < levelSpacing.size(); ++i) {
         spacing.local[i].w = std::max(spacing.local[i].w, calibration * levelSpacing[i] / dominant);
     }
     return spacing;

@@ -64,5 +64,9 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& 
 /// and the fill's expected gap there was the finer level's (holes along the border,
 /// StreamedSurfaceGLTest). Level spacing 0 sets no minimum.
 PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float> levelSpacing);
+/// That raise applied to an estimate of the same points (`spacing`: estimatePointSpacing's, its
+/// local spacing one entry per point or empty). Throws std::invalid_argument where the counts
+/// differ.
+PointSpacing withLevelSpacing(PointSpacing spacing, std::span<const float> levelSpacing);
 
 }  // namespace subscan

@@ -36,8 +36,7 @@ double CloudData::spacing() const {
 const PointSpacing& CloudData::pointSpacing() const {
     std::call_once(pointSpacingOnce_, [this] {
         spacing();
-        pointSpacing_ = levelSpacing.empty() ? estimatePointSpacing(cloud_, sample_)
-                                             : estimatePointSpacing(cloud_, levelSpacing);
+        pointSpacing_ = withLevelSpacing(estimatePointSpacing(cloud_, sample_), levelSpacing);
     });
     return pointSpacing_;
 }

@@ -7,7 +7,6 @@
 #include <numeric>
 #include <optional>
 #include <set>
-#include <span>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -308,22 +307,13 @@ int runBench(const BenchOptions& options) {
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
-    // A streamed survey: its top levels give the path's bounds (the whole survey's), then one
-    // set of nodes for every frame of the path within the budget, as turntable loads them.
+    // A streamed survey: its top levels give the path's bounds (the whole survey's) and the
+    // sensor's view; the frames' nodes load once the cameras are known (below).
     const std::unique_ptr<lod::NodeSource> streamed =
         lod::openStreamed(options.source, settings.streaming.lod);
     LoadedScan scan =
         streamed ? lod::loadStreamedOverview(*streamed) : loadScanForCommand(options.source);
     const UpAxis up = upAxisFor(options.up, scan.format);
-    if (streamed && !options.sensorView.wanted()) {
-        std::vector<Camera> cameras;
-        for (int frame = 0; frame < options.frames; ++frame) {
-            cameras.push_back(pathCamera(scan.cloud.bounds, options, up, frame));
-        }
-        scan = loadStreamedView(
-            *streamed, cameras,
-            lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software));
-    }
     // --view sensor: every frame from the sensor, a still camera instead of the path.
     std::optional<Camera> still;
     if (options.sensorView.wanted()) {
@@ -331,9 +321,14 @@ int runBench(const BenchOptions& options) {
             scan, options.source, up, options.width, options.height,
             options.widthOption->count() > 0 || options.heightOption->count() > 0, 45.0);
     }
-    if (streamed && still) {
+    if (streamed) {
+        // One set of nodes for every frame within the budget, as turntable loads them.
+        std::vector<Camera> cameras;
+        for (int frame = 0; frame < (still ? 1 : options.frames); ++frame) {
+            cameras.push_back(still ? *still : pathCamera(scan.cloud.bounds, options, up, frame));
+        }
         scan = loadStreamedView(
-            *streamed, std::span(&*still, 1),
+            *streamed, cameras,
             lod::pointBudgetFor(settings.streaming.pointBudget, context->capabilities().software));
     }
     const int width = still ? still->width : options.width;
