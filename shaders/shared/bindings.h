@@ -32,6 +32,7 @@ using mat4 = glm::mat4;
 #define SUBSCAN_UNIFORM_ORIGIN 1   // ivec2: the texel of invocation (0, 0) (shared/region.glsl)
 #define SUBSCAN_UNIFORM_DIVISOR 2  // int: output pixels per pipeline pixel and side (Present)
 #define SUBSCAN_UNIFORM_END 3      // ivec2: the texel past the region's last (shared/region.glsl)
+#define SUBSCAN_UNIFORM_FADE 4     // float: the new picture's weight (the viewer's CrossFade)
 
 // Beyond its outermost points a sparse surface is kept for this share of the expected gap, times
 // 1 - 1 / (local spacing ratio) (FillRemoval.glsl's kBeyondOutermostPoints says why and how it

@@ -156,15 +156,20 @@ void to_json(nlohmann::json& json, const StreamingSettings& settings) {
     json = {
         {"lod", nameOf(lod::kLodModeNames, settings.lod)},
         {"point_budget", settings.pointBudget},
+        {"node_cache_megabytes", settings.nodeCacheMegabytes},
     };
 }
 
 void from_json(const nlohmann::json& json, StreamingSettings& settings) {
-    rejectUnknownKeys(json, "streaming", {"lod", "point_budget"});
+    rejectUnknownKeys(json, "streaming", {"lod", "point_budget", "node_cache_megabytes"});
     readEnum(json, "lod", settings.lod, lod::kLodModeNames, "level-of-detail mode");
     // 2^40 points: more than any survey a machine of today holds.
     readSetting(json, "point_budget", settings.pointBudget, std::uint64_t{0},
                 std::uint64_t{1} << 40);
+    // 16 MiB holds a view of a few hundred thousand points; 2^20 MiB (1 TiB), more than any
+    // machine's memory.
+    readSetting(json, "node_cache_megabytes", settings.nodeCacheMegabytes, std::uint64_t{16},
+                std::uint64_t{1} << 20);
 }
 
 void to_json(nlohmann::json& json, const RenderSettings& settings) {

@@ -10,6 +10,7 @@
 
 #include "gpu/GpuClear.h"
 #include "gpu/PassTimer.h"
+#include "lod/NodeCache.h"
 #include "lod/NodeSource.h"
 #include "render/ScatteringSettings.h"
 #include "render/SurfaceSettings.h"
@@ -83,6 +84,8 @@ struct TemporalSettings {
 struct StreamingSettings {
     lod::LodMode lod = lod::LodMode::Auto;
     std::uint64_t pointBudget = 0;
+    /// The viewer's decoded nodes kept in memory (lod::CachedNodeSource), in MiB.
+    std::uint64_t nodeCacheMegabytes = lod::kDefaultNodeCacheBytes >> 20;
 
     bool operator==(const StreamingSettings&) const = default;
 };

@@ -16,9 +16,9 @@ struct LoadCancelled {};
 
 }  // namespace
 
-ScanLoadJob::ScanLoadJob(std::string source, lod::LodMode lod)
+ScanLoadJob::ScanLoadJob(std::string source, const StreamingSettings& streaming)
     : source_(std::move(source)),
-      lod_(lod),
+      streaming_(streaming),
       job_(source_, [this](const std::function<bool()>& cancelled) { return load(cancelled); }) {}
 
 PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
@@ -31,8 +31,10 @@ PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
     try {
         PreparedScan prepared;
         prepared.source = source_;
-        prepared.streamed = lod::openStreamed(source_, lod_);
-        if (prepared.streamed) {
+        if (std::shared_ptr<const lod::NodeSource> opened =
+                lod::openStreamed(source_, streaming_.lod)) {
+            prepared.streamed = std::make_shared<lod::CachedNodeSource>(
+                std::move(opened), streaming_.nodeCacheMegabytes << 20);
             prepared.scan = lod::loadStreamedOverview(*prepared.streamed, &prepared.nodes);
         } else {
             prepared.scan = loadScan(source_, reportProgress);

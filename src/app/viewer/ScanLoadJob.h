@@ -11,7 +11,8 @@
 #include "app/viewer/BackgroundJob.h"
 #include "core/LocalSpacing.h"
 #include "io/ScanLoader.h"
-#include "lod/NodeSource.h"
+#include "lod/NodeCache.h"
+#include "render/RenderSettings.h"
 
 namespace subscan::viewer {
 
@@ -24,7 +25,7 @@ struct PreparedScan {
     std::vector<glm::vec3> normals;  // normalsFor(cloud, auto): empty where none are estimated
     /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
     /// it (the overview when first opened, then the nodes a view shows). Null: loaded whole.
-    std::shared_ptr<const lod::NodeSource> streamed;
+    std::shared_ptr<const lod::CachedNodeSource> streamed;
     std::vector<std::size_t> nodes;
 };
 
@@ -35,12 +36,13 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)
 /// while a big file is decoded; a COPC file or EPT dataset only its overview (topLevels), which
-/// StreamedViewJob refines. Destroying an unfinished job cancels it at the reader's next
-/// progress report and waits for the thread.
+/// StreamedViewJob refines, through a lod::CachedNodeSource that every later view shares.
+/// Destroying an unfinished job cancels it at the reader's next progress report and waits for the
+/// thread.
 class ScanLoadJob {
   public:
-    /// `lod`: whether a COPC file or EPT dataset is streamed (settings' streaming.lod).
-    ScanLoadJob(std::string source, lod::LodMode lod);
+    /// `streaming`: whether a COPC file or EPT dataset is streamed, and its nodes' cache.
+    ScanLoadJob(std::string source, const StreamingSettings& streaming);
 
     const std::string& source() const { return source_; }
     /// 0..1 while the file is decoded; readers of small files and synthetic scenes report
@@ -54,7 +56,7 @@ class ScanLoadJob {
     PreparedScan load(const std::function<bool()>& cancelled);
 
     std::string source_;
-    lod::LodMode lod_;
+    StreamingSettings streaming_;
     std::atomic<double> progress_{0.0};
     BackgroundJob<PreparedScan> job_;  // last: starts once everything it touches exists
 };

@@ -8,7 +8,7 @@
 
 namespace subscan::viewer {
 
-StreamedViewJob::StreamedViewJob(std::shared_ptr<const lod::NodeSource> source,
+StreamedViewJob::StreamedViewJob(std::shared_ptr<const lod::CachedNodeSource> source,
                                  std::string sourceName, const Camera& camera,
                                  std::uint64_t pointBudget, std::vector<std::size_t> shown)
     : source_(std::move(source)),

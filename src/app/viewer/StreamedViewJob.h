@@ -11,7 +11,7 @@
 #include "app/viewer/BackgroundJob.h"
 #include "app/viewer/ScanLoadJob.h"
 #include "core/Camera.h"
-#include "lod/NodeSource.h"
+#include "lod/NodeCache.h"
 
 namespace subscan::viewer {
 
@@ -22,7 +22,7 @@ namespace subscan::viewer {
 class StreamedViewJob {
   public:
     /// `shown`: the nodes on screen now; a view that selects the same ones loads nothing.
-    StreamedViewJob(std::shared_ptr<const lod::NodeSource> source, std::string sourceName,
+    StreamedViewJob(std::shared_ptr<const lod::CachedNodeSource> source, std::string sourceName,
                     const Camera& camera, std::uint64_t pointBudget,
                     std::vector<std::size_t> shown);
 
@@ -34,7 +34,7 @@ class StreamedViewJob {
   private:
     std::optional<PreparedScan> load(const std::function<bool()>& cancelled);
 
-    std::shared_ptr<const lod::NodeSource> source_;
+    std::shared_ptr<const lod::CachedNodeSource> source_;
     std::string sourceName_;
     Camera camera_;
     std::uint64_t pointBudget_;

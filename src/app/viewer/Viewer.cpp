@@ -109,6 +109,7 @@ Viewer::Viewer(ViewerOptions options)
       unattended_(!options_.script.empty() || options_.exitAfterFrames.has_value()),
       context_(windowOptions(options_)),
       imgui_(context_.window()),
+      crossFade_(ShaderSources()),
       settings_(options_.settings),
       scattering_(options_.settings.scattering),
       showPanel_(options_.showPanel) {
@@ -135,7 +136,7 @@ int Viewer::run() {
         const double now = glfwGetTime();
         const double seconds = now - lastFrameTime_;
         lastFrameTime_ = now;
-        const bool showing = renderer_ != nullptr;
+        const bool showing = renderer_ != nullptr && !awaitingViewNodes();
         if (showing && !exiting) {
             runScript();
             flyWithKeys(seconds);
@@ -151,10 +152,20 @@ int Viewer::run() {
             writeScreenshot(options_.screenshotAtExit);
         }
         context_.swapBuffers();
+        recordOpeningTimes();
         if (showing) {
             ++frame_;
         }
         if (exiting) {
+            if (unattended_ && streamed_) {
+                const lod::CachedNodeSource::Usage cache = streamed_->usage();
+                fmt::print(stderr,
+                           "subscan: {}: first picture {:.2f} s after opening, the view's nodes "
+                           "{:.2f} s; node cache {:.0f} of {:.0f} MiB, {} nodes read, {} reused\n",
+                           status_.scanSource, status_.firstPictureSeconds,
+                           status_.viewCompleteSeconds, cache.bytes / 1048576.0,
+                           streamed_->byteBudget() / 1048576.0, cache.misses, cache.hits);
+            }
             return 0;
         }
     }
@@ -182,7 +193,7 @@ void Viewer::installCallbacks() {
 void Viewer::waitForEvents() {
     if (loading_ || refining_ || dueRefinement()) {
         glfwWaitEventsTimeout(kLoadingWaitSeconds);
-    } else if (unattended_ || flying_ || frameIsStale()) {
+    } else if (unattended_ || flying_ || frameIsStale() || fading()) {
         // A change made while drawing the last frame (the panel, a script) shows at once.
         glfwPollEvents();
     } else {
@@ -387,8 +398,35 @@ void Viewer::flyWithKeys(double seconds) {
 
 void Viewer::startLoading(const std::string& source) {
     // Replacing a running job cancels it (its destructor waits for the thread).
-    loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming.lod);
+    loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming);
     status_.loadingSource = source;
+    // The first scan opens with the program (GLFW's clock starts at its initialisation).
+    openedAt_ = initialScanShown_ ? glfwGetTime() : 0.0;
+    status_.firstPictureSeconds = 0.0;
+    status_.viewCompleteSeconds = 0.0;
+    viewNodesShown_ = false;
+}
+
+void Viewer::recordOpeningTimes() {
+    if (!renderer_ || !renderedImage_ || loading_) {
+        return;
+    }
+    const double seconds = glfwGetTime() - openedAt_;
+    if (status_.firstPictureSeconds == 0.0) {
+        status_.firstPictureSeconds = seconds;
+    }
+    if (streamed_ && viewNodesShown_ && status_.viewCompleteSeconds == 0.0) {
+        status_.viewCompleteSeconds = seconds;
+    }
+}
+
+bool Viewer::fading() const {
+    return renderer_ && renderedImage_ &&
+           crossFade_.active(renderer_->resources().texture("image"), glfwGetTime());
+}
+
+bool Viewer::awaitingViewNodes() const {
+    return unattended_ && streamed_ && (refining_ || dueRefinement());
 }
 
 void Viewer::finishLoading() {
@@ -424,6 +462,15 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
     const Coloring coloring = newScan ? options_.coloring : status_.coloring;
     prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);
+    // Interactive: what was on screen fades into the new nodes' picture (unattended runs show
+    // what `render` would at once).
+    if (!newScan && !unattended_ && renderer_ && renderedImage_) {
+        const Texture& image = renderer_->resources().texture("image");
+        const double now = glfwGetTime();
+        crossFade_.start(crossFade_.active(image, now) ? crossFade_.blended() : image, now);
+    } else {
+        crossFade_.stop();
+    }
     // Built before the old one goes, so a failure keeps the scan on screen. The renderer
     // reads the points where they are (no copy where the driver allows): the scan stays at
     // its address until the renderer that reads it has gone.
@@ -447,6 +494,8 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     status_.streamedNodes = streamedNodes_.size();
     status_.streamedNodesInAll = streamed_ ? streamed_->nodes().size() : 0;
     status_.streamedPointsInAll = streamed_ ? streamed_->info().points : 0;
+    status_.nodeCacheBytes = streamed_ ? streamed_->usage().bytes : 0;
+    status_.nodeCacheBudgetBytes = streamed_ ? streamed_->byteBudget() : 0;
     renderedCamera_.reset();
     renderedImage_ = false;
     if (!newScan) {
@@ -491,6 +540,7 @@ void Viewer::refineStreamedView() {
             if (std::optional<PreparedScan> prepared = job->take()) {
                 show(std::move(*prepared), false);
             }
+            viewNodesShown_ = true;
         } catch (const Error& error) {
             fail(error.what());
         }
@@ -500,8 +550,7 @@ void Viewer::refineStreamedView() {
         return;
     }
     // Interactive: once the camera has rested a moment, so that an orbit does not start a
-    // load at every step. Unattended (scripts, tests): at once, and waited for, so that every
-    // frame shows what `render` would.
+    // load at every step. Unattended (scripts, tests): at once (awaitingViewNodes).
     const double now = glfwGetTime();
     if (!stillCamera_ || !sameCamera(*stillCamera_, *camera)) {
         stillCamera_ = camera;
@@ -517,12 +566,6 @@ void Viewer::refineStreamedView() {
     refining_ = std::make_unique<StreamedViewJob>(streamed_, status_.scanSource, *camera, budget,
                                                   streamedNodes_);
     status_.streamingView = true;
-    if (unattended_) {
-        while (!refining_->finished()) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        }
-        refineStreamedView();
-    }
 }
 
 // ---- script ----------------------------------------------------------------------------------
@@ -659,8 +702,11 @@ bool Viewer::frameIsStale() const {
     const bool changed = !renderedCamera_ ||
                          !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
                          nlohmann::json(settings).dump() != renderedSettings_;
+    // While a view's nodes load, the temporal filter does not refine the picture at rest: the
+    // nodes replace it in a moment, and on llvmpipe its frames took the cores their loading
+    // needs.
     return redrawEveryFrame_ || changed ||
-           (filtersTemporally(settings) && renderedImage_ &&
+           (filtersTemporally(settings) && renderedImage_ && !refining_ &&
             framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
 }
 
@@ -700,7 +746,9 @@ void Viewer::drawFrame() {
     }
     renderIfNeeded();
     if (renderer_ && renderedImage_) {
-        context_.presentImage(renderer_->resources().texture("image"));
+        const Texture& image = renderer_->resources().texture("image");
+        const double now = glfwGetTime();
+        context_.presentImage(crossFade_.active(image, now) ? crossFade_.blend(image, now) : image);
     } else {
         context_.clearWindow(settings_.raster.backgroundSrgb);
     }

@@ -8,6 +8,7 @@
 
 #include <glm/vec2.hpp>
 
+#include "app/viewer/CrossFade.h"
 #include "app/viewer/ImGuiSession.h"
 #include "app/viewer/ScanLoadJob.h"
 #include "app/viewer/StreamedViewJob.h"
@@ -98,6 +99,14 @@ class Viewer {
     /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
     /// start afresh), or another set of the streamed scan's nodes (the view stays).
     void show(PreparedScan prepared, bool newScan);
+    /// An unattended run (script, frame limit) is waiting for a streamed view's nodes: its
+    /// frames show the overview meanwhile but do not count, so every counted frame shows what
+    /// `subscan render` would.
+    bool awaitingViewNodes() const;
+    /// A cross-fade to a streamed view's new nodes is under way: frames are drawn until it ends.
+    bool fading() const;
+    /// After a frame was shown: when the scan's first picture and its view's nodes came.
+    void recordOpeningTimes();
     /// The camera whose nodes a streamed scan should load next: the view, where it is not the
     /// one last refined for and no load runs.
     std::optional<Camera> dueRefinement() const;
@@ -147,6 +156,7 @@ class Viewer {
     bool unattended_;
     GlfwContext context_;
     ImGuiSession imgui_;
+    CrossFade crossFade_;  // from a streamed view's nodes to the next ones
     ViewerPanel panel_;
     RenderSettings settings_;  // as the panel shows them
     AppliedScattering scattering_;
@@ -173,13 +183,15 @@ class Viewer {
     std::unique_ptr<ScanLoadJob> loading_;
     // A streamed scan (COPC, EPT): its source, the nodes on screen, the job loading a view's,
     // the camera as last seen and since when it rests, and the view last refined for.
-    std::shared_ptr<const lod::NodeSource> streamed_;
+    std::shared_ptr<const lod::CachedNodeSource> streamed_;
     std::vector<std::size_t> streamedNodes_;
     std::unique_ptr<StreamedViewJob> refining_;
     std::optional<Camera> stillCamera_;
     double stillSince_ = 0.0;
     std::optional<Camera> refinedCamera_;
     std::uint64_t refinedBudget_ = 0;  // the settings' point budget it was refined with
+    bool viewNodesShown_ = false;      // a view's own nodes came since the scan opened
+    double openedAt_ = 0.0;            // glfwGetTime() when the scan on screen began to open
     bool initialScanShown_ = false;
     std::optional<std::string> pendingOpen_;
 

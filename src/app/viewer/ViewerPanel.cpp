@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "render/SettingsJson.h"
 #include "shared/bindings.h"
 #include "sss/MaterialLibrary.h"
 
@@ -243,11 +244,27 @@ void ViewerPanel::drawScan(const PanelStatus& status, StreamingSettings& streami
         ImGui::TextWrapped("%s", status.scanSource.c_str());
         ImGui::TextWrapped("%s", status.scanFormat.c_str());
         ImGui::Text("%s points, h = %.4g", groupedThousands(status.points).c_str(), status.spacing);
+        const auto lodName = [](lod::LodMode mode) { return nameOf(lod::kLodModeNames, mode); };
+        constexpr lod::LodMode kLodModes[] = {lod::LodMode::Auto, lod::LodMode::On,
+                                              lod::LodMode::Off};
+        if (choiceCombo("levels of detail", streaming.lod, std::span<const lod::LodMode>(kLodModes),
+                        lodName)) {
+            requests.openScan = status.scanSource;  // the file opens again, streamed or whole
+        }
+        helpTooltip(
+            "auto: COPC files and EPT datasets stream by their levels of detail, the view's "
+            "nodes within the point budget; every other file loads whole. on: only streamed "
+            "sources open. off: every file loads whole. A change opens the scan again.");
         if (status.streamedNodesInAll > 0) {
             ImGui::TextWrapped("streamed: %zu of %zu nodes, of %s points%s", status.streamedNodes,
                                status.streamedNodesInAll,
                                groupedThousands(status.streamedPointsInAll).c_str(),
                                status.streamingView ? "; loading the view's nodes" : "");
+            ImGui::Text("node cache: %.0f of %.0f MiB", status.nodeCacheBytes / 1048576.0,
+                        status.nodeCacheBudgetBytes / 1048576.0);
+            helpTooltip(
+                "Decoded nodes kept in memory (settings file: streaming.node_cache_megabytes); "
+                "the least recently used leave first.");
             // Applied when Enter is pressed: every change reloads the view's nodes.
             constexpr std::uint64_t kStep = 100'000, kFastStep = 1'000'000;
             ImGui::InputScalar("point budget", ImGuiDataType_U64, &streaming.pointBudget, &kStep,
@@ -258,6 +275,12 @@ void ViewerPanel::drawScan(const PanelStatus& status, StreamingSettings& streami
                 "rests.");
         }
         ImGui::Text("loaded in %.0f ms", status.loadMilliseconds);
+        if (status.firstPictureSeconds > 0.0) {
+            ImGui::Text("first picture %.2f s after opening", status.firstPictureSeconds);
+        }
+        if (status.viewCompleteSeconds > 0.0) {
+            ImGui::Text("the view's nodes shown %.2f s after opening", status.viewCompleteSeconds);
+        }
         constexpr Coloring kColorings[] = {Coloring::Auto,           Coloring::Rgb,
                                            Coloring::Intensity,      Coloring::Height,
                                            Coloring::Classification, Coloring::Uniform};

@@ -33,6 +33,13 @@ struct PanelStatus {
     std::size_t streamedNodesInAll = 0;
     std::uint64_t streamedPointsInAll = 0;
     bool streamingView = false;
+    std::uint64_t nodeCacheBytes = 0;  // decoded nodes kept (lod::CachedNodeSource)
+    std::uint64_t nodeCacheBudgetBytes = 0;
+    // Seconds from opening the scan (the command's start, or choosing another file) to its
+    // first frame, and a streamed scan's to the first frame of the first view's own nodes;
+    // 0 until then.
+    double firstPictureSeconds = 0.0;
+    double viewCompleteSeconds = 0.0;
     double loadingProgress = 0.0;
     std::string glRenderer;
     bool int64Atomics = false;

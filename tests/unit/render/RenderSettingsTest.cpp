@@ -57,9 +57,12 @@ TEST(RenderSettingsTest, StreamingSettingsRoundTripAndRefuseImpossibleValues) {
     EXPECT_EQ(settings.streaming.pointBudget, 0u);  // the renderer's default
     settings.streaming.lod = lod::LodMode::Off;
     settings.streaming.pointBudget = 2'500'000;
+    EXPECT_EQ(settings.streaming.nodeCacheMegabytes, 512u);
+    settings.streaming.nodeCacheMegabytes = 100;
     const nlohmann::json json = settings;
     EXPECT_EQ(json["streaming"]["lod"], "off");
     EXPECT_EQ(json["streaming"]["point_budget"], 2'500'000);
+    EXPECT_EQ(json["streaming"]["node_cache_megabytes"], 100);
     EXPECT_EQ(json.get<RenderSettings>(), settings);
     const auto refusal = [](const nlohmann::json& streaming) {
         return test::errorMessage([&] {
@@ -71,6 +74,8 @@ TEST(RenderSettingsTest, StreamingSettingsRoundTripAndRefuseImpossibleValues) {
     EXPECT_THAT(refusal({{"point_budget", -1}}), ::testing::HasSubstr("'point_budget'"));
     EXPECT_THAT(refusal({{"point_budget", 2e12}}), ::testing::HasSubstr("'point_budget'"));
     EXPECT_THAT(refusal({{"budget", 5}}), ::testing::HasSubstr("budget"));
+    EXPECT_THAT(refusal({{"node_cache_megabytes", 4}}),
+                ::testing::HasSubstr("'node_cache_megabytes'"));
     EXPECT_EQ(lod::pointBudgetFor(0, true), lod::kSoftwarePointBudget);
     EXPECT_EQ(lod::pointBudgetFor(0, false), lod::kHardwarePointBudget);
     EXPECT_EQ(lod::pointBudgetFor(5, true), 5u);

@@ -1,0 +1,42 @@
+#pragma once
+
+#include "gpu/GlObjects.h"
+#include "gpu/ShaderSources.h"
+
+namespace subscan::viewer {
+
+/// How long the viewer fades from one set of a streamed view's nodes to the next: long enough
+/// that the change reads as a refinement, not a jump; short enough to be over before the eye
+/// looks for it.
+inline constexpr double kCrossFadeSeconds = 0.3;
+
+/// The new picture's weight `elapsed` seconds into a fade: 0 at its start, 1 from its end on,
+/// easing in and out (smoothstep) so that neither end shows a kink in brightness.
+double crossFadeWeight(double elapsed);
+
+/// A cross-fade from the picture on screen to the next one (CrossFade.comp), so that a
+/// streamed view's nodes arriving or leaving do not pop: the old picture is kept when the
+/// nodes change, and each frame until the fade ends shows the new one mixed over it.
+class CrossFade {
+  public:
+    explicit CrossFade(const ShaderSources& sources);
+
+    /// Keeps a copy of `shown` (an RGBA8 picture) to fade from, starting at `now` seconds.
+    void start(const Texture& shown, double now);
+    /// Whether a fade is under way at `now` for pictures the size of `image`.
+    bool active(const Texture& image, double now) const;
+    /// `image` mixed over the kept picture by the fade's weight at `now`; what to present.
+    /// Only while active().
+    const Texture& blend(const Texture& image, double now);
+    void stop() { started_ = -1.0; }
+    /// The last blend(): what is on screen while a fade is under way.
+    const Texture& blended() const { return blended_; }
+
+  private:
+    Program program_;
+    Texture from_;
+    Texture blended_;
+    double started_ = -1.0;  // < 0: no fade
+};
+
+}  // namespace subscan::viewer
