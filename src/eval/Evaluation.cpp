@@ -405,14 +405,43 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
                                 const EvaluationSettings& settings,
                                 const TemporalEvaluationSettings& temporal,
                                 const RenderSettings& render) {
+    std::vector<Camera> cameras;
+    for (int t = 0; t < temporal.frames; ++t) {
+        OrbitView orbit;
+        if (settings.scannerView) {
+            orbit = settings.scannerView(t * temporal.stepDegrees);
+        } else {
+            orbit.yawDegrees = 20.0 + t * temporal.stepDegrees;
+            orbit.pitchDegrees = 25.0;
+            orbit.distance = settings.distance;
+        }
+        cameras.push_back(orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
+                                      settings.fovyDegrees));
+    }
     const PointSpacing spacing = estimatePointSpacing(points);
-    Renderer renderer(context, points, spacing);
+    Renderer renderer(context, points, spacing);  // the baselines' (and the surface's, whole)
+    std::optional<LoadedScan> streamed;
+    if (settings.pointBudget) {
+        const StreamedPoints indexed(points);
+        streamed = lod::loadStreamedScan(
+            indexed.source(), lod::selectNodes(indexed.source(), cameras, *settings.pointBudget));
+    }
+    const PointCloud& surfacePoints = streamed ? streamed->cloud : points;
+    const PointSpacing surfaceSpacing =
+        streamed ? estimatePointSpacing(streamed->cloud, streamed->levelSpacing) : spacing;
+    std::optional<Renderer> streamedRenderer;
+    if (streamed) {
+        streamedRenderer.emplace(context, surfacePoints, surfaceSpacing);
+    }
+    Renderer& surfaceRenderer = streamedRenderer ? *streamedRenderer : renderer;
     // Their own renderers, so the filter's histories run on undisturbed by the other methods.
-    Renderer filtered(context, points, spacing);
-    Renderer converged(context, points, spacing);
-    if (const std::vector<glm::vec3> normals = normalsFor(points, render.surface.normals);
+    Renderer filtered(context, surfacePoints, surfaceSpacing);
+    Renderer converged(context, surfacePoints, surfaceSpacing);
+    const NormalSource normalSource =
+        streamed ? streamedNormals(render.surface.normals) : render.surface.normals;
+    if (const std::vector<glm::vec3> normals = normalsFor(surfacePoints, normalSource);
         !normals.empty()) {
-        for (Renderer* each : {&renderer, &filtered, &converged}) {
+        for (Renderer* each : {&surfaceRenderer, &filtered, &converged}) {
             each->setPointNormals(normals);
         }
     }
@@ -437,16 +466,7 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
         return frame;
     };
     for (int t = 0; t < temporal.frames; ++t) {
-        OrbitView orbit;
-        if (settings.scannerView) {
-            orbit = settings.scannerView(t * temporal.stepDegrees);
-        } else {
-            orbit.yawDegrees = 20.0 + t * temporal.stepDegrees;
-            orbit.pitchDegrees = 25.0;
-            orbit.distance = settings.distance;
-        }
-        const Camera camera = orbitCamera(truth.bounds(), orbit, settings.width, settings.height,
-                                          settings.fovyDegrees);
+        const Camera& camera = cameras[static_cast<std::size_t>(t)];
         truthFrames.push_back(
             supersampledTruth(truth, shader, camera, render, temporal.supersampling));
 
@@ -457,9 +477,10 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
             frames->push_back({std::move(frame.image), maskOf(frame.images.depth)});
         }
 
-        renderer.render(camera, surfaceSettings, FrameOutputs::Everything);
+        surfaceRenderer.render(camera, surfaceSettings, FrameOutputs::Everything);
         surfaceFrames.push_back(
-            {renderer.readImage(), maskOf(atOutputPixels(renderer, "surfaceDepth", 1, camera))});
+            {surfaceRenderer.readImage(),
+             maskOf(atOutputPixels(surfaceRenderer, "surfaceDepth", 1, camera))});
 
         // The filtered sequence starts converged at the first pose, then follows the orbit.
         for (int still = 0; still < (t == 0 ? temporal.stillSamples : 1); ++still) {
@@ -494,6 +515,7 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
     report.supersampling = temporal.supersampling;
     report.points = points.size();
     report.spacing = renderer.spacing();
+    report.surfacePoints = surfacePoints.size();
     report.splatSize = render.raster.pointSize;
     report.points1px = compareSequences(pointFrames, truthFrames);
     report.splats = compareSequences(splatFrames, truthFrames);
@@ -523,6 +545,7 @@ nlohmann::json toJson(const TemporalReport& report) {
         {"supersampling", report.supersampling},
         {"points", report.points},
         {"spacing", report.spacing},
+        {"surface_points", report.surfacePoints},
         {"methods",
          {{"points", method(report.points1px)},
           {"splats", splats},

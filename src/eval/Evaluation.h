@@ -135,6 +135,8 @@ struct TemporalReport {
     int supersampling = 0;
     std::size_t points = 0;
     double spacing = 0.0;
+    /// With a point budget: the points of the one set of nodes the surface drew for every frame.
+    std::size_t surfacePoints = 0;
     TemporalMetrics points1px;
     TemporalMetrics splats;
     float splatSize = 0.0f;  // RasterSettings::pointSize
@@ -150,7 +152,10 @@ struct TemporalReport {
 };
 
 /// Renders the orbit with each method (the temporal filter's sequence starting converged) and
-/// compares the sequences with the truth's, supersampled.
+/// compares the sequences with the truth's, supersampled. With settings.pointBudget the surface
+/// is streamed as `bench` and `turntable` stream it: one set of nodes for the whole orbit
+/// (lod::selectNodes over every frame's camera), as the viewer keeps its nodes while the camera
+/// moves and loads a view's own only once it rests; the baselines draw every point.
 TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const PointCloud& points,
                                 const EvaluationSettings& settings,
                                 const TemporalEvaluationSettings& temporal,

@@ -62,6 +62,11 @@ class LightMaps {
                                    const Camera& camera, const RenderSettings& settings,
                                    double spacing, PassRunner& runner);
     const std::vector<Map>& maps() const { return maps_; }
+    /// The next update builds every map again: the cloud changed (Renderer::replaceCloud).
+    void forget() {
+        maps_.clear();
+        keys_.clear();
+    }
     /// Maps built so far (a light's first map counts): for tests of the caching.
     std::size_t builds() const { return builds_; }
     /// Bytes of the maps and of the pipeline images they are built in.

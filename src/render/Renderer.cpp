@@ -64,6 +64,7 @@ Renderer::Renderer(GlContext& context, const PointCloud& cloud, const PointSpaci
                    std::size_t maxChunkPoints, PointMemory memory)
     : context_(context),
       clears_(sources_, context.capabilities()),
+      maxChunkPoints_(maxChunkPoints),
       cloud_(cloud, context.capabilities(), maxChunkPoints, memory),
       spacing_(usableSpacing(cloud, spacing.global)),
       resolutionChooser_(cloud),
@@ -81,6 +82,20 @@ void Renderer::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
 }
 
 Renderer::~Renderer() = default;
+
+void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
+                            PointMemory memory) {
+    GpuPointCloud uploaded(cloud, context_.capabilities(), maxChunkPoints_, memory);
+    cloud_ = std::move(uploaded);
+    spacing_ = usableSpacing(cloud, spacing.global);
+    resolutionChooser_ = ResolutionChooser(cloud);
+    cloudBounds_ = cloud.bounds;
+    if (!spacing.local.empty()) {
+        setLocalSpacing(spacing.local);
+    }
+    lightMaps_.forget();
+    restartTemporalFilter();
+}
 
 RenderSettings Renderer::resolvedSettings(const RenderSettings& settings) const {
     RenderSettings resolved = settings;

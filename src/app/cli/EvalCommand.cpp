@@ -88,9 +88,6 @@ int runEval(const EvalOptions& options) {
     contextOptions.preferHardware = !options.software;
     contextOptions.debugOutput = glDebugOutputRequested();
     const std::unique_ptr<GlContext> context = createHeadlessContext(contextOptions);
-    if (options.temporal && evaluation.pointBudget) {
-        throw Error("--point-budget measures still views; --temporal does not stream yet");
-    }
     if (options.temporal) {
         const TemporalReport report = evaluateTemporal(*context, *truth, points, evaluation,
                                                        options.temporalEvaluation, render);
@@ -101,9 +98,13 @@ int runEval(const EvalOptions& options) {
         }
         fmt::print(
             "{}: {} points (h = {:.4g}), {} frames of {}x{}, {}° apart, truth {}x{} rays "
-            "per pixel\n",
+            "per pixel{}\n",
             options.source, report.points, report.spacing, report.frames, report.width,
-            report.height, report.stepDegrees, report.supersampling, report.supersampling);
+            report.height, report.stepDegrees, report.supersampling, report.supersampling,
+            evaluation.pointBudget
+                ? fmt::format("; the surface streamed within {} points: {} for every frame",
+                              *evaluation.pointBudget, report.surfacePoints)
+                : "");
         fmt::print("{:<18} {:>10} {:>12} {:>8} {:>12}\n", "method", "E_t", "mask flicker", "PSNR",
                    "still PSNR");
         auto row = [](const std::string& name, const TemporalMetrics& m, std::string still) {

@@ -123,6 +123,7 @@ Viewer::~Viewer() = default;
 
 int Viewer::run() {
     startLoading(options_.source);
+    warmUpRenderer();
     lastFrameTime_ = glfwGetTime();
     for (;;) {
         waitForEvents();
@@ -407,6 +408,24 @@ void Viewer::startLoading(const std::string& source) {
     viewNodesShown_ = false;
 }
 
+void Viewer::warmUpRenderer() {
+    PointCloud placeholder;
+    placeholder.positions = {glm::vec3(0.0f), glm::vec3(1.0f)};
+    placeholder.colors = {Rgba8{128, 128, 128, 255}, Rgba8{128, 128, 128, 255}};
+    placeholder.bounds.add(glm::dvec3(0.0));
+    placeholder.bounds.add(glm::dvec3(1.0));
+    const glm::ivec2 size = viewportSize();
+    try {
+        auto renderer = std::make_unique<Renderer>(context_, placeholder, PointSpacing{0.1, {}});
+        renderer->render(orbitCamera(placeholder.bounds, OrbitView{}, std::max(size.x, 1),
+                                     std::max(size.y, 1), ViewerCamera::kFovyDegrees),
+                         appliedSettings());
+        warmRenderer_ = std::move(renderer);
+    } catch (const Error&) {
+        // Only time is lost: the scan's own first frame compiles and reports what failed.
+    }
+}
+
 void Viewer::recordOpeningTimes() {
     if (!renderer_ || !renderedImage_ || loading_) {
         return;
@@ -471,16 +490,23 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     } else {
         crossFade_.stop();
     }
-    // Built before the old one goes, so a failure keeps the scan on screen. The renderer
-    // reads the points where they are (no copy where the driver allows): the scan stays at
-    // its address until the renderer that reads it has gone.
+    // The renderer reads the points where they are (no copy where the driver allows): the
+    // scan stays at its address until the renderer reads another. One renderer for every scan
+    // and view (its passes compiled and images made once); a failure to take the new points
+    // keeps the old ones on screen.
     auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
-    auto renderer =
-        std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
-    if (!prepared.normals.empty()) {
-        renderer->setPointNormals(prepared.normals);
+    if (renderer_) {
+        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow);
+    } else if (warmRenderer_) {
+        warmRenderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow);
+        renderer_ = std::move(warmRenderer_);
+    } else {
+        renderer_ =
+            std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
     }
-    renderer_ = std::move(renderer);
+    if (!prepared.normals.empty()) {
+        renderer_->setPointNormals(prepared.normals);
+    }
     scan_ = std::move(scan);
     scanColors_ = std::move(fileColors);
     scanUp_ = up;
@@ -550,13 +576,14 @@ void Viewer::refineStreamedView() {
         return;
     }
     // Interactive: once the camera has rested a moment, so that an orbit does not start a
-    // load at every step. Unattended (scripts, tests): at once (awaitingViewNodes).
+    // load at every step; the view the scan opens with at once. Unattended (scripts, tests):
+    // at once (awaitingViewNodes).
     const double now = glfwGetTime();
     if (!stillCamera_ || !sameCamera(*stillCamera_, *camera)) {
         stillCamera_ = camera;
         stillSince_ = now;
     }
-    if (!unattended_ && now - stillSince_ < kRefineAfterRestSeconds) {
+    if (!unattended_ && refinedCamera_ && now - stillSince_ < kRefineAfterRestSeconds) {
         return;
     }
     refinedCamera_ = camera;
