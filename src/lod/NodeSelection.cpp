@@ -176,7 +176,7 @@ std::vector<std::size_t> topLevels(const NodeSource& source, std::uint64_t point
 
 PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> nodes,
                      std::vector<std::string>& warnings, unsigned threads,
-                     const std::function<bool()>& cancelled) {
+                     const std::function<bool()>& cancelled, std::vector<std::size_t>* read) {
     std::vector<std::optional<PointCloud>> loaded(nodes.size());
     std::vector<std::string> failures(nodes.size());
     std::atomic<std::size_t> next{0};
@@ -217,6 +217,9 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
             warnings.push_back(failures[i]);
         }
         if (loaded[i]) {
+            if (read != nullptr) {
+                read->push_back(nodes[i]);
+            }
             total += loaded[i]->size();
             colors = colors && loaded[i]->hasColors();
             normals = normals && loaded[i]->hasNormals();
@@ -275,8 +278,9 @@ struct CoarserBeside {
 /// survey holds nothing deeper (a node holding every point of its cube, as the indexer leaves
 /// a cube of few points), the points lie at the scan's own spacing, which their estimate
 /// gives, so they get 0 (none) unless a coarser part lies beside them; at a budget that takes
-/// every point, every point. (A node that could not be read still counts as loaded: beside
-/// it the spacing is too fine.)
+/// every point, every point. `nodes`: those read; a node that could not be read counts as left
+/// out, so its ancestors' points in its cube take their own level's spacing, as where the view
+/// cut the octree there.
 std::vector<float> levelSpacingOf(const NodeSource& source, std::span<const std::size_t> nodes,
                                   const PointCloud& cloud) {
     const std::span<const StreamedNode> all = source.nodes();
@@ -357,13 +361,14 @@ LoadedScan loadStreamedScan(const NodeSource& source, std::span<const std::size_
     if (withSourceWarnings) {
         scan.warnings = source.info().warnings;
     }
-    scan.cloud = loadNodes(source, nodes, scan.warnings, 0, cancelled);
+    std::vector<std::size_t> read;
+    scan.cloud = loadNodes(source, nodes, scan.warnings, 0, cancelled, &read);
     if (scan.cloud.size() == 0 && !nodes.empty() && !(cancelled && cancelled())) {
         throw Error(fmt::format("{}: none of the {} nodes it needs could be read ({})",
                                 source.info().name, nodes.size(),
                                 scan.warnings.empty() ? "?" : scan.warnings.back()));
     }
-    scan.levelSpacing = levelSpacingOf(source, nodes, scan.cloud);
+    scan.levelSpacing = levelSpacingOf(source, read, scan.cloud);
     scan.cloud.bounds.add(source.info().bounds.min);
     scan.cloud.bounds.add(source.info().bounds.max);
     scan.format = source.info().format;

@@ -73,8 +73,10 @@ LoadedScan loadStreamedOverview(const NodeSource& source,
 /// positions about the middle of the source's bounds. A node that cannot be read is left out
 /// with one warning that names the node (the caller names the source); the rest still shows.
 /// `cancelled` (may be empty) is asked before each node: once true, the rest are left out.
+/// `read` (may be null) receives the nodes whose points the cloud holds, in the order given.
 PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> nodes,
                      std::vector<std::string>& warnings, unsigned threads = 0,
-                     const std::function<bool()>& cancelled = {});
+                     const std::function<bool()>& cancelled = {},
+                     std::vector<std::size_t>* read = nullptr);
 
 }  // namespace subscan::lod
