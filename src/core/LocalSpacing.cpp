@@ -108,9 +108,14 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
     }
     const PositionsAdaptor adaptor{positions};
     const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    // Raw distances first (w: the spacing neighbour's, xyz: the across vector).
+    // Raw distances first (w: the spacing neighbour's, xyz: the across vector). In the tree's
+    // own order, as estimateNormals queries: each thread's queries stay close together and
+    // their nodes in the cache (a streamed view of 1 M Autzen points: 0.58-0.70 s of queries in
+    // the file's order, 0.53-0.56 s in the tree's).
     std::vector<NearestIndices> nearest(positions.size());
-    inParallel(positions.size(), [&](std::size_t i) {
+    constexpr std::size_t kQueriesPerBlock = 4096;
+    inParallelBlocks(positions.size(), kQueriesPerBlock, [&](std::size_t query) {
+        const std::size_t i = tree.vAcc[query];
         Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
         if (!std::isfinite(found.spacingNeighbour)) {
             found.nearest.fill(static_cast<std::uint32_t>(i));
