@@ -130,6 +130,10 @@ int Viewer::run() {
         bool exiting = exitRequested_ || glfwWindowShouldClose(context_.window()) == GLFW_TRUE;
         if (pendingOpen_) {
             startLoading(*std::exchange(pendingOpen_, std::nullopt));
+        } else if (!loading_ && initialScanShown_ && settings_.streaming.lod != openedLod_) {
+            // Streamed or whole is decided when a scan opens: the panel's, a script's or a
+            // loaded file's change opens it again.
+            startLoading(status_.scanSource);
         }
         finishLoading();
         refineStreamedView();
@@ -137,7 +141,7 @@ int Viewer::run() {
         const double now = glfwGetTime();
         const double seconds = now - lastFrameTime_;
         lastFrameTime_ = now;
-        const bool showing = renderer_ != nullptr && !awaitingViewNodes();
+        const bool showing = renderer_ != nullptr && !awaitingScan();
         if (showing && !exiting) {
             runScript();
             flyWithKeys(seconds);
@@ -400,6 +404,7 @@ void Viewer::flyWithKeys(double seconds) {
 void Viewer::startLoading(const std::string& source) {
     // Replacing a running job cancels it (its destructor waits for the thread).
     loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming);
+    openedLod_ = settings_.streaming.lod;
     status_.loadingSource = source;
     // The first scan opens with the program (GLFW's clock starts at its initialisation).
     openedAt_ = initialScanShown_ ? glfwGetTime() : 0.0;
@@ -444,8 +449,8 @@ bool Viewer::fading() const {
            crossFade_.active(renderer_->resources().texture("image"), glfwGetTime());
 }
 
-bool Viewer::awaitingViewNodes() const {
-    return unattended_ && streamed_ && (refining_ || dueRefinement());
+bool Viewer::awaitingScan() const {
+    return unattended_ && (loading_ || (streamed_ && (refining_ || dueRefinement())));
 }
 
 void Viewer::finishLoading() {
@@ -577,7 +582,7 @@ void Viewer::refineStreamedView() {
     }
     // Interactive: once the camera has rested a moment, so that an orbit does not start a
     // load at every step; the view the scan opens with at once. Unattended (scripts, tests):
-    // at once (awaitingViewNodes).
+    // at once (awaitingScan).
     const double now = glfwGetTime();
     if (!stillCamera_ || !sameCamera(*stillCamera_, *camera)) {
         stillCamera_ = camera;

@@ -104,10 +104,10 @@ class Viewer {
     /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
     /// start afresh), or another set of the streamed scan's nodes (the view stays).
     void show(PreparedScan prepared, bool newScan);
-    /// An unattended run (script, frame limit) is waiting for a streamed view's nodes: its
-    /// frames show the overview meanwhile but do not count, so every counted frame shows what
-    /// `subscan render` would.
-    bool awaitingViewNodes() const;
+    /// An unattended run (script, frame limit) is waiting for a scan that opens again or for a
+    /// streamed view's nodes: its frames show what is there meanwhile but do not count, so
+    /// every counted frame shows what `subscan render` would.
+    bool awaitingScan() const;
     /// A cross-fade to a streamed view's new nodes is under way: frames are drawn until it ends.
     bool fading() const;
     /// After a frame was shown: when the scan's first picture and its view's nodes came.
@@ -198,6 +198,7 @@ class Viewer {
     std::uint64_t refinedBudget_ = 0;  // the settings' point budget it was refined with
     bool viewNodesShown_ = false;      // a view's own nodes came since the scan opened
     double openedAt_ = 0.0;            // glfwGetTime() when the scan on screen began to open
+    lod::LodMode openedLod_ = lod::LodMode::Auto;  // the streaming.lod it was opened with
     bool initialScanShown_ = false;
     std::optional<std::string> pendingOpen_;
 

@@ -247,10 +247,9 @@ void ViewerPanel::drawScan(const PanelStatus& status, StreamingSettings& streami
         const auto lodName = [](lod::LodMode mode) { return nameOf(lod::kLodModeNames, mode); };
         constexpr lod::LodMode kLodModes[] = {lod::LodMode::Auto, lod::LodMode::On,
                                               lod::LodMode::Off};
-        if (choiceCombo("levels of detail", streaming.lod, std::span<const lod::LodMode>(kLodModes),
-                        lodName)) {
-            requests.openScan = status.scanSource;  // the file opens again, streamed or whole
-        }
+        // The viewer opens the scan again when this changes.
+        choiceCombo("levels of detail", streaming.lod, std::span<const lod::LodMode>(kLodModes),
+                    lodName);
         helpTooltip(
             "auto: COPC files and EPT datasets stream by their levels of detail, the view's "
             "nodes within the point budget; every other file loads whole. on: only streamed "
