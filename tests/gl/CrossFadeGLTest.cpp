@@ -50,11 +50,20 @@ TEST(CrossFadeGLTest, MixesThePicturesInLinearLightAndEndsOnTime) {
     CrossFade fade{ShaderSources()};
     const std::vector<float> oldValues = picture(1), newValues = picture(2);
     const Texture oldPicture = texture(oldValues), newPicture = texture(newValues);
-    const double start = 100.0;
-    fade.start(oldPicture, start);
-    EXPECT_TRUE(fade.active(newPicture, start));
+    fade.start(oldPicture);
+    // Started, not yet blended: under way however long the new picture's first frame takes.
+    EXPECT_TRUE(fade.active(newPicture, 1000.0));
     const Texture otherSize(TextureFormat::RGBA8, kWidth + 1, kHeight, "test.resized");
-    EXPECT_FALSE(fade.active(otherSize, start));  // the window changed: nothing to fade from
+    EXPECT_FALSE(fade.active(otherSize, 0.0));  // the window changed: nothing to fade from
+    // The first blend shows the old picture and starts the fade's clock.
+    const double start = 100.0;
+    const std::vector<std::uint8_t> first = fade.blend(newPicture, start).readRgba8();
+    int notOld = 0;
+    for (std::size_t i = 0; i < first.size(); ++i) {
+        // One step: the sRGB round trip through linear light on the GPU.
+        notOld += std::abs(first[i] - static_cast<int>(std::lround(oldValues[i] * 255.0f))) > 1;
+    }
+    EXPECT_EQ(notOld, 0);
     const double now = start + kCrossFadeSeconds * 0.4;
     const float weight = static_cast<float>(crossFadeWeight(now - start));
     const std::vector<std::uint8_t> blended = fade.blend(newPicture, now).readRgba8();

@@ -14,23 +14,28 @@ double crossFadeWeight(double elapsed) {
 CrossFade::CrossFade(const ShaderSources& sources)
     : program_(Program::compute(sources, "viewer/CrossFade.comp")) {}
 
-void CrossFade::start(const Texture& shown, double now) {
+void CrossFade::start(const Texture& shown) {
     if (from_.width() != shown.width() || from_.height() != shown.height()) {
         from_ = Texture(TextureFormat::RGBA8, shown.width(), shown.height(), "cross-fade from");
         blended_ = Texture(TextureFormat::RGBA8, shown.width(), shown.height(), "cross-fade");
     }
     glCopyImageSubData(shown.id(), GL_TEXTURE_2D, 0, 0, 0, 0, from_.id(), GL_TEXTURE_2D, 0, 0, 0, 0,
                        shown.width(), shown.height(), 1);
-    started_ = now;
+    pending_ = true;
+    started_ = -1.0;
 }
 
 bool CrossFade::active(const Texture& image, double now) const {
     // A picture of another size (the window changed) has nothing to fade from.
-    return started_ >= 0.0 && now - started_ < kCrossFadeSeconds &&
+    return (pending_ || (started_ >= 0.0 && now - started_ < kCrossFadeSeconds)) &&
            image.width() == from_.width() && image.height() == from_.height();
 }
 
 const Texture& CrossFade::blend(const Texture& image, double now) {
+    if (pending_) {
+        pending_ = false;
+        started_ = now;
+    }
     program_.use();
     glUniform1f(SUBSCAN_UNIFORM_FADE, static_cast<float>(crossFadeWeight(now - started_)));
     from_.bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);

@@ -491,7 +491,7 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     if (!newScan && !unattended_ && renderer_ && renderedImage_) {
         const Texture& image = renderer_->resources().texture("image");
         const double now = glfwGetTime();
-        crossFade_.start(crossFade_.active(image, now) ? crossFade_.blended() : image, now);
+        crossFade_.start(crossFade_.active(image, now) ? crossFade_.blended() : image);
     } else {
         crossFade_.stop();
     }
@@ -736,9 +736,10 @@ bool Viewer::frameIsStale() const {
                          nlohmann::json(settings).dump() != renderedSettings_;
     // While a view's nodes load, the temporal filter does not refine the picture at rest: the
     // nodes replace it in a moment, and on llvmpipe its frames took the cores their loading
-    // needs.
+    // needs. Nor during a cross-fade: on llvmpipe a filtered frame took 0.25 s at 1280x720,
+    // which left two frames of a 0.3 s fade; the fade's own frames are a blend and a copy.
     return redrawEveryFrame_ || changed ||
-           (filtersTemporally(settings) && renderedImage_ && !refining_ &&
+           (filtersTemporally(settings) && renderedImage_ && !refining_ && !fading() &&
             framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
 }
 
