@@ -1,5 +1,6 @@
 #include "lod/NodeCache.h"
 
+#include <type_traits>
 #include <utility>
 #include <vector>
 

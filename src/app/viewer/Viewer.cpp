@@ -1,13 +1,11 @@
 #include "app/viewer/Viewer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <limits>
 #include <new>
-#include <thread>
 #include <utility>
 
 #include <epoxy/gl.h>
