@@ -68,10 +68,15 @@ void CachedNodeSource::keep(std::size_t index, Entry entry) const {
     if (entry.bytes > byteBudget_ || entries_.contains(index)) {
         return;  // too large to keep, or kept by another thread meanwhile
     }
-    recency_.push_front(index);
-    entry.recency = recency_.begin();
-    usage_.bytes += entry.bytes;
-    entries_.emplace(index, std::move(entry));
+    const auto kept = entries_.emplace(index, std::move(entry)).first;
+    try {
+        recency_.push_front(index);
+    } catch (...) {
+        entries_.erase(kept);  // out of memory: not kept, and no recency without its entry
+        throw;
+    }
+    kept->second.recency = recency_.begin();
+    usage_.bytes += kept->second.bytes;
     ++usage_.nodes;
     while (usage_.bytes > byteBudget_) {
         const std::size_t oldest = recency_.back();

@@ -13,13 +13,9 @@
 namespace subscan::lod {
 
 /// Bytes a decoded node takes in memory: its attribute arrays' elements (not their spare
-/// capacity, which a loaded node does not have).
+/// capacity, which a loaded node does not have, nor the cache's own bookkeeping, a few dozen
+/// bytes a node: the budget is the points').
 std::size_t memoryBytes(const PointCloud& cloud);
-
-/// The nodes a streamed source's cache keeps by default, in bytes. At the software renderer's
-/// budget a view's nodes take about 20 MB (1 M points of position, colour, intensity and
-/// class): this holds some 25 views, and keeps the viewer's memory within the 1.5 GB.
-inline constexpr std::uint64_t kDefaultNodeCacheBytes = std::uint64_t{512} << 20;
 
 /// A node source that keeps the nodes it decoded, the least recently used leaving first once
 /// they take more than a byte budget: a viewer that moves back and forth over a survey decodes

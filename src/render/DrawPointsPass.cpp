@@ -56,6 +56,10 @@ void DrawPointsPass::execute(FrameContext& frame) {
                                   sizeof(std::uint32_t));
         glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(chunk.pointCount));
     }
+    // Detached, so that the vertex array does not keep a replaced cloud's buffers (and, where
+    // they borrow it, its memory) alive (Renderer::replaceCloud).
+    glVertexArrayVertexBuffer(vertexArray_.id(), 0, 0, 0, 3 * sizeof(float));
+    glVertexArrayVertexBuffer(vertexArray_.id(), 1, 0, 0, sizeof(std::uint32_t));
     glBindVertexArray(0);
     glDisable(GL_PROGRAM_POINT_SIZE);
     glDisable(GL_DEPTH_TEST);

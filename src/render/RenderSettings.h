@@ -10,7 +10,6 @@
 
 #include "gpu/GpuClear.h"
 #include "gpu/PassTimer.h"
-#include "lod/NodeCache.h"
 #include "lod/NodeSource.h"
 #include "render/ScatteringSettings.h"
 #include "render/SurfaceSettings.h"
@@ -84,8 +83,11 @@ struct TemporalSettings {
 struct StreamingSettings {
     lod::LodMode lod = lod::LodMode::Auto;
     std::uint64_t pointBudget = 0;
-    /// The viewer's decoded nodes kept in memory (lod::CachedNodeSource), in MiB.
-    std::uint64_t nodeCacheMegabytes = lod::kDefaultNodeCacheBytes >> 20;
+    /// The viewer's decoded nodes kept in memory (lod::CachedNodeSource), in MiB; read when a
+    /// scan opens. At the software renderer's budget a view's nodes take about 20 MiB (1 M
+    /// points of position, colour, intensity and class): 512 holds some 25 views and keeps the
+    /// viewer within 1.5 GB (bench/README.md).
+    std::uint64_t nodeCacheMegabytes = 512;
 
     bool operator==(const StreamingSettings&) const = default;
 };

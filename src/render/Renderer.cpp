@@ -84,15 +84,22 @@ void Renderer::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
 Renderer::~Renderer() = default;
 
 void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
-                            PointMemory memory) {
+                            PointMemory memory, const std::vector<glm::vec3>& normals) {
+    // Everything that can fail (the uploads) first, on the side: a failure leaves the renderer
+    // as it was, reading the old points.
     GpuPointCloud uploaded(cloud, context_.capabilities(), maxChunkPoints_, memory);
-    cloud_ = std::move(uploaded);
-    spacing_ = usableSpacing(cloud, spacing.global);
-    resolutionChooser_ = ResolutionChooser(cloud);
-    cloudBounds_ = cloud.bounds;
+    ResolutionChooser chooser(cloud);
     if (!spacing.local.empty()) {
-        setLocalSpacing(spacing.local);
+        uploaded.setLocalSpacing(spacing.local);
+        chooser.setLocalSpacing(spacing.local);
     }
+    if (!normals.empty()) {
+        uploaded.setNormals(normals);
+    }
+    cloud_ = std::move(uploaded);
+    resolutionChooser_ = std::move(chooser);
+    spacing_ = usableSpacing(cloud, spacing.global);
+    cloudBounds_ = cloud.bounds;
     lightMaps_.forget();
     restartTemporalFilter();
 }

@@ -81,10 +81,12 @@ class Renderer {
     /// does not depend on the points: the compiled passes and the images (the viewer's next
     /// set of a streamed survey's nodes shows a frame sooner, 0.1 s instead of 0.35 s on
     /// llvmpipe at 1280x720). The light maps are built again and the temporal filter starts
-    /// afresh; normals are the cloud's own until setPointNormals() gives others. On failure
-    /// (the GPU cannot hold the points) it throws and keeps rendering the old cloud.
+    /// afresh; normals are `normals` (setPointNormals' form) where given, else the cloud's own.
+    /// On failure (the GPU cannot hold the points) it throws and keeps rendering the old cloud,
+    /// which must then stay where it is.
     void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
-                      PointMemory memory = PointMemory::Copy);
+                      PointMemory memory = PointMemory::Copy,
+                      const std::vector<glm::vec3>& normals = {});
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a
     /// forced raster path the driver lacks) and GL errors inside a pass.

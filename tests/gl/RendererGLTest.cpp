@@ -1,5 +1,6 @@
 // Renderer::replaceCloud: a renderer that drew one cloud and was given another draws what a
-// renderer made for the second one draws, shadows included (its light maps are built again).
+// renderer made for the second one draws, shadows included (its light maps are built again) and
+// through the temporal filter (which starts afresh).
 #include <cstdint>
 #include <cstdlib>
 #include <vector>
@@ -25,6 +26,8 @@ RenderSettings shadowedSurface() {
     light.direction = {0.6f, 0.8f, 0.2f};
     settings.shading.lights = {light};
     settings.shading.shadows = true;
+    // Through the temporal filter: a history of the old cloud must not blend into the new.
+    settings.temporal.enabled = true;
     return settings;
 }
 

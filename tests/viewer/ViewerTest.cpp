@@ -166,7 +166,6 @@ class ViewerTest : public ::testing::Test {
 
     std::string path(std::string_view name) const { return (directory_ / name).string(); }
 
-    /// Settings that turn the viewer's temporal filter off: one frame per change.
     /// The viewer's screenshot `shot`.png is what `subscan render` draws of `scan` with the
     /// camera and settings files written beside it.
     void expectRendersPicture(const std::string& scan, const std::string& shot) const {
@@ -183,6 +182,7 @@ class ViewerTest : public ::testing::Test {
     std::string writeSettings(const std::string& name, const std::string& json) const {
         return directory_.write(name, json).string();
     }
+    /// Settings that turn the viewer's temporal filter off: one frame per change.
     std::string withoutTemporalFilter() const {
         return directory_.write("no-temporal.json", R"({"temporal": {"enabled": false}})").string();
     }

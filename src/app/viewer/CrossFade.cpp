@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "render/RenderPass.h"
 #include "shared/bindings.h"
 
 namespace subscan::viewer {
@@ -43,8 +44,9 @@ const Texture& CrossFade::blend(const Texture& image, double now) {
     blended_.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     Program::dispatch2D(image.width(), image.height(), SUBSCAN_IMAGE_GROUP_SIZE,
                         SUBSCAN_IMAGE_GROUP_SIZE);
-    // The blit that presents it reads the texture as a framebuffer attachment.
-    glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT);
+    // The blit that presents it reads the texture as a framebuffer attachment; the next
+    // start() may copy it, and tests read it back.
+    glMemoryBarrier(kImageWritesBarrier | GL_FRAMEBUFFER_BARRIER_BIT);
     return blended_;
 }
 

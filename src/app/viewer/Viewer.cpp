@@ -129,9 +129,7 @@ int Viewer::run() {
         if (pendingOpen_) {
             startLoading(*std::exchange(pendingOpen_, std::nullopt));
         } else if (!loading_ && initialScanShown_ && settings_.streaming.lod != openedLod_) {
-            // Streamed or whole is decided when a scan opens: the panel's, a script's or a
-            // loaded file's change opens it again.
-            startLoading(status_.scanSource);
+            reopenForLevelsOfDetail();
         }
         finishLoading();
         refineStreamedView();
@@ -139,17 +137,21 @@ int Viewer::run() {
         const double now = glfwGetTime();
         const double seconds = now - lastFrameTime_;
         lastFrameTime_ = now;
-        const bool showing = renderer_ != nullptr && !awaitingScan();
-        if (showing && !exiting) {
+        if (renderer_ && !awaitingScan() && !exiting) {
             runScript();
             flyWithKeys(seconds);
         }
+        // After the script's changes: a frame whose camera or settings it changed waits, with
+        // its screenshots, for the nodes or the scan they need.
+        const bool showing = renderer_ != nullptr && !awaitingScan();
         exiting = exiting || exitRequested_ ||
                   (showing && options_.exitAfterFrames && frame_ + 1 >= *options_.exitAfterFrames);
 
         drawFrame();
-        for (const std::filesystem::path& path : std::exchange(pendingScreenshots_, {})) {
-            writeScreenshot(path);
+        if (showing || exiting) {
+            for (const std::filesystem::path& path : std::exchange(pendingScreenshots_, {})) {
+                writeScreenshot(path);
+            }
         }
         if (exiting && !options_.screenshotAtExit.empty()) {
             writeScreenshot(options_.screenshotAtExit);
@@ -162,11 +164,15 @@ int Viewer::run() {
         if (exiting) {
             if (unattended_ && streamed_) {
                 const lod::CachedNodeSource::Usage cache = streamed_->usage();
+                const auto timeOf = [](double value) {
+                    return value > 0.0 ? fmt::format("{:.2f} s", value) : std::string("not yet");
+                };
                 fmt::print(stderr,
-                           "subscan: {}: first picture {:.2f} s after opening, the view's nodes "
-                           "{:.2f} s; node cache {:.0f} of {:.0f} MiB, {} nodes read, {} reused\n",
-                           status_.scanSource, status_.firstPictureSeconds,
-                           status_.viewCompleteSeconds, cache.bytes / 1048576.0,
+                           "subscan: {}: first picture {} after opening, the view's nodes {}; "
+                           "node cache {:.0f} of {:.0f} MiB, {} node loads read the file, {} "
+                           "did not\n",
+                           status_.scanSource, timeOf(status_.firstPictureSeconds),
+                           timeOf(status_.viewCompleteSeconds), cache.bytes / 1048576.0,
                            streamed_->byteBudget() / 1048576.0, cache.misses, cache.hits);
             }
             return 0;
@@ -399,9 +405,13 @@ void Viewer::flyWithKeys(double seconds) {
 
 // ---- loading ---------------------------------------------------------------------------------
 
-void Viewer::startLoading(const std::string& source) {
-    // Replacing a running job cancels it (its destructor waits for the thread).
+void Viewer::startLoading(const std::string& source, bool reopening) {
+    // Replacing a running job cancels it (its destructor waits for the thread); so does
+    // dropping a view's, whose nodes belong to the scan on screen.
     loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming);
+    refining_.reset();
+    status_.streamingView = false;
+    reopening_ = reopening;
     openedLod_ = settings_.streaming.lod;
     status_.loadingSource = source;
     // The first scan opens with the program (GLFW's clock starts at its initialisation).
@@ -409,6 +419,21 @@ void Viewer::startLoading(const std::string& source) {
     status_.firstPictureSeconds = 0.0;
     status_.viewCompleteSeconds = 0.0;
     viewNodesShown_ = false;
+}
+
+void Viewer::reopenForLevelsOfDetail() {
+    // Streamed or whole is decided when a scan opens: the panel's, a script's or a loaded
+    // file's change opens it again, where that changes which it is. A streamed scan stays
+    // streamed under `auto` and `on`; a scan `auto` loaded whole is not COPC or EPT, and
+    // stays whole under `off` (`on` opens it again, to refuse it).
+    const lod::LodMode wanted = settings_.streaming.lod;
+    const bool same = streamed_ ? wanted != lod::LodMode::Off
+                                : openedLod_ != lod::LodMode::Off && wanted == lod::LodMode::Off;
+    if (same) {
+        openedLod_ = shownLod_ = wanted;
+        return;
+    }
+    startLoading(status_.scanSource, true);
 }
 
 void Viewer::warmUpRenderer() {
@@ -448,7 +473,9 @@ bool Viewer::fading() const {
 }
 
 bool Viewer::awaitingScan() const {
-    return unattended_ && (loading_ || (streamed_ && (refining_ || dueRefinement())));
+    return unattended_ &&
+           (loading_ || (initialScanShown_ && settings_.streaming.lod != openedLod_) ||
+            (streamed_ && (refining_ || dueRefinement())));
 }
 
 void Viewer::finishLoading() {
@@ -467,6 +494,8 @@ void Viewer::finishLoading() {
         if (!initialScanShown_) {
             throw;  // nothing to show: the command fails as `subscan render` would
         }
+        // The scan on screen stays, and so does the mode it was opened with.
+        settings_.streaming.lod = openedLod_ = shownLod_;
         fail(error.what());
     }
 }
@@ -482,7 +511,9 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     std::optional<std::pair<glm::dvec3, glm::dvec3>> look =
         newScan ? sensorLook(prepared.scan, up) : sensorLook_;
     std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
-    const Coloring coloring = newScan ? options_.coloring : status_.coloring;
+    // A scan opened again (another streaming.lod) keeps the view and the colouring.
+    const bool keepView = !newScan || reopening_;
+    const Coloring coloring = keepView ? status_.coloring : options_.coloring;
     prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);
     // Interactive: what was on screen fades into the new nodes' picture (unattended runs show
     // what `render` would at once).
@@ -496,19 +527,20 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     // The renderer reads the points where they are (no copy where the driver allows): the
     // scan stays at its address until the renderer reads another. One renderer for every scan
     // and view (its passes compiled and images made once); a failure to take the new points
-    // keeps the old ones on screen.
+    // keeps the old ones on screen, where they are.
     auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
     if (renderer_) {
-        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow);
+        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.normals);
     } else if (warmRenderer_) {
-        warmRenderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow);
+        warmRenderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.normals);
         renderer_ = std::move(warmRenderer_);
     } else {
-        renderer_ =
+        auto renderer =
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
-    }
-    if (!prepared.normals.empty()) {
-        renderer_->setPointNormals(prepared.normals);
+        if (!prepared.normals.empty()) {
+            renderer->setPointNormals(prepared.normals);
+        }
+        renderer_ = std::move(renderer);
     }
     scan_ = std::move(scan);
     scanColors_ = std::move(fileColors);
@@ -538,9 +570,12 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     status_.scanFormat =
         prepared.scan.formatDetail.empty() ? prepared.scan.format : prepared.scan.formatDetail;
     status_.loadMilliseconds = prepared.scan.loadMilliseconds;
-    const glm::ivec2 size = viewportSize();
-    camera_ =
-        ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1), framingBounds(cloud));
+    if (!reopening_) {
+        const glm::ivec2 size = viewportSize();
+        camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
+                               framingBounds(cloud));
+    }
+    shownLod_ = openedLod_;
     glfwSetWindowTitle(context_.window(), ("subscan: " + prepared.source).c_str());
     initialScanShown_ = true;
 }
@@ -779,7 +814,12 @@ void Viewer::drawFrame() {
     if (renderer_ && renderedImage_) {
         const Texture& image = renderer_->resources().texture("image");
         const double now = glfwGetTime();
-        context_.presentImage(crossFade_.active(image, now) ? crossFade_.blend(image, now) : image);
+        if (crossFade_.active(image, now)) {
+            context_.presentImage(crossFade_.blend(image, now));
+        } else {
+            crossFade_.stop();  // over, or the window changed size
+            context_.presentImage(image);
+        }
     } else {
         context_.clearWindow(settings_.raster.backgroundSrgb);
     }

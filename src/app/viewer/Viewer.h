@@ -94,7 +94,11 @@ class Viewer {
     bool panelTakes(const glm::dvec2& cursor) const;
 
     void waitForEvents();
-    void startLoading(const std::string& source);
+    /// `reopening`: the scan on screen opens again (another streaming.lod), keeping its view
+    /// and colouring.
+    void startLoading(const std::string& source, bool reopening = false);
+    /// Opens the scan again where streaming.lod changed which it is, streamed or whole.
+    void reopenForLevelsOfDetail();
     /// While the first scan loads on its own thread: a renderer of a placeholder renders one
     /// frame that is not shown, so that its passes are compiled and its images made by the
     /// time the scan comes (show() gives it the scan). On llvmpipe the first frame of a new
@@ -198,7 +202,9 @@ class Viewer {
     std::uint64_t refinedBudget_ = 0;  // the settings' point budget it was refined with
     bool viewNodesShown_ = false;      // a view's own nodes came since the scan opened
     double openedAt_ = 0.0;            // glfwGetTime() when the scan on screen began to open
-    lod::LodMode openedLod_ = lod::LodMode::Auto;  // the streaming.lod it was opened with
+    lod::LodMode openedLod_ = lod::LodMode::Auto;  // the streaming.lod of the last opening
+    lod::LodMode shownLod_ = lod::LodMode::Auto;   // that of the scan on screen
+    bool reopening_ = false;                       // the opening under way keeps the view
     bool initialScanShown_ = false;
     std::optional<std::string> pendingOpen_;
 
