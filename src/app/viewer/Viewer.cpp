@@ -596,6 +596,17 @@ std::optional<Camera> Viewer::dueRefinement() const {
 void Viewer::refineStreamedView() {
     if (refining_) {
         if (!refining_->finished()) {
+            // Interactive: the view's first nodes while the rest load (unattended runs wait
+            // for the whole view, which is what `render` draws).
+            if (!unattended_) {
+                if (std::optional<PreparedScan> partial = refining_->takePartial()) {
+                    try {
+                        show(std::move(*partial), false);
+                    } catch (const Error& error) {
+                        fail(error.what());
+                    }
+                }
+            }
             return;
         }
         const std::unique_ptr<StreamedViewJob> job = std::move(refining_);
@@ -629,7 +640,7 @@ void Viewer::refineStreamedView() {
     const std::uint64_t budget =
         lod::pointBudgetFor(settings_.streaming.pointBudget, context_.capabilities().software);
     refining_ = std::make_unique<StreamedViewJob>(streamed_, status_.scanSource, *camera, budget,
-                                                  streamedNodes_);
+                                                  streamedNodes_, partialViewPoints(budget));
     status_.streamingView = true;
 }
 
