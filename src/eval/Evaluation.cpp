@@ -6,6 +6,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -247,18 +248,23 @@ class StreamedPoints {
     std::unique_ptr<lod::NodeSource> source_;  // declared after the folder: closed before it goes
 };
 
-/// The nodes a view selects, with a renderer of their own prepared as `render` prepares a
-/// streamed view.
+/// The nodes a view selects (or several views: one set for all), with the spacing and normals
+/// `render` gives a streamed view and a renderer of their own.
 struct StreamedView {
-    StreamedView(GlContext& context, const StreamedPoints& points, const Camera& camera,
-                 std::uint64_t budget, NormalSource normals)
+    StreamedView(GlContext& context, const StreamedPoints& points, std::span<const Camera> cameras,
+                 std::uint64_t budget, NormalSource requested)
         : scan(lod::loadStreamedScan(points.source(),
-                                     lod::selectNodes(points.source(), camera, budget))),
-          renderer(std::make_unique<Renderer>(
-              context, scan.cloud, estimatePointSpacing(scan.cloud, scan.levelSpacing))) {
-        renderer->prepareNormals(scan.cloud, streamedNormals(normals));
+                                     lod::selectNodes(points.source(), cameras, budget))),
+          spacing(estimatePointSpacing(scan.cloud, scan.levelSpacing)),
+          normals(normalsFor(scan.cloud, streamedNormals(requested))),
+          renderer(std::make_unique<Renderer>(context, scan.cloud, spacing)) {
+        if (!normals.empty()) {
+            renderer->setPointNormals(normals);
+        }
     }
     LoadedScan scan;
+    PointSpacing spacing;
+    std::vector<glm::vec3> normals;  // empty where none are estimated
     std::unique_ptr<Renderer> renderer;
 };
 
@@ -324,7 +330,7 @@ EvaluationReport evaluate(GlContext& context, const Scene& truth, const PointClo
         surfaceSettings.temporal.enabled = false;  // one frame per view (eval --temporal has it)
         std::optional<StreamedView> streamedView;
         if (streamed) {
-            streamedView.emplace(context, *streamed, camera, *settings.pointBudget,
+            streamedView.emplace(context, *streamed, std::span(&camera, 1), *settings.pointBudget,
                                  render.surface.normals);
             report.surfacePoints += static_cast<double>(streamedView->scan.cloud.size()) / views;
         }
@@ -420,27 +426,20 @@ TemporalReport evaluateTemporal(GlContext& context, const Scene& truth, const Po
     }
     const PointSpacing spacing = estimatePointSpacing(points);
     Renderer renderer(context, points, spacing);  // the baselines' (and the surface's, whole)
-    std::optional<LoadedScan> streamed;
+    std::optional<StreamedView> streamed;
     if (settings.pointBudget) {
-        const StreamedPoints indexed(points);
-        streamed = lod::loadStreamedScan(
-            indexed.source(), lod::selectNodes(indexed.source(), cameras, *settings.pointBudget));
+        streamed.emplace(context, StreamedPoints(points), cameras, *settings.pointBudget,
+                         render.surface.normals);
     }
-    const PointCloud& surfacePoints = streamed ? streamed->cloud : points;
-    const PointSpacing surfaceSpacing =
-        streamed ? estimatePointSpacing(streamed->cloud, streamed->levelSpacing) : spacing;
-    std::optional<Renderer> streamedRenderer;
-    if (streamed) {
-        streamedRenderer.emplace(context, surfacePoints, surfaceSpacing);
-    }
-    Renderer& surfaceRenderer = streamedRenderer ? *streamedRenderer : renderer;
+    const PointCloud& surfacePoints = streamed ? streamed->scan.cloud : points;
+    const PointSpacing& surfaceSpacing = streamed ? streamed->spacing : spacing;
+    Renderer& surfaceRenderer = streamed ? *streamed->renderer : renderer;
     // Their own renderers, so the filter's histories run on undisturbed by the other methods.
     Renderer filtered(context, surfacePoints, surfaceSpacing);
     Renderer converged(context, surfacePoints, surfaceSpacing);
-    const NormalSource normalSource =
-        streamed ? streamedNormals(render.surface.normals) : render.surface.normals;
-    if (const std::vector<glm::vec3> normals = normalsFor(surfacePoints, normalSource);
-        !normals.empty()) {
+    const std::vector<glm::vec3> normals =
+        streamed ? streamed->normals : normalsFor(points, render.surface.normals);
+    if (!normals.empty()) {
         for (Renderer* each : {&surfaceRenderer, &filtered, &converged}) {
             each->setPointNormals(normals);
         }

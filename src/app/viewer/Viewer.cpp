@@ -128,7 +128,7 @@ int Viewer::run() {
         bool exiting = exitRequested_ || glfwWindowShouldClose(context_.window()) == GLFW_TRUE;
         if (pendingOpen_) {
             startLoading(*std::exchange(pendingOpen_, std::nullopt));
-        } else if (!loading_ && initialScanShown_ && settings_.streaming.lod != openedLod_) {
+        } else if (!loading_ && levelsOfDetailChanged()) {
             reopenForLevelsOfDetail();
         }
         finishLoading();
@@ -472,10 +472,13 @@ bool Viewer::fading() const {
            crossFade_.active(renderer_->resources().texture("image"), glfwGetTime());
 }
 
+bool Viewer::levelsOfDetailChanged() const {
+    return initialScanShown_ && settings_.streaming.lod != openedLod_;
+}
+
 bool Viewer::awaitingScan() const {
     return unattended_ &&
-           (loading_ || (initialScanShown_ && settings_.streaming.lod != openedLod_) ||
-            (streamed_ && (refining_ || dueRefinement())));
+           (loading_ || levelsOfDetailChanged() || (streamed_ && (refining_ || dueRefinement())));
 }
 
 void Viewer::finishLoading() {

@@ -97,6 +97,8 @@ class Viewer {
     /// `reopening`: the scan on screen opens again (another streaming.lod), keeping its view
     /// and colouring.
     void startLoading(const std::string& source, bool reopening = false);
+    /// streaming.lod differs from the one the scan on screen was opened with.
+    bool levelsOfDetailChanged() const;
     /// Opens the scan again where streaming.lod changed which it is, streamed or whole.
     void reopenForLevelsOfDetail();
     /// While the first scan loads on its own thread: a renderer of a placeholder renders one
