@@ -63,52 +63,6 @@ vec2 meanPointPosition(uint onLevel, ivec2 texel, uint index) {
     return (vec2(texel) + inTexel) * float(1u << onLevel);
 }
 
-/// cos 67.5 degrees. Eight cones this wide around the directions leave one wholly on the far
-/// side of any straight line through a pixel (each open half-plane holds a direction within
-/// 22.5 degrees of its normal, and 22.5 + 67.5 = 90), so a pixel beyond a straight outline
-/// finds no points in that direction; any narrower cone would turn away more true gaps.
-const float kEnclosingConeCos = 0.38268343;
-
-/// Whether the points of the texel beside `own` on `onLevel` (>= 2, laid out as `place`), in
-/// direction k, lie in that direction as seen from `centre` (window coordinates, inside
-/// `own`): within the cone above around it, judged by their mean position
-/// (MinDepthPyramid.comp). A coarse texel beside the viewpoint's reaches up to 90 degrees to
-/// either side of the direction, so without this a pixel beyond a sparse cloud's outline
-/// found points "around" it in texels that hold them only on the cloud's side, and the fill
-/// ran past the outline in the coarse texels' blocks. Beyond the image the surface goes on,
-/// but counts only where the border lies within `borderReach` pixels, or where `own`'s points
-/// lie in the direction: a coarse level's texel beside the border reaches far into the picture
-/// (once the fill looked a level beyond the gap's, the corners between a sphere's silhouette
-/// and the border filled).
-bool enclosesTowards(vec2 centre, ivec2 own, int k, uint onLevel, LevelLayout place,
-                     float borderReach) {
-    ivec2 texel = own + kDirections[k];
-    vec2 direction = vec2(kDirections[k]);
-    if (!insideLevel(place, texel)) {
-        // How far along the direction the image ends.
-        vec2 size = vec2(pyramid.levels[0].yz);
-        vec2 toBorder = mix(centre, size - centre, greaterThan(direction, vec2(0.0)));
-        float distance = min(direction.x != 0.0 ? toBorder.x : kInfinity,
-                             direction.y != 0.0 ? toBorder.y : kInfinity);
-        if (distance * length(direction) <= borderReach) {
-            return true;
-        }
-        // Farther, where the points of the pixel's own texel on this level, which the border
-        // cuts, lie towards it: the surface reaches the border there. A sparse ground seen at
-        // a slant left bands of background beside the border where its gap's next row lay
-        // beyond twice the gap (StreamedSurfaceGLTest), while between an object's outline and
-        // the border, this texel's points lie on the object's side.
-        texel = own;
-    }
-    uint index = texelIndex(place, texel);
-    // A texel of the walk above the finest weighted one may hold no points.
-    if (isinf(texelFetch(minDepthTexels, int(index)).r)) {
-        return false;
-    }
-    vec2 offset = meanPointPosition(onLevel, texel, index) - centre;
-    return dot(offset, direction) > kEnclosingConeCos * length(offset) * length(direction);
-}
-
 /// Whether `texel` of `onLevel` (>= 1, laid out as `place`) lies in the image and holds
 /// points; `offset`: their mean position (meanPointPosition) less `centre`.
 bool pointsOf(uint onLevel, LevelLayout place, ivec2 texel, vec2 centre, out vec2 offset) {
@@ -122,6 +76,28 @@ bool pointsOf(uint onLevel, LevelLayout place, ivec2 texel, vec2 centre, out vec
     }
     offset = meanPointPosition(onLevel, texel, index) - centre;
     return true;
+}
+
+/// Whether the points of `texel` on `onLevel` (>= 2, at `index`) may enclose a gap on that
+/// level by their own spacing: the level is at most one beyond their own expected gap's, as
+/// sparseEnclosure's search is for the pixel's. A pixel in a gap takes the spacing of the finest
+/// texel above it that holds points, which over sparse ground is a coarse one: where it held
+/// one stray point far from the rest (a return beside a river, a scan's fringe), every pixel of
+/// that texel searched as far as that point's spacing said, found the ground around it in
+/// every direction, and the texel filled as one square (`render lone_star.laz --yaw 30
+/// --pitch 35`). Texels without visible points (hidden ones only) count as they are.
+bool enclosesOnItsOwnGap(uint onLevel, uint index) {
+    if (surface.spacing.x < 0.5) {
+        return true;
+    }
+    vec2 pulled = texelFetch(pullWeightTexels, int(index)).rg;
+    if (!(pulled.x > 0.0)) {
+        return true;
+    }
+    float ratio = max(pulled.y / pulled.x, 1.0);
+    float ownGapLevel =
+        levelForRadius(surface.fill.x * ratio, texelFetch(minDepthTexels, int(index)).r);
+    return float(onLevel) <= ceil(max(ownGapLevel, 1.0)) + 1.0;
 }
 
 /// Whether the 3x3 texels of `onLevel` (>= 1, laid out as `place`) around the one holding
@@ -204,14 +180,31 @@ bool pointAcrossWithin(vec2 centre, float radius, vec2 across, float alongGap) {
 /// alone, unscaled, fattened the bunny's vertices at 512x512 from leakage 0.005 to 0.037).
 const float kBeyondOutermostPoints = SUBSCAN_BEYOND_OUTERMOST_POINTS;
 
+/// sparseEnclosure's near cones are 44 degrees wide, not 45: a mean (nearly) on a direction
+/// encloses that one alone, not also the two at exactly 45 degrees, which float rounding would
+/// decide either way.
+const float kConeMargin = 1.0 / 45.0;
+
 /// What the level-1 texel `texel` (whose reach is `reach`) adds to its pixels' gap test
 /// (fillsGap), judged from its centre at its own complete depth and spacing ratio: bit k for
-/// direction k, whose points on some level from 2 up to one beyond the expected gap's lie in
-/// its cone (enclosesTowards: the fill stays within the points' convex hull); bit 8 where a
-/// point lies within kBeyondOutermostPoints of the gap. Once per level-1 texel instead of per
-/// pixel: on llvmpipe, where every lane of a group runs a loop any of them enters, the walk
-/// over levels and the 18 texels near a point per pixel took FillRemoval from 19.7 to 45.8
-/// ms at 1920x1080 (the Happy Buddha). Its pixels lie within 0.71 pixels of the centre.
+/// direction k, enclosed by points on some level from 2 up to one beyond the expected gap's;
+/// bit 8 where a point lies within kBeyondOutermostPoints of the gap. A level's points enclose
+/// a direction where the mean position of a texel's points (MinDepthPyramid.comp) lies within
+/// 1.5 of the level's texels of the centre and within 44 degrees of the direction (each mean so
+/// encloses the directions on either side of it), or within 2 texels and 22.5 degrees (the
+/// direction nearest it). Eight such cones leave one wholly on the far side of any straight
+/// line through the centre (an open half-plane holds a direction within 22.5 degrees of its
+/// normal, and 22.5 + 44 < 90), so nothing beyond a straight outline fills: the fill stays
+/// inside the points' convex hull. The distance, measured from the centre over the 5x5 texels
+/// around its own, makes the filled region's outline follow the points: the rule before looked
+/// at the 8 texels beside the centre's own, the same for every pixel of it, and sparse surfaces
+/// ended in squares of coarse texels. The far, narrow cones reach the next row of a plane seen
+/// at a grazing angle, whose rows lie farther apart on screen than its spacing says
+/// (StreamedSurfaceGLTest); wide ones that far fill a sculpture's notches (leakage 0.0062 ->
+/// 0.0080; docs/pipeline.md). Once per level-1 texel instead of per pixel: on llvmpipe, where
+/// every lane of a group runs a loop any of them enters, the walk over levels per pixel took
+/// FillRemoval from 19.7 to 45.8 ms at 1920x1080 (the Happy Buddha). Its pixels lie within 0.71
+/// pixels of the centre.
 uint sparseEnclosure(ivec2 texel, uint reach) {
     uint index = texelIndex(1u, texel);
     float depth = pushValueAt(index).x;
@@ -224,32 +217,59 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
     float gapLevel = levelForRadius(surface.fill.x * spacingRatio, depth);
     // One level more than the gap's (at least 1: its texels bridge one-pixel gaps between
     // dense points): a texel on the gap's level beside the pixel's own holds a point of the
-    // next row only where the rows fall that way, which the pull weight's spread used to
-    // paper over (without it coverage fell to 0.97 on the bunny's vertices at 512x512, 0.95
-    // near the station); the cone keeps the coarser level from reaching past the outline.
-    // kNoReach never counts: it could only mean the top level, whose one texel has no
-    // neighbours.
+    // next row only where the rows fall that way (without it coverage fell to 0.97 on the
+    // bunny's vertices at 512x512, 0.95 near the station); the cones keep the coarser level
+    // from reaching past the outline. kNoReach never counts: it could only mean the top level.
     uint levels = min(uint(ceil(clamp(gapLevel, 1.0, float(levelCount() - 1u)))) + 1u,
                       min(kNoReach - 1u, levelCount() - 1u));
     // Twice the gap: the points that enclose a pixel lie up to about that far (the level
     // beyond the gap's), and a pixel 1.5 pixels from the border between points 2.2 pixels
-    // apart must still count it (SurfaceCloseUpGLTest).
+    // apart must still count it (SurfaceCloseUpGLTest). Beyond the image the surface goes on.
     float borderReach = 2.0 * exp2(gapLevel);
     vec2 centre = (vec2(texel) + 0.5) * 2.0;
+    vec2 size = vec2(pyramid.levels[0].yz);
+    // Directions its pixels find on levels 0 and 1 (a neighbour on level 1 is weighted) need
+    // nothing more; the walk starts on the finest level weighted in a direction still open.
     uint enclosure = 0u;
+    uint first = kNoReach;
     for (int k = 0; k < 8; ++k) {
-        // From the finest weighted level on (levels 0 and 1 the pixels count themselves):
-        // the finest texel's points may lie beside the direction where a coarser texel's do
-        // not.
+        vec2 direction = vec2(kDirections[k]);
+        vec2 toBorder = mix(centre, size - centre, greaterThan(direction, vec2(0.0)));
+        float distance = min(direction.x != 0.0 ? toBorder.x : kInfinity,
+                             direction.y != 0.0 ? toBorder.y : kInfinity);
         uint finest = (reach >> (4 * k)) & 0xFu;
-        if (finest < 2u || finest > levels) {
-            continue;
+        if (finest <= 1u || distance * length(direction) <= borderReach) {
+            enclosure |= 1u << k;
+        } else {
+            first = min(first, finest);
         }
-        LevelLayout place = levelLayout(finest);
-        for (uint l = finest; l <= levels; ++l, place = nextLevel(place)) {
-            if (enclosesTowards(centre, texel >> (l - 1u), k, l, place, borderReach)) {
-                enclosure |= 1u << k;
-                break;
+    }
+    first = max(first, 2u);
+    LevelLayout place = levelLayout(min(first, levelCount() - 1u));
+    for (uint l = first; l <= levels && enclosure != 0xFFu; ++l, place = nextLevel(place)) {
+        float texelSize = float(1u << l);
+        ivec2 corner = ivec2(centre / texelSize) - 2;
+        for (int j = 0; j < 25; ++j) {
+            ivec2 around = corner + ivec2(j % 5, j / 5);
+            vec2 offset;
+            if (!pointsOf(l, place, around, centre, offset) ||
+                dot(offset, offset) > 4.0 * texelSize * texelSize || offset == vec2(0.0)) {
+                continue;
+            }
+            // In 45 degree sectors from direction 0 (kDirections turns by 45 each): the
+            // directions on either side of the mean, each where it lies within its cone (44
+            // degrees within 1.5 texels, 22.5 within 2).
+            float sector = atan(offset.y, offset.x) * (4.0 / kPi) + 8.0;
+            uint before = uint(sector) & 7u;
+            uint after = (before + 1u) & 7u;
+            float past = fract(sector);
+            bool close = dot(offset, offset) <= 2.25 * texelSize * texelSize;
+            float margin = close ? kConeMargin : 0.5;
+            uint directions = (past < 1.0 - margin ? 1u << before : 0u) |
+                              (past > margin ? 1u << after : 0u);
+            if ((directions & ~enclosure) != 0u &&
+                enclosesOnItsOwnGap(l, texelIndex(place, around))) {
+                enclosure |= directions;
             }
         }
     }

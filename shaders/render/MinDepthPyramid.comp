@@ -3,7 +3,7 @@
 // minimum of its 2x2 children on level R-1 (children past an odd edge simply do not exist).
 // Levels from 1 on also record where in a texel its points lie ("pointCentroids": the mean of
 // the children's that hold points; on level 1 the pixels' centres), for fill removal's
-// outline (FillRemoval.glsl's enclosesTowards). Children count alike, not by their points:
+// outline (FillRemoval.glsl's sparseEnclosure). Children count alike, not by their points:
 // any such mean lies inside the points' convex hull, which is all the outline needs. With the
 // local spacing, every level also records the spacing ratio of its nearest points
 // ("frontSpacing", level 0 from the "color" image's alpha), for hidden point removal.

@@ -53,7 +53,6 @@ layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outSingl
 layout(binding = SUBSCAN_IMAGE_OUT2, rgba32f) writeonly uniform image2D outSigmaSPrime;
 layout(binding = SUBSCAN_IMAGE_OUT3, rgba32f) writeonly uniform image2D outSigmaA;
 
-const float kPi = 3.14159265358979;
 // The march looks for the entry up to where the light is down to e^-6 (0.25 %) of itself.
 const float kExtinctionDepths = 6.0;
 const int kRefinements = 8;  // bisections of the step that crossed the surface, at most

@@ -6,6 +6,7 @@ layout(std140, binding = SUBSCAN_UBO_FRAME) uniform FrameBlock {
 };
 
 const float kInfinity = uintBitsToFloat(0x7F800000u);
+const float kPi = 3.14159265358979;
 
 ivec2 imageSizeOfFrame() { return ivec2(frame.viewport.xy); }
 

@@ -151,9 +151,11 @@ TEST(LidarEvaluationGLTest, AStreamedOrbitDrawsOneSetOfNodesAndStaysAsSteady) {
 }
 
 TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
-    // At 320 px the far ground's rings lie several pixels apart: the global h (the spacing
-    // near the station) leaves them apart, the local spacing closes them.
-    SyntheticSource source = makeSyntheticSource("outdoor-station?points=100000");
+    // At 320 px the far ground's rings of 50,000 points lie several pixels apart: the global h
+    // (the spacing near the station) leaves them apart, the local spacing closes them. (With
+    // 100,000 points the gap test, which looks up to 2 texels beyond the pixel, closes most of
+    // them with h alone since 2026-12-06: coverage 0.945.)
+    SyntheticSource source = makeSyntheticSource("outdoor-station?points=50000");
     source.points.normals.clear();  // the scanner's true ones: eval estimates its own
     const EvaluationSettings settings = viewsNearTheScanner(source, 2, 320);
     RenderSettings local;
@@ -164,13 +166,13 @@ TEST(LidarEvaluationGLTest, LocalSpacingFillsTheStationsSparseFarField) {
     const EvaluationReport withGlobal =
         evaluate(test::glTestContext(), *source.scene, source.points, settings, global);
     // docs/eval.md's targets (coverage >= 0.97, leakage <= 0.03, occlusion errors <= 0.01) with a
-    // margin for two small views instead of four at 1024 px (measured 2026-12-03: 0.992,
-    // 0.007, 0.008 against the global h's 0.780, 0.000, 0.004).
+    // margin for two small views instead of four at 1024 px (measured 2026-12-06: 0.995,
+    // 0.006, 0.0004 against the global h's 0.780, 0.000, 0.0002).
     EXPECT_GE(withLocal.surface.coverage, 0.96);
     EXPECT_LE(withLocal.surface.leakage, 0.03);
     EXPECT_LE(withLocal.surface.occlusionErrorRate, 0.015);
     EXPECT_GT(withLocal.surface.coverage, withGlobal.surface.coverage + 0.1);
-    EXPECT_GT(withLocal.surface.psnrDb, withGlobal.surface.psnrDb + 3.0);  // measured +7.7 dB
+    EXPECT_GT(withLocal.surface.psnrDb, withGlobal.surface.psnrDb + 3.0);  // measured +9.7 dB
 }
 
 TEST(LidarEvaluationGLTest, OrbitViewsLookDownAtTheWholeStationScene) {
