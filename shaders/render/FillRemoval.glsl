@@ -84,8 +84,10 @@ bool pointsOf(uint onLevel, LevelLayout place, ivec2 texel, vec2 centre, out vec
 /// texel above it that holds points, which over sparse ground is a coarse one: where it held
 /// one stray point far from the rest (a return beside a river, a scan's fringe), every pixel of
 /// that texel searched as far as that point's spacing said, found the ground around it in
-/// every direction, and the texel filled as one square (`render lone_star.laz --yaw 30
-/// --pitch 35`). Texels without visible points (hidden ones only) count as they are.
+/// every direction, and the texel filled as one square (`render lone_star.laz --mode surface
+/// --yaw 30 --pitch 35`). The ratio is the pull's: the kernel-weighted mean of the visible
+/// points' in and beside the texel. Texels it gives no weight (hidden points only, away from
+/// visible ones) count as they are.
 bool enclosesOnItsOwnGap(uint onLevel, uint index) {
     if (surface.spacing.x < 0.5) {
         return true;
@@ -252,8 +254,11 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
         for (int j = 0; j < 25; ++j) {
             ivec2 around = corner + ivec2(j % 5, j / 5);
             vec2 offset;
+            // A mean at the centre has no direction (its 16-bit position in the texel would
+            // give it one at random).
             if (!pointsOf(l, place, around, centre, offset) ||
-                dot(offset, offset) > 4.0 * texelSize * texelSize || offset == vec2(0.0)) {
+                dot(offset, offset) > 4.0 * texelSize * texelSize ||
+                dot(offset, offset) <= 1e-4 * texelSize * texelSize) {
                 continue;
             }
             // In 45 degree sectors from direction 0 (kDirections turns by 45 each): the

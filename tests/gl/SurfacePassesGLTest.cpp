@@ -831,9 +831,11 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
             const glm::dvec2 offset = inputs.centroids[texelAt(l, qx, qy)] - centre;
             const double distance = glm::length(offset) / size;
             // 16-bit positions in the texel and float arithmetic on the GPU.
-            bool maybe = std::abs(distance - 2.0) < 1e-3;
+            // A mean at the centre has no direction (FillRemoval.glsl skips those within 0.01
+            // texel).
+            bool maybe = std::abs(distance - 2.0) < 1e-3 || std::abs(distance - 0.01) < 1e-3;
             const bool nearMaybe = std::abs(distance - 1.5) < 1e-3;
-            if ((distance > 2.0 && !maybe) || distance == 0.0) {
+            if ((distance > 2.0 || distance < 0.01) && !maybe) {
                 continue;
             }
             const glm::vec2 texel = inputs.pulled[texelAt(l, qx, qy)];
@@ -864,9 +866,13 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
                 const bool inFar = farWithin > 0.0;
                 // Either cone may decide, where the distance or the angle is this close to a
                 // limit.
-                const bool unsure = maybe || (nearMaybe && inNear != inFar) ||
-                                    (distance <= 1.5 + 1e-3 && std::abs(nearWithin) < 1e-3) ||
-                                    (distance > 1.5 - 1e-3 && std::abs(farWithin) < 1e-3);
+                // The GPU's 16-bit positions in the texel turn a short offset by up to about
+                // 3e-5 / distance of a sector.
+                const double angleTolerance = 1e-3 + 3e-5 / distance;
+                const bool unsure =
+                    maybe || (nearMaybe && inNear != inFar) ||
+                    (distance <= 1.5 + 1e-3 && std::abs(nearWithin) < angleTolerance) ||
+                    (distance > 1.5 - 1e-3 && std::abs(farWithin) < angleTolerance);
                 if (inNear || inFar) {
                     (unsure ? maybeBy : enclosedBy)[k] = true;
                 } else if (unsure) {
@@ -1210,9 +1216,6 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     EXPECT_GT(hiddenKept, 10);
 }
 
-// The outline's sub-pixel cells pass from the raster to the mask in the "occupancy" buffer:
-// declared where a frame's settings use it, so that PassRunner refuses a frame that would read
-// an earlier frame's cells.
 /// The fill removal's mask of a `size` x `size` frame of `depth` and `color` (RGBA, alpha the
 /// spacing ratio) through the passes before it.
 std::vector<float> fillMaskOf(PassHarness& harness, int size, const std::vector<float>& depth,
@@ -1271,7 +1274,8 @@ TEST(SurfacePassesGLTest, AStrayPointInAHoleFillsNoSquare) {
     // Ground points 2 pixels apart, as dense as h (ratio 1, an expected gap of 2.2 pixels),
     // around a round hole of radius 20 with one stray point in its middle, 4 times as sparse.
     // A pixel in the hole takes the spacing of the finest texel above it that holds points:
-    // around the stray point that is the level-4 texel holding it alone. With the stray point's
+    // around the stray point that is the level-4 texel holding it alone (its pulled ratio
+    // near 4: the pull's kernel reaches the ground only at the hole's edge). With the stray point's
     // spacing the gap test searched up to level 5, found the ground in every direction and
     // filled that texel whole: a 16x16 square floating in the hole (measured before the texels'
     // own gaps limited them: all 255 of its pixels, 147 beyond the stray point's reach). Now within
@@ -1280,6 +1284,7 @@ TEST(SurfacePassesGLTest, AStrayPointInAHoleFillsNoSquare) {
     constexpr int kSize = 128;
     RenderSettings settings = makeHarness().settings();
     PassHarness harness(kSize, kSize, settings, kSpacing, 50.0, true);
+    harness.setSparseSpacingRatio(4.0f);
     const float depthOfPlane = static_cast<float>(kSpacing * harness.focal() / 2.2);
     const double strayRatio = 4.0;
     const glm::dvec2 holeCentre(56.0, 56.0);
@@ -1409,6 +1414,9 @@ TEST(SurfacePassesGLTest, TheLocalSpacingsBuffersAreDeclaredWhereTheyAreUsed) {
     }
 }
 
+// The outline's sub-pixel cells pass from the raster to the mask in the "occupancy" buffer:
+// declared where a frame's settings use it, so that PassRunner refuses a frame that would read
+// an earlier frame's cells.
 TEST(SurfacePassesGLTest, TheOutlinesCellsAreDeclaredWhereTheyAreUsed) {
     PassHarness harness = makeHarness();
     const RasterizePointsPass raster(harness.sources(), test::glTestContext().capabilities());
