@@ -703,12 +703,12 @@ double cpuSpacingRatio(const std::vector<glm::vec2>& pulled, bool local, int x, 
     return cpuSpacingRatioFrom(pulled, local, 0, x, y);
 }
 
-/// What FillRemoval.glsl's fillsGap reads: the pull weights w (level 0: the visibility), the
-/// min-depth pyramid, finite wherever a point lies, hidden ones too, where each texel's points
-/// lie (cpuPointCentroids of that pyramid), and per level-1 texel its complete depth (the
-/// push) and spacing ratio, at which sparseEnclosure judges it.
+/// What FillRemoval.glsl's fillsGap reads: the pull weights w and w * ratio (level 0: the
+/// visibility), whether the frame uses the local spacing, the min-depth pyramid, finite wherever a
+/// point lies, hidden ones too, where each texel's points lie (cpuPointCentroids of that pyramid),
+/// and per level-1 texel its complete depth (the push) and spacing ratio, at which sparseEnclosure
+/// judges it.
 struct FillInputs {
-    std::vector<float> weights;
     std::vector<glm::vec2> pulled;  // w, w * spacing ratio, on every level
     bool localSpacing = false;
     std::vector<double> minDepth;
@@ -738,7 +738,7 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
     const auto visibleUnder = [&](int l, int qx, int qy) {
         for (int py = qy << l; py < std::min((qy + 1) << l, kHeight); ++py) {
             for (int px = qx << l; px < std::min((qx + 1) << l, kWidth); ++px) {
-                if (inputs.weights[py * kWidth + px] > 0.0f) {
+                if (inputs.pulled[py * kWidth + px].x > 0.0f) {
                     return true;
                 }
             }
@@ -751,7 +751,7 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
             return true;
         }
         if (l == 0) {
-            return inputs.weights[texelAt(0, qx, qy)] > 0.0f;
+            return inputs.pulled[texelAt(0, qx, qy)].x > 0.0f;
         }
         return hiddenEnclose ? std::isfinite(inputs.minDepth[texelAt(l, qx, qy)])
                              : visibleUnder(l, qx, qy);
@@ -976,16 +976,8 @@ FillInputs fillInputsOf(const std::vector<glm::vec2>& pulled, const FrameResourc
     const std::vector<float> pyramid = resources.buffer("pyramid").read<float>();
     const auto pushed = resources.buffer("pushValues").read<glm::vec4>();
     const auto axisSums = resources.buffer("pullAxes").read<glm::vec4>();
-    FillInputs inputs{std::vector<float>(pulled.size()),
-                      pulled,
-                      local,
-                      std::vector<double>(pyramid.begin(), pyramid.end()),
-                      {},
-                      {},
-                      {},
-                      {}};
-    std::transform(pulled.begin(), pulled.end(), inputs.weights.begin(),
-                   [](const glm::vec2& texel) { return texel.x; });
+    FillInputs inputs{pulled, local, std::vector<double>(pyramid.begin(), pyramid.end()), {}, {},
+                      {},     {}};
     inputs.centroids = cpuPointCentroids(inputs.minDepth);
     const Level levelOne = levels()[1];
     for (int y = 0; y < levelOne.height; ++y) {
@@ -1043,7 +1035,7 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalMaskMatchesExceptTies) {
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
-            bool expected = inputs.weights[i] > 0.0f;  // a visible point of its own
+            bool expected = inputs.pulled[i].x > 0.0f;  // a visible point of its own
             if (!inRegion(x, y)) {
                 ++outsideRegion;
             } else if (!expected) {
@@ -1147,7 +1139,6 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     const FrameResources& resources = harness.resources();
     const auto pulled = resources.buffer("pullWeights").read<glm::vec2>();
     const FillInputs inputs = fillInputsOf(pulled, resources, GetParam());
-    const std::vector<float>& weights = inputs.weights;
     const std::vector<float> filled = resources.texture("filledDepth").readFloats();
     const std::vector<float> mask = resources.texture("mask").readFloats();
     const auto cellsAt = [&](int x, int y) { return std::popcount(cells[y * kWidth + x]); };
@@ -1157,8 +1148,8 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     for (int y = 0; y < kHeight; ++y) {
         for (int x = 0; x < kWidth; ++x) {
             const int i = y * kWidth + x;
-            const bool hiddenOnly = !(weights[i] > 0.0f) && cellsAt(x, y) > 0;
-            if (!(weights[i] > 0.0f) && !hiddenOnly) {
+            const bool hiddenOnly = !(inputs.pulled[i].x > 0.0f) && cellsAt(x, y) > 0;
+            if (!(inputs.pulled[i].x > 0.0f) && !hiddenOnly) {
                 continue;  // the gap rule, tested above
             }
             int densest = cellsAt(x, y);

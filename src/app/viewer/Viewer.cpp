@@ -532,11 +532,13 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     // and view (its passes compiled and images made once); a failure to take the new points
     // keeps the old ones on screen, where they are.
     auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
+    if (!renderer_) {
+        // The first scan: the warmed-up renderer where there is one (a failure here ends the
+        // program, as nothing is on screen).
+        renderer_ = std::move(warmRenderer_);
+    }
     if (renderer_) {
         renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.normals);
-    } else if (warmRenderer_) {
-        warmRenderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.normals);
-        renderer_ = std::move(warmRenderer_);
     } else {
         auto renderer =
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
