@@ -786,8 +786,11 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
     const int maxLevel = std::min({static_cast<int>(std::ceil(level)) + 1, top, 14});
     const glm::dvec2 centre((tx + 0.5) * 2.0, (ty + 0.5) * 2.0);
     // Directions the texel's neighbours on level 1 enclose, or whose image border lies within
-    // twice the gap; the others from their finest weighted level on (at least 2).
+    // twice the gap; the others from their finest weighted level on (at least 2). Those whose
+    // border lies within 3 gaps are enclosed also by points that reach it (nearBorder).
+    const double gap = std::exp2(raw);
     bool enclosedBy[8] = {};
+    bool nearBorder[8] = {};
     // Directions a mean this close to a limit (of distance, angle or level) may enclose on the
     // GPU or not: float arithmetic and 16-bit positions in the texel. Only where they decide
     // the outcome is the pixel a tie.
@@ -799,10 +802,12 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
         const double toY = d.y > 0 ? kHeight - centre.y : centre.y;
         const double distance =
             std::min(d.x != 0 ? toX : kInf, d.y != 0 ? toY : kInf) * glm::length(d);
-        const double borderReach = 2.0 * std::exp2(raw);
-        tie = tie || std::abs(distance - borderReach) < 1e-4 * borderReach;
+        const double borderReach = 2.0 * gap;
+        tie = tie || std::abs(distance - borderReach) < 1e-4 * borderReach ||
+              std::abs(distance - 3.0 * gap) < 1e-4 * gap;
         enclosedBy[k] =
             weighted(1, tx + directions[k][0], ty + directions[k][1]) || distance <= borderReach;
+        nearBorder[k] = !enclosedBy[k] && distance <= 3.0 * gap;
         for (int l = 2; l <= top && !enclosedBy[k]; ++l) {
             if (weighted(l, (tx >> (l - 1)) + directions[k][0],
                          (ty >> (l - 1)) + directions[k][1])) {
@@ -859,6 +864,37 @@ std::optional<bool> cpuFillsGap(const PassHarness& harness, const FillInputs& in
                                                         {(before + 1) % 8, past - margin}};
             const std::pair<int, double> farCones[] = {{before, 0.5 - past},
                                                        {(before + 1) % 8, past - 0.5}};
+            // Points that reach the border of a direction within 3 gaps of it: within a gap
+            // and half a texel of that border, 67.5 degrees of the direction, and not behind
+            // the centre by more than the pull keeps.
+            const double texelDepth = inputs.minDepth[texelAt(l, qx, qy)];
+            const double behindAllowed =
+                surface.pullDepthSlope * glm::length(offset) * depth / harness.focal();
+            const double behind = texelDepth - depth;
+            const glm::dvec2 position = centre + offset;
+            const double cos67 = std::cos(67.5 * std::numbers::pi / 180.0);
+            for (int k = 0; k < 8; ++k) {
+                if (!nearBorder[k]) {
+                    continue;
+                }
+                const glm::dvec2 d(directions[k][0], directions[k][1]);
+                const double toX = d.x > 0 ? kWidth - position.x : position.x;
+                const double toY = d.y > 0 ? kHeight - position.y : position.y;
+                const double toBorder = std::min(d.x != 0 ? toX : kInf, d.y != 0 ? toY : kInf);
+                const double reach = gap + 0.5 * size;
+                const double cone = glm::dot(offset, d) / (glm::length(offset) * glm::length(d));
+                // Each limit as sure (0), unsure (1: this close to it; 16-bit positions in
+                // the texel move a mean by about 1e-3 texel) or failed (2).
+                const auto limit = [](double value, double bound, double tolerance) {
+                    return std::abs(value - bound) < tolerance ? 1 : value <= bound ? 0 : 2;
+                };
+                const int worst = std::max(
+                    {limit(toBorder, reach, 1e-3 * size), limit(cos67, cone, 1e-3),
+                     limit(behind, behindAllowed, 1e-4 * (depth + behindAllowed)), maybe ? 1 : 0});
+                if (worst < 2) {
+                    (worst == 0 ? enclosedBy : maybeBy)[k] = true;
+                }
+            }
             for (int c = 0; c < 2; ++c) {
                 const auto [k, nearWithin] = nearCones[c];
                 const double farWithin = farCones[c].second;
