@@ -143,45 +143,65 @@ void GpuPointCloud::setColors(const std::vector<Rgba8>& colors) {
     }
 }
 
-void GpuPointCloud::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
-    if (spacing.size() != size_) {
-        throw Error(fmt::format("local spacing for {} points given to a cloud of {}",
-                                spacing.size(), size_));
-    }
-    std::vector<glm::u16vec4> halves;
-    for (Chunk& chunk : chunks_) {
-        halves.resize(chunk.pointCount);
-        for (std::uint32_t i = 0; i < chunk.pointCount; ++i) {
-            halves[i] = glm::u16vec4(glm::packHalf(spacing[chunk.firstPoint + i]));
-        }
-        chunk.localSpacing =
-            Buffer::fromSpan(std::span<const glm::u16vec4>(halves), "points.localSpacing");
-    }
-    hasLocalSpacing_ = true;
+PackedLocalSpacing packLocalSpacing(const std::vector<glm::vec4>& spacing) {
+    PackedLocalSpacing packed;
+    packed.halves.resize(spacing.size());
+    std::transform(spacing.begin(), spacing.end(), packed.halves.begin(),
+                   [](const glm::vec4& entry) { return glm::u16vec4(glm::packHalf(entry)); });
     std::vector<float> ratios(spacing.size());
     std::transform(spacing.begin(), spacing.end(), ratios.begin(), [](const glm::vec4& entry) {
         return std::max(entry.w, glm::length(glm::vec3(entry)));
     });
-    sparseSpacingRatio_ = 1.0f;
     if (!ratios.empty()) {
         const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
                                                    0.999 * static_cast<double>(ratios.size() - 1));
         std::nth_element(ratios.begin(), quantile, ratios.end());
-        sparseSpacingRatio_ = std::max(1.0f, *quantile);
+        packed.sparseSpacingRatio = std::max(1.0f, *quantile);
     }
+    return packed;
+}
+
+std::vector<std::uint32_t> packNormals(const std::vector<glm::vec3>& normals) {
+    std::vector<std::uint32_t> packed(normals.size());
+    std::transform(normals.begin(), normals.end(), packed.begin(), packNormal);
+    return packed;
+}
+
+PackedPointAttributes packPointAttributes(const std::vector<glm::vec4>& spacing,
+                                          const std::vector<glm::vec3>& normals) {
+    return {packLocalSpacing(spacing), packNormals(normals)};
+}
+
+void GpuPointCloud::setLocalSpacing(const std::vector<glm::vec4>& spacing) {
+    setLocalSpacing(packLocalSpacing(spacing));
+}
+
+void GpuPointCloud::setLocalSpacing(const PackedLocalSpacing& spacing) {
+    if (spacing.halves.size() != size_) {
+        throw Error(fmt::format("local spacing for {} points given to a cloud of {}",
+                                spacing.halves.size(), size_));
+    }
+    for (Chunk& chunk : chunks_) {
+        chunk.localSpacing = Buffer::fromSpan(
+            std::span<const glm::u16vec4>(&spacing.halves[chunk.firstPoint], chunk.pointCount),
+            "points.localSpacing");
+    }
+    hasLocalSpacing_ = true;
+    sparseSpacingRatio_ = spacing.sparseSpacingRatio;
 }
 
 void GpuPointCloud::setNormals(const std::vector<glm::vec3>& normals) {
-    if (normals.size() != size_) {
-        throw Error(fmt::format("{} normals given to a cloud of {} points", normals.size(), size_));
+    setNormals(packNormals(normals));
+}
+
+void GpuPointCloud::setNormals(const std::vector<std::uint32_t>& packed) {
+    if (packed.size() != size_) {
+        throw Error(fmt::format("{} normals given to a cloud of {} points", packed.size(), size_));
     }
-    std::vector<std::uint32_t> packed;
     for (Chunk& chunk : chunks_) {
-        packed.resize(chunk.pointCount);
-        for (std::uint32_t i = 0; i < chunk.pointCount; ++i) {
-            packed[i] = packNormal(normals[chunk.firstPoint + i]);
-        }
-        chunk.normals = Buffer::fromSpan(std::span<const std::uint32_t>(packed), "points.normals");
+        chunk.normals = Buffer::fromSpan(
+            std::span<const std::uint32_t>(&packed[chunk.firstPoint], chunk.pointCount),
+            "points.normals");
     }
     hasNormals_ = true;
 }

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/ext/vector_uint4_sized.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -12,6 +13,27 @@
 #include "gpu/GlObjects.h"
 
 namespace subscan {
+
+/// A cloud's local spacing (estimateLocalSpacing's, one entry per point) as the GPU reads it:
+/// four half floats a point, and the ratio GpuPointCloud::sparseSpacingRatio reports.
+struct PackedLocalSpacing {
+    std::vector<glm::u16vec4> halves;  // empty: no local spacing
+    float sparseSpacingRatio = 1.0f;
+};
+PackedLocalSpacing packLocalSpacing(const std::vector<glm::vec4>& spacing);
+/// packNormal of each.
+std::vector<std::uint32_t> packNormals(const std::vector<glm::vec3>& normals);
+
+/// What a GpuPointCloud uploads of a cloud beside its positions and colours, packed as the GPU
+/// reads it. Packing is a pass over every point that callers may do off the render thread: for a
+/// viewer's view of a million points it took 30 to 65 ms of the frame the view arrived in.
+struct PackedPointAttributes {
+    PackedLocalSpacing localSpacing;
+    std::vector<std::uint32_t> normals;  // packNormal's, one per point; empty: none given
+};
+/// `spacing`'s local spacing and `normals` (unit or 0, one per point, or empty) packed.
+PackedPointAttributes packPointAttributes(const std::vector<glm::vec4>& spacing,
+                                          const std::vector<glm::vec3>& normals);
 
 /// Whether a GpuPointCloud copies the cloud's points or reads the caller's arrays in place.
 enum class PointMemory {
@@ -46,8 +68,9 @@ class GpuPointCloud {
 
     /// Replaces the points' colours (sRGB-encoded, one per point), e.g. for another colouring.
     void setColors(const std::vector<Rgba8>& colors);
-    /// Uploads estimateLocalSpacing's result, one entry per point.
+    /// Uploads estimateLocalSpacing's result, one entry per point, packed here or beforehand.
     void setLocalSpacing(const std::vector<glm::vec4>& spacing);
+    void setLocalSpacing(const PackedLocalSpacing& spacing);
     bool hasLocalSpacing() const { return hasLocalSpacing_; }
     /// The local spacing ratio (a point's spacing or its across-lines vector, in h) that all
     /// points but the sparsest 0.1 % stay within, 1 without local spacing: how far the fill
@@ -57,8 +80,9 @@ class GpuPointCloud {
     /// took 5 % longer.
     float sparseSpacingRatio() const { return sparseSpacingRatio_; }
     /// Uploads one normal per point (unit length, or 0 where none is known); the constructor
-    /// uploads the cloud's own.
+    /// uploads the cloud's own. Packed here, or beforehand (packNormal's, one per point).
     void setNormals(const std::vector<glm::vec3>& normals);
+    void setNormals(const std::vector<std::uint32_t>& packed);
     bool hasNormals() const { return hasNormals_; }
     /// True when the positions are read from the cloud's own memory (PointMemory::Borrow on a
     /// driver that allows it).

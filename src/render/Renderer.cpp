@@ -85,16 +85,21 @@ Renderer::~Renderer() = default;
 
 void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
                             PointMemory memory, const std::vector<glm::vec3>& normals) {
+    replaceCloud(cloud, spacing, memory, packPointAttributes(spacing.local, normals));
+}
+
+void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
+                            PointMemory memory, const PackedPointAttributes& packed) {
     // Everything that can fail (the uploads) first, on the side: a failure leaves the renderer
     // as it was, reading the old points.
     GpuPointCloud uploaded(cloud, context_.capabilities(), maxChunkPoints_, memory);
     ResolutionChooser chooser(cloud);
     if (!spacing.local.empty()) {
-        uploaded.setLocalSpacing(spacing.local);
+        uploaded.setLocalSpacing(packed.localSpacing);
         chooser.setLocalSpacing(spacing.local);
     }
-    if (!normals.empty()) {
-        uploaded.setNormals(normals);
+    if (!packed.normals.empty()) {
+        uploaded.setNormals(packed.normals);
     }
     cloud_ = std::move(uploaded);
     resolutionChooser_ = std::move(chooser);

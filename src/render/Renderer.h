@@ -87,6 +87,11 @@ class Renderer {
     void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
                       PointMemory memory = PointMemory::Copy,
                       const std::vector<glm::vec3>& normals = {});
+    /// The same with `spacing.local` and the normals packed beforehand (packPointAttributes),
+    /// e.g. off the render thread, where the viewer's streamed views pack them; no normals in
+    /// `packed`: the cloud's own.
+    void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing, PointMemory memory,
+                      const PackedPointAttributes& packed);
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a
     /// forced raster path the driver lacks) and GL errors inside a pass.

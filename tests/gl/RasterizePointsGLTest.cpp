@@ -348,6 +348,28 @@ TEST(RasterizePointsGLTest, PackedNormalsKeepTheirDirection) {
     EXPECT_EQ(unpackNormal(0u), glm::vec3(0.0f));
 }
 
+TEST(RasterizePointsGLTest, PackedLocalSpacingKeepsItsValuesAndSkipsTheSparsest) {
+    // 1,000 points: the ratio that 99.9 % stay within ignores one sparse point, not two.
+    std::vector<glm::vec4> spacing(1000, glm::vec4(0.0f, 0.0f, 0.0f, 1.5f));
+    spacing[10] = glm::vec4(0.0f, 0.0f, 0.0f, 40.0f);
+    EXPECT_EQ(packLocalSpacing(spacing).sparseSpacingRatio, 1.5f);
+    // Along an across vector (3, 4, 0): its length, 5, beats w; below 1 the ratio is 1.
+    spacing[20] = glm::vec4(3.0f, 4.0f, 0.0f, 2.0f);
+    for (glm::vec4& entry : spacing) {
+        entry.w = std::min(entry.w, 0.5f);
+    }
+    spacing[10].w = 40.0f;
+    const PackedLocalSpacing packed = packLocalSpacing(spacing);
+    EXPECT_EQ(packed.sparseSpacingRatio, 5.0f);
+    spacing[10].w = 0.5f;
+    EXPECT_EQ(packLocalSpacing(spacing).sparseSpacingRatio, 1.0f);
+    ASSERT_EQ(packed.halves.size(), spacing.size());
+    // Half floats hold these values exactly.
+    EXPECT_EQ(glm::unpackHalf(packed.halves[20]), glm::vec4(3.0f, 4.0f, 0.0f, 0.5f));
+    EXPECT_EQ(glm::unpackHalf(packed.halves[10]), glm::vec4(0.0f, 0.0f, 0.0f, 40.0f));
+    EXPECT_TRUE(packLocalSpacing({}).halves.empty());
+}
+
 INSTANTIATE_TEST_SUITE_P(RasterizePointsGLTest, RasterPathGLTest,
                          ::testing::Values(RasterPath::TwoPass32, RasterPath::Int64),
                          [](const ::testing::TestParamInfo<RasterPath>& tested) {

@@ -55,6 +55,7 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
     prepared.normals = normalsFor(
         prepared.scan.cloud,
         prepared.streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto, cancelled);
+    prepared.packed = packPointAttributes(prepared.spacing.local, prepared.normals);
     return !cancelled();
 }
 

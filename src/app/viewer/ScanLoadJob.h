@@ -3,15 +3,19 @@
 #include <atomic>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "app/viewer/BackgroundJob.h"
+#include "core/Coloring.h"
 #include "core/LocalSpacing.h"
 #include "io/ScanLoader.h"
 #include "lod/NodeCache.h"
+#include "render/GpuPointCloud.h"
 #include "render/RenderSettings.h"
 
 namespace subscan::viewer {
@@ -23,6 +27,11 @@ struct PreparedScan {
     LoadedScan scan;
     PointSpacing spacing;  // estimatePointSpacing's result (h = 0: the renderer picks one)
     std::vector<glm::vec3> normals;  // normalsFor(cloud, auto): empty where none are estimated
+    PackedPointAttributes packed;    // the local spacing and `normals` as the GPU reads them
+    /// The points' colours as the viewer shows them under `coloredBy` (pointColors), where the
+    /// job knew how it colours them; else empty, and the viewer colours them itself.
+    std::vector<Rgba8> displayColors;
+    std::optional<std::pair<Coloring, UpAxis>> coloredBy;
     /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
     /// it (the overview when first opened, then the nodes a view shows). Null: loaded whole.
     std::shared_ptr<const lod::CachedNodeSource> streamed;
@@ -30,8 +39,9 @@ struct PreparedScan {
 };
 
 /// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as
-/// Renderer::prepareNormals does for `auto` (streamedNormals(auto) for a streamed scan), here
-/// off the render thread. Returns false where `cancelled` turned true meanwhile.
+/// Renderer::prepareNormals does for `auto` (streamedNormals(auto) for a streamed scan), and
+/// packs them for the GPU, here off the render thread. Returns false where `cancelled` turned
+/// true meanwhile.
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled);
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)

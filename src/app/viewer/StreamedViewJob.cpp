@@ -36,12 +36,13 @@ std::vector<std::size_t> partialViewEnds(std::span<const lod::StreamedNode> all,
 StreamedViewJob::StreamedViewJob(std::shared_ptr<const lod::CachedNodeSource> source,
                                  std::string sourceName, const Camera& camera,
                                  std::uint64_t pointBudget, std::vector<std::size_t> shown,
-                                 std::uint64_t partialPoints)
+                                 std::pair<Coloring, UpAxis> coloredBy, std::uint64_t partialPoints)
     : source_(std::move(source)),
       sourceName_(std::move(sourceName)),
       camera_(camera),
       pointBudget_(pointBudget),
       shown_(std::move(shown)),
+      coloredBy_(coloredBy),
       partialPoints_(partialPoints),
       job_(sourceName_,
            [this](const std::function<bool()>& cancelled) { return load(cancelled); }) {}
@@ -69,8 +70,16 @@ std::optional<PreparedScan> StreamedViewJob::prepare(std::vector<std::size_t> no
         // No normals either way: a streamed view estimates none (streamedNormals).
         prepared.spacing = withLevelSpacing(PointSpacing{sampleSpacing(prepared.scan.cloud).h, {}},
                                             prepared.scan.levelSpacing);
+        prepared.packed = packPointAttributes(prepared.spacing.local, {});
     } else if (!prepareForRenderer(prepared, cancelled)) {
         return std::nullopt;
+    }
+    try {
+        prepared.displayColors =
+            pointColors(prepared.scan.cloud, coloredBy_.first, coloredBy_.second);
+        prepared.coloredBy = coloredBy_;
+    } catch (const Error&) {
+        // What the colouring lacks: the viewer says so when it colours the points itself.
     }
     if (cancelled && cancelled()) {
         return std::nullopt;

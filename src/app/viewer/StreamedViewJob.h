@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/viewer/BackgroundJob.h"
@@ -41,9 +42,10 @@ std::vector<std::size_t> partialViewEnds(std::span<const lod::StreamedNode> all,
 class StreamedViewJob {
   public:
     /// `shown`: the nodes on screen now; a view that selects the same ones loads nothing.
+    /// `coloredBy`: how the viewer colours the points (PreparedScan::displayColors).
     StreamedViewJob(std::shared_ptr<const lod::CachedNodeSource> source, std::string sourceName,
                     const Camera& camera, std::uint64_t pointBudget, std::vector<std::size_t> shown,
-                    std::uint64_t partialPoints = 0);
+                    std::pair<Coloring, UpAxis> coloredBy, std::uint64_t partialPoints = 0);
 
     bool finished() const { return job_.finished(); }
     /// Once finished(): the view's nodes prepared, or nullopt where they are the ones shown.
@@ -69,6 +71,7 @@ class StreamedViewJob {
     Camera camera_;
     std::uint64_t pointBudget_;
     std::vector<std::size_t> shown_;
+    std::pair<Coloring, UpAxis> coloredBy_;
     std::uint64_t partialPoints_;
     mutable std::mutex partialMutex_;
     std::optional<PreparedScan> partial_;

@@ -513,11 +513,17 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     // Before the cloud moves on: an organised grid's camera is fitted to its points.
     std::optional<std::pair<glm::dvec3, glm::dvec3>> look =
         newScan ? sensorLook(prepared.scan, up) : sensorLook_;
-    std::vector<Rgba8> fileColors = prepared.scan.cloud.colors;
     // A scan opened again (another streaming.lod) keeps the view and the colouring.
     const bool keepView = !newScan || reopening_;
     const Coloring coloring = keepView ? status_.coloring : options_.coloring;
-    prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);
+    std::vector<Rgba8> fileColors;
+    if (prepared.coloredBy == std::pair(coloring, up)) {
+        fileColors = std::move(prepared.scan.cloud.colors);
+        prepared.scan.cloud.colors = std::move(prepared.displayColors);
+    } else {
+        fileColors = prepared.scan.cloud.colors;
+        prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);
+    }
     // Interactive: what was on screen fades into the new nodes' picture (unattended runs show
     // what `render` would at once).
     if (!newScan && !unattended_ && renderer_ && renderedImage_) {
@@ -538,7 +544,7 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
         renderer_ = std::move(warmRenderer_);
     }
     if (renderer_) {
-        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.normals);
+        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.packed);
     } else {
         auto renderer =
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
@@ -644,8 +650,9 @@ void Viewer::refineStreamedView() {
     refinedBudget_ = settings_.streaming.pointBudget;
     const std::uint64_t budget =
         lod::pointBudgetFor(settings_.streaming.pointBudget, context_.capabilities().software);
-    refining_ = std::make_unique<StreamedViewJob>(streamed_, status_.scanSource, *camera, budget,
-                                                  streamedNodes_, partialViewPoints(budget));
+    refining_ = std::make_unique<StreamedViewJob>(
+        streamed_, status_.scanSource, *camera, budget, streamedNodes_,
+        std::pair(status_.coloring, scanUp_), partialViewPoints(budget));
     status_.streamingView = true;
 }
 

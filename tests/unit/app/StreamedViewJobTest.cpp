@@ -5,10 +5,12 @@
 #include <chrono>
 #include <memory>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "core/Coloring.h"
 #include "lod/NodeSelection.h"
 
 namespace subscan::viewer {
@@ -78,7 +80,8 @@ TEST(StreamedViewJobTest, TheJobOffersItsFirstNodesOnTheWayToTheWholeView) {
     const std::vector<std::size_t> ends = partialViewEnds(source->nodes(), whole, 4);
     ASSERT_GE(ends.size(), 2u);
 
-    StreamedViewJob job(source, "small octree", camera, 1000, {}, 4);
+    const std::pair coloredBy(Coloring::Height, UpAxis::Z);
+    StreamedViewJob job(source, "small octree", camera, 1000, {}, coloredBy, 4);
     for (int wait = 0; wait < 10'000 && !job.finished(); ++wait) {
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
@@ -95,15 +98,28 @@ TEST(StreamedViewJobTest, TheJobOffersItsFirstNodesOnTheWayToTheWholeView) {
     ASSERT_TRUE(result);
     EXPECT_EQ(result->nodes, whole);
     EXPECT_GT(result->scan.cloud.size(), partial->scan.cloud.size());
+    // Each set comes coloured as the viewer asked and packed for the GPU, off its thread.
+    for (const PreparedScan* prepared : {&*partial, &*result}) {
+        EXPECT_EQ(prepared->coloredBy, coloredBy);
+        EXPECT_EQ(prepared->displayColors,
+                  pointColors(prepared->scan.cloud, coloredBy.first, coloredBy.second));
+        EXPECT_EQ(prepared->packed.localSpacing.halves.size(), prepared->spacing.local.size());
+    }
 
-    // Without partial sets (llvmpipe's budget) none is offered.
-    StreamedViewJob plain(source, "small octree", camera, 1000, {});
+    // Without partial sets (llvmpipe's budget) none is offered. A colouring the points lack
+    // (they have no RGB) is left to the viewer, which says what is missing.
+    StreamedViewJob plain(source, "small octree", camera, 1000, {},
+                          std::pair(Coloring::Rgb, UpAxis::Z));
     for (int wait = 0; wait < 10'000 && !plain.finished(); ++wait) {
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     ASSERT_TRUE(plain.finished());
     EXPECT_EQ(plain.partialsPrepared(), 0u);
     EXPECT_FALSE(plain.takePartial());
+    std::optional<PreparedScan> uncoloured = plain.take();
+    ASSERT_TRUE(uncoloured);
+    EXPECT_FALSE(uncoloured->coloredBy);
+    EXPECT_TRUE(uncoloured->displayColors.empty());
 }
 
 }  // namespace
