@@ -182,25 +182,29 @@ bool pointAcrossWithin(vec2 centre, float radius, vec2 across, float alongGap) {
 /// alone, unscaled, fattened the bunny's vertices at 512x512 from leakage 0.005 to 0.037).
 const float kBeyondOutermostPoints = SUBSCAN_BEYOND_OUTERMOST_POINTS;
 
-/// How far from the image's border (in gaps) sparseEnclosure looks for points that reach it.
-const float kBorderPointsReach = 3.0;
-/// cos(67.5 degrees): bordersReached's cone about a direction.
-const float kBorderPointsCone = 0.38268343;
+/// How far the image's border lies from `position` along `direction` (one of kDirections): to
+/// the nearer of the borders it meets, across that border.
+float toBorderAlong(vec2 position, vec2 direction) {
+    vec2 size = vec2(pyramid.levels[0].yz);
+    vec2 toBorders = mix(position, size - position, greaterThan(direction, vec2(0.0)));
+    return min(direction.x != 0.0 ? toBorders.x : kInfinity,
+               direction.y != 0.0 ? toBorders.y : kInfinity);
+}
 
 /// The directions among `open` whose image border the points of the texel at `index` reach,
 /// seen from `centre` (sparseEnclosure's): their mean, `offset` from the centre, lies within one
 /// `gap` (in pixels) of that border, plus half a `texelSize` (a mean lies up to that far inside
-/// the texel's points), within 67.5 degrees of the direction (its half of the plane, less the
-/// band along the dividing line), and not behind the centre's `depth` by more than the pull
-/// keeps (surface.fill.z texel widths, here pixels of the offset): a near surface reaching the
-/// border does not let a far one behind the gap close it (a bunny's back against its ear at a
-/// close-up). A surface that runs off the image goes on beyond it, so such a direction is
-/// enclosed; the rule before (the border itself within twice the gap) left holes above the
-/// bottom border of ground seen at a slant, where the rows lie closer on screen than the points
-/// along them and the points below a gap lie beside its downward cone (a jittered grid plane at
-/// 320x240, 27 views: 324 hole pixels, now 10; Autzen's ground alike).
-uint bordersReached(vec2 centre, vec2 offset, uint open, float gap, float texelSize,
-                    float depth, uint index) {
+/// the texel's points), within SUBSCAN_BORDER_POINTS_CONE_DEGREES of the direction (its half of
+/// the plane, less the band along the dividing line), and not behind the centre's `depth` by
+/// more than the pull keeps (surface.fill.z pixel widths per pixel of the offset): a near
+/// surface reaching the border does not let a far one behind the gap close it (a bunny's back
+/// against its ear at a close-up). A surface that runs off the image goes on beyond it, so such
+/// a direction is enclosed; with the border counted within two gaps only, holes showed above
+/// the bottom border of ground seen at a slant, where the rows lie closer on screen than the
+/// points along them and the points below a gap lie beside its downward cone (a jittered grid
+/// plane at 320x240, 27 views: 324 hole pixels, now 10; Autzen's ground alike).
+uint bordersReached(vec2 centre, vec2 offset, uint open, float gap, float texelSize, float depth,
+                    uint index) {
     if (open == 0u) {
         return 0u;
     }
@@ -208,16 +212,13 @@ uint bordersReached(vec2 centre, vec2 offset, uint open, float gap, float texelS
     if (behind > surface.fill.z * length(offset) * projectiveDepth(depth) / frame.depthRange.z) {
         return 0u;
     }
-    vec2 position = centre + offset;
-    vec2 size = vec2(pyramid.levels[0].yz);
+    const float cone = cos(radians(SUBSCAN_BORDER_POINTS_CONE_DEGREES));
     uint reached = 0u;
     for (int k = 0; k < 8; ++k) {
         vec2 direction = vec2(kDirections[k]);
-        vec2 toBorders = mix(position, size - position, greaterThan(direction, vec2(0.0)));
-        float toBorder = min(direction.x != 0.0 ? toBorders.x : kInfinity,
-                             direction.y != 0.0 ? toBorders.y : kInfinity);
-        if ((open & (1u << k)) != 0u && toBorder <= gap + 0.5 * texelSize &&
-            dot(offset, direction) >= kBorderPointsCone * length(offset) * length(direction)) {
+        if ((open & (1u << k)) != 0u &&
+            toBorderAlong(centre + offset, direction) <= gap + 0.5 * texelSize &&
+            dot(offset, direction) >= cone * length(offset) * length(direction)) {
             reached |= 1u << k;
         }
     }
@@ -269,11 +270,10 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
     // Twice the gap: the points that enclose a pixel lie up to about that far (the level
     // beyond the gap's), and a pixel 1.5 pixels from the border between points 2.2 pixels
     // apart must still count it (SurfaceCloseUpGLTest). Beyond the image the surface goes on.
-    // Farther, up to kBorderPointsReach gaps, where points reach the border (bordersReached).
+    // Farther, up to SUBSCAN_BORDER_POINTS_REACH gaps, where points reach it (bordersReached).
     float gap = exp2(gapLevel);
     float borderReach = 2.0 * gap;
     vec2 centre = (vec2(texel) + 0.5) * 2.0;
-    vec2 size = vec2(pyramid.levels[0].yz);
     // Directions its pixels find on levels 0 and 1 (a neighbour on level 1 is weighted) need
     // nothing more; the walk starts on the finest level weighted in a direction still open.
     uint enclosure = 0u;
@@ -281,16 +281,13 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
     uint first = kNoReach;
     for (int k = 0; k < 8; ++k) {
         vec2 direction = vec2(kDirections[k]);
-        vec2 toBorder = mix(centre, size - centre, greaterThan(direction, vec2(0.0)));
-        float distance =
-            min(direction.x != 0.0 ? toBorder.x : kInfinity,
-                direction.y != 0.0 ? toBorder.y : kInfinity) * length(direction);
+        float distance = toBorderAlong(centre, direction) * length(direction);
         uint finest = (reach >> (4 * k)) & 0xFu;
         if (finest <= 1u || distance <= borderReach) {
             enclosure |= 1u << k;
         } else {
             first = min(first, finest);
-            nearBorder |= distance <= kBorderPointsReach * gap ? 1u << k : 0u;
+            nearBorder |= distance <= SUBSCAN_BORDER_POINTS_REACH * gap ? 1u << k : 0u;
         }
     }
     first = max(first, 2u);
@@ -319,10 +316,10 @@ uint sparseEnclosure(ivec2 texel, uint reach) {
             float margin = close ? kConeMargin : 0.5;
             uint directions = (past < 1.0 - margin ? 1u << before : 0u) |
                               (past > margin ? 1u << after : 0u);
+            uint index = texelIndex(place, around);
             directions |= bordersReached(centre, offset, nearBorder & ~enclosure, gap,
-                                         texelSize, depth, texelIndex(place, around));
-            if ((directions & ~enclosure) != 0u &&
-                enclosesOnItsOwnGap(l, texelIndex(place, around))) {
+                                         texelSize, depth, index);
+            if ((directions & ~enclosure) != 0u && enclosesOnItsOwnGap(l, index)) {
                 enclosure |= directions;
             }
         }

@@ -38,6 +38,10 @@ using mat4 = glm::mat4;
 // 1 - 1 / (local spacing ratio) (FillRemoval.glsl's kBeyondOutermostPoints says why and how it
 // was measured); the passes' region (MinDepthPyramidPass) reaches that far beyond the points.
 #define SUBSCAN_BEYOND_OUTERMOST_POINTS 0.75
+// The image border encloses a gap's direction up to this many expected gaps away where points
+// reach it within this many degrees of the direction (FillRemoval.glsl's bordersReached).
+#define SUBSCAN_BORDER_POINTS_REACH 3.0
+#define SUBSCAN_BORDER_POINTS_CONE_DEGREES 67.5
 
 // ---- shader storage blocks (std430) ----
 #define SUBSCAN_SSBO_DEPTH_INDEX 4    // uint64 per pixel: depth bits << 32 | point index

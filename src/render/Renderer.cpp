@@ -94,8 +94,10 @@ void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing
     // as it was, reading the old points.
     GpuPointCloud uploaded(cloud, context_.capabilities(), maxChunkPoints_, memory);
     ResolutionChooser chooser(cloud);
-    if (!spacing.local.empty()) {
+    if (!packed.localSpacing.halves.empty()) {
         uploaded.setLocalSpacing(packed.localSpacing);
+    }
+    if (!spacing.local.empty()) {
         chooser.setLocalSpacing(spacing.local);
     }
     if (!packed.normals.empty()) {

@@ -87,9 +87,9 @@ class Renderer {
     void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
                       PointMemory memory = PointMemory::Copy,
                       const std::vector<glm::vec3>& normals = {});
-    /// The same with `spacing.local` and the normals packed beforehand (packPointAttributes),
-    /// e.g. off the render thread, where the viewer's streamed views pack them; no normals in
-    /// `packed`: the cloud's own.
+    /// The same with `spacing.local` and the normals packed beforehand (packPointAttributes of
+    /// that local spacing, which `packed` must hold), e.g. off the render thread, where the
+    /// viewer packs them; no normals in `packed`: the cloud's own.
     void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing, PointMemory memory,
                       const PackedPointAttributes& packed);
 

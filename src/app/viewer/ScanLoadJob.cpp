@@ -55,8 +55,11 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
     prepared.normals = normalsFor(
         prepared.scan.cloud,
         prepared.streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto, cancelled);
+    if (cancelled()) {
+        return false;
+    }
     prepared.packed = packPointAttributes(prepared.spacing.local, prepared.normals);
-    return !cancelled();
+    return true;
 }
 
 }  // namespace subscan::viewer

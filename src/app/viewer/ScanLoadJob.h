@@ -30,7 +30,7 @@ struct PreparedScan {
     PackedPointAttributes packed;    // the local spacing and `normals` as the GPU reads them
     /// The points' colours as the viewer shows them under `coloredBy` (pointColors), where the
     /// job knew how it colours them; else empty, and the viewer colours them itself.
-    std::vector<Rgba8> displayColors;
+    std::vector<Rgba8> shownColors;
     std::optional<std::pair<Coloring, UpAxis>> coloredBy;
     /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
     /// it (the overview when first opened, then the nodes a view shows). Null: loaded whole.

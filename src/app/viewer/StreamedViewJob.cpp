@@ -75,7 +75,7 @@ std::optional<PreparedScan> StreamedViewJob::prepare(std::vector<std::size_t> no
         return std::nullopt;
     }
     try {
-        prepared.displayColors =
+        prepared.shownColors =
             pointColors(prepared.scan.cloud, coloredBy_.first, coloredBy_.second);
         prepared.coloredBy = coloredBy_;
     } catch (const Error&) {

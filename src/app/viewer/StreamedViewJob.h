@@ -42,7 +42,7 @@ std::vector<std::size_t> partialViewEnds(std::span<const lod::StreamedNode> all,
 class StreamedViewJob {
   public:
     /// `shown`: the nodes on screen now; a view that selects the same ones loads nothing.
-    /// `coloredBy`: how the viewer colours the points (PreparedScan::displayColors).
+    /// `coloredBy`: how the viewer colours the points (PreparedScan::shownColors).
     StreamedViewJob(std::shared_ptr<const lod::CachedNodeSource> source, std::string sourceName,
                     const Camera& camera, std::uint64_t pointBudget, std::vector<std::size_t> shown,
                     std::pair<Coloring, UpAxis> coloredBy, std::uint64_t partialPoints = 0);

@@ -519,7 +519,7 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     std::vector<Rgba8> fileColors;
     if (prepared.coloredBy == std::pair(coloring, up)) {
         fileColors = std::move(prepared.scan.cloud.colors);
-        prepared.scan.cloud.colors = std::move(prepared.displayColors);
+        prepared.scan.cloud.colors = std::move(prepared.shownColors);
     } else {
         fileColors = prepared.scan.cloud.colors;
         prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);

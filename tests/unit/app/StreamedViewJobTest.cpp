@@ -101,9 +101,12 @@ TEST(StreamedViewJobTest, TheJobOffersItsFirstNodesOnTheWayToTheWholeView) {
     // Each set comes coloured as the viewer asked and packed for the GPU, off its thread.
     for (const PreparedScan* prepared : {&*partial, &*result}) {
         EXPECT_EQ(prepared->coloredBy, coloredBy);
-        EXPECT_EQ(prepared->displayColors,
+        EXPECT_EQ(prepared->shownColors,
                   pointColors(prepared->scan.cloud, coloredBy.first, coloredBy.second));
-        EXPECT_EQ(prepared->packed.localSpacing.halves.size(), prepared->spacing.local.size());
+        // The nodes' levels give every point a local spacing, provisional sets too.
+        ASSERT_EQ(prepared->spacing.local.size(), prepared->scan.cloud.size());
+        EXPECT_EQ(prepared->packed.localSpacing.halves,
+                  packLocalSpacing(prepared->spacing.local).halves);
     }
 
     // Without partial sets (llvmpipe's budget) none is offered. A colouring the points lack
@@ -119,7 +122,7 @@ TEST(StreamedViewJobTest, TheJobOffersItsFirstNodesOnTheWayToTheWholeView) {
     std::optional<PreparedScan> uncoloured = plain.take();
     ASSERT_TRUE(uncoloured);
     EXPECT_FALSE(uncoloured->coloredBy);
-    EXPECT_TRUE(uncoloured->displayColors.empty());
+    EXPECT_TRUE(uncoloured->shownColors.empty());
 }
 
 }  // namespace
