@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "core/Error.h"
+#include "core/Spacing.h"
 #include "lod/NodeSelection.h"
 #include "render/Renderer.h"
 
@@ -36,18 +37,32 @@ PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
             prepared.streamed = std::make_shared<lod::CachedNodeSource>(
                 std::move(opened), streaming_.nodeCacheMegabytes << 20);
             prepared.scan = lod::loadStreamedOverview(*prepared.streamed, &prepared.nodes);
-        } else {
-            prepared.scan = loadScan(source_, reportProgress);
+            if (!prepareForRenderer(prepared, cancelled)) {
+                throw LoadCancelled{};
+            }
+            return prepared;
         }
-        if (!prepareForRenderer(prepared, cancelled)) {
-            throw LoadCancelled{};
-        }
+        prepared.scan = loadScan(source_, reportProgress);
+        prepared.spacing = PointSpacing{sampleSpacing(prepared.scan.cloud).h, {}};
+        prepared.provisional = true;
         return prepared;
     } catch (const LoadCancelled&) {
         throw Error(source_ + ": loading was cancelled");
     } catch (const std::bad_alloc&) {
         throw Error(source_ + ": out of memory (the scan is too large for this machine)");
     }
+}
+
+std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
+                                                const std::function<bool()>& cancelled) {
+    CompletedSpacing completed;
+    completed.spacing = estimatePointSpacing(cloud);
+    const std::vector<glm::vec3> normals = normalsFor(cloud, NormalSource::Auto, cancelled);
+    if (cancelled()) {
+        return std::nullopt;
+    }
+    completed.packed = packPointAttributes(completed.spacing.local, normals);
+    return completed;
 }
 
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {

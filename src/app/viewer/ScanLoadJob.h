@@ -32,11 +32,25 @@ struct PreparedScan {
     /// job knew how it colours them; else empty, and the viewer colours them itself.
     std::vector<Rgba8> shownColors;
     std::optional<std::pair<Coloring, UpAxis>> coloredBy;
+    /// A scan loaded whole, with h from a sample only: its local spacing and normals come after
+    /// its first picture (completeSpacing).
+    bool provisional = false;
     /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
     /// it (the overview when first opened, then the nodes a view shows). Null: loaded whole.
     std::shared_ptr<const lod::CachedNodeSource> streamed;
     std::vector<std::size_t> nodes;
 };
+
+/// What a scan loaded whole lacks after its provisional first picture: its spacing (h and the
+/// local spacing) and normals, estimated as prepareForRenderer does, packed for the GPU.
+struct CompletedSpacing {
+    PointSpacing spacing;
+    PackedPointAttributes packed;
+};
+/// Estimates them for `cloud` (read, not changed, while the render thread draws it); nullopt
+/// where `cancelled` turned true meanwhile.
+std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
+                                                const std::function<bool()>& cancelled);
 
 /// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as
 /// Renderer::prepareNormals does for `auto` (streamedNormals(auto) for a streamed scan), and
@@ -46,7 +60,9 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)
 /// while a big file is decoded; a COPC file or EPT dataset only its overview (topLevels), which
-/// StreamedViewJob refines, through a lod::CachedNodeSource that every later view shares.
+/// StreamedViewJob refines, through a lod::CachedNodeSource that every later view shares. A scan
+/// loaded whole comes provisional (h from a sample, no local spacing or normals): its first
+/// picture shows while completeSpacing estimates the rest.
 /// Destroying an unfinished job cancels it at the reader's next progress report and waits for the
 /// thread.
 class ScanLoadJob {

@@ -132,6 +132,7 @@ int Viewer::run() {
             reopenForLevelsOfDetail();
         }
         finishLoading();
+        finishCompleting();
         refineStreamedView();
 
         const double now = glfwGetTime();
@@ -162,11 +163,18 @@ int Viewer::run() {
             ++frame_;
         }
         if (exiting) {
+            const auto timeOf = [](double value) {
+                return value > 0.0 ? fmt::format("{:.2f} s", value) : std::string("not yet");
+            };
+            if (unattended_ && !streamed_) {
+                fmt::print(stderr,
+                           "subscan: {}: first picture {} after opening, with its local spacing "
+                           "and normals {}\n",
+                           status_.scanSource, timeOf(status_.firstPictureSeconds),
+                           timeOf(status_.viewCompleteSeconds));
+            }
             if (unattended_ && streamed_) {
                 const lod::CachedNodeSource::Usage cache = streamed_->usage();
-                const auto timeOf = [](double value) {
-                    return value > 0.0 ? fmt::format("{:.2f} s", value) : std::string("not yet");
-                };
                 fmt::print(stderr,
                            "subscan: {}: first picture {} after opening, the view's nodes {}; "
                            "node cache {:.0f} of {:.0f} MiB, {} node loads read the file, {} "
@@ -200,7 +208,7 @@ void Viewer::installCallbacks() {
 }
 
 void Viewer::waitForEvents() {
-    if (loading_ || refining_ || dueRefinement()) {
+    if (loading_ || refining_ || completing_ || dueRefinement()) {
         glfwWaitEventsTimeout(kLoadingWaitSeconds);
     } else if (unattended_ || flying_ || frameIsStale() || fading()) {
         // A change made while drawing the last frame (the panel, a script) shows at once.
@@ -410,6 +418,8 @@ void Viewer::startLoading(const std::string& source, bool reopening) {
     // dropping a view's, whose nodes belong to the scan on screen.
     loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming);
     refining_.reset();
+    completing_.reset();
+    status_.completingSpacing = false;
     status_.streamingView = false;
     reopening_ = reopening;
     openedLod_ = settings_.streaming.lod;
@@ -462,7 +472,7 @@ void Viewer::recordOpeningTimes() {
     if (status_.firstPictureSeconds == 0.0) {
         status_.firstPictureSeconds = seconds;
     }
-    if (streamed_ && viewNodesShown_ && status_.viewCompleteSeconds == 0.0) {
+    if ((streamed_ ? viewNodesShown_ : !completing_) && status_.viewCompleteSeconds == 0.0) {
         status_.viewCompleteSeconds = seconds;
     }
 }
@@ -477,8 +487,35 @@ bool Viewer::levelsOfDetailChanged() const {
 }
 
 bool Viewer::awaitingScan() const {
-    return unattended_ &&
-           (loading_ || levelsOfDetailChanged() || (streamed_ && (refining_ || dueRefinement())));
+    return unattended_ && (loading_ || completing_ || levelsOfDetailChanged() ||
+                           (streamed_ && (refining_ || dueRefinement())));
+}
+
+void Viewer::finishCompleting() {
+    if (!completing_ || !completing_->finished()) {
+        return;
+    }
+    const std::unique_ptr<BackgroundJob<std::optional<CompletedSpacing>>> job =
+        std::move(completing_);
+    status_.completingSpacing = false;
+    try {
+        std::optional<CompletedSpacing> completed = job->take();
+        if (!completed || !renderer_) {
+            return;
+        }
+        // Interactive: the provisional picture fades into the completed one.
+        if (!unattended_ && renderedImage_) {
+            const Texture& image = renderer_->resources().texture("image");
+            const double now = glfwGetTime();
+            crossFade_.start(crossFade_.active(image, now) ? crossFade_.blended() : image);
+        }
+        renderer_->replaceCloud(*scan_, completed->spacing, PointMemory::Borrow, completed->packed);
+        status_.spacing = renderer_->spacing();
+        renderedCamera_.reset();
+        renderedImage_ = false;
+    } catch (const Error& error) {
+        fail(error.what());
+    }
 }
 
 void Viewer::finishLoading() {
@@ -504,6 +541,9 @@ void Viewer::finishLoading() {
 }
 
 void Viewer::show(PreparedScan prepared, bool newScan) {
+    // Its work reads the scan on screen, which this replaces.
+    completing_.reset();
+    const bool provisional = prepared.provisional;
     for (const std::string& warning : prepared.scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
     }
@@ -555,6 +595,14 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     }
     scan_ = std::move(scan);
     scanColors_ = std::move(fileColors);
+    status_.completingSpacing = provisional;
+    if (provisional) {
+        const PointCloud* shown = scan_.get();
+        completing_ = std::make_unique<BackgroundJob<std::optional<CompletedSpacing>>>(
+            prepared.source, [shown](const std::function<bool()>& cancelled) {
+                return completeSpacing(*shown, cancelled);
+            });
+    }
     scanUp_ = up;
     sensorLook_ = std::move(look);
     streamed_ = std::move(prepared.streamed);
@@ -790,13 +838,14 @@ bool Viewer::frameIsStale() const {
     const bool changed = !renderedCamera_ ||
                          !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
                          nlohmann::json(settings).dump() != renderedSettings_;
-    // While a view's nodes load, the temporal filter does not refine the picture at rest: the
-    // nodes replace it in a moment, and on llvmpipe its frames took the cores their loading
-    // needs. Nor during a cross-fade: on llvmpipe a filtered frame took 0.25 s at 1280x720,
-    // which left two frames of a 0.3 s fade; the fade's own frames are a blend and a copy.
+    // While a view's nodes load, or a scan's local spacing and normals, the temporal filter
+    // does not refine the picture at rest: they replace it in a moment, and on llvmpipe its
+    // frames took the cores their work needs. Nor during a cross-fade: on llvmpipe a filtered
+    // frame took 0.25 s at 1280x720, which left two frames of a 0.3 s fade; the fade's own
+    // frames are a blend and a copy.
     return redrawEveryFrame_ || changed ||
-           (filtersTemporally(settings) && renderedImage_ && !refining_ && !fading() &&
-            framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
+           (filtersTemporally(settings) && renderedImage_ && !refining_ && !completing_ &&
+            !fading() && framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
 }
 
 void Viewer::renderIfNeeded() {

@@ -107,6 +107,8 @@ class Viewer {
     /// renderer took 0.64 s at 1280x720.
     void warmUpRenderer();
     void finishLoading();
+    /// Hands the renderer a whole scan's completed spacing and normals once they are estimated.
+    void finishCompleting();
     /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
     /// start afresh), or another set of the streamed scan's nodes (the view stays).
     void show(PreparedScan prepared, bool newScan);
@@ -198,6 +200,9 @@ class Viewer {
     std::shared_ptr<const lod::CachedNodeSource> streamed_;
     std::vector<std::size_t> streamedNodes_;
     std::unique_ptr<StreamedViewJob> refining_;
+    /// A scan loaded whole: its local spacing and normals, estimated after its provisional
+    /// first picture (reads scan_: declared after it, so that it goes first).
+    std::unique_ptr<BackgroundJob<std::optional<CompletedSpacing>>> completing_;
     std::optional<Camera> stillCamera_;
     double stillSince_ = 0.0;
     std::optional<Camera> refinedCamera_;

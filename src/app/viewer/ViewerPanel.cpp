@@ -277,8 +277,13 @@ void ViewerPanel::drawScan(const PanelStatus& status, StreamingSettings& streami
         if (status.firstPictureSeconds > 0.0) {
             ImGui::Text("first picture %.2f s after opening", status.firstPictureSeconds);
         }
-        if (status.viewCompleteSeconds > 0.0) {
+        if (status.completingSpacing) {
+            ImGui::TextUnformatted("estimating the local spacing and normals...");
+        } else if (status.viewCompleteSeconds > 0.0 && status.streamedNodesInAll > 0) {
             ImGui::Text("the view's nodes shown %.2f s after opening", status.viewCompleteSeconds);
+        } else if (status.viewCompleteSeconds > 0.0) {
+            ImGui::Text("with its local spacing and normals %.2f s after opening",
+                        status.viewCompleteSeconds);
         }
         constexpr Coloring kColorings[] = {Coloring::Auto,           Coloring::Rgb,
                                            Coloring::Intensity,      Coloring::Height,

@@ -36,10 +36,11 @@ struct PanelStatus {
     std::uint64_t nodeCacheBytes = 0;  // decoded nodes kept (lod::CachedNodeSource)
     std::uint64_t nodeCacheBudgetBytes = 0;
     // Seconds from opening the scan (the command's start, or choosing another file) to its
-    // first frame, and a streamed scan's to the first frame of the first view's own nodes;
-    // 0 until then.
+    // first frame, and a streamed scan's to the first frame of the first view's own nodes (a
+    // scan loaded whole: the first with its local spacing and normals); 0 until then.
     double firstPictureSeconds = 0.0;
     double viewCompleteSeconds = 0.0;
+    bool completingSpacing = false;  // a scan loaded whole: its local spacing and normals come
     double loadingProgress = 0.0;
     std::string glRenderer;
     bool int64Atomics = false;
