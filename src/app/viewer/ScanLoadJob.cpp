@@ -43,7 +43,8 @@ PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
             return prepared;
         }
         prepared.scan = loadScan(source_, reportProgress);
-        prepared.spacing = PointSpacing{sampleSpacing(prepared.scan.cloud).h, {}};
+        prepared.sample = sampleSpacing(prepared.scan.cloud);
+        prepared.spacing = PointSpacing{prepared.sample.h, {}};
         prepared.provisional = true;
         return prepared;
     } catch (const LoadCancelled&) {
@@ -54,15 +55,23 @@ PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
 }
 
 std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
+                                                const SpacingSample& sample,
                                                 const std::function<bool()>& cancelled) {
-    CompletedSpacing completed;
-    completed.spacing = estimatePointSpacing(cloud);
-    const std::vector<glm::vec3> normals = normalsFor(cloud, NormalSource::Auto, cancelled);
-    if (cancelled()) {
-        return std::nullopt;
+    try {
+        CompletedSpacing completed;
+        completed.spacing = estimatePointSpacing(cloud, sample);
+        if (cancelled()) {
+            return std::nullopt;
+        }
+        const std::vector<glm::vec3> normals = normalsFor(cloud, NormalSource::Auto, cancelled);
+        if (cancelled()) {
+            return std::nullopt;
+        }
+        completed.packed = packPointAttributes(completed.spacing.local, normals);
+        return completed;
+    } catch (const std::bad_alloc&) {
+        throw Error("out of memory for the scan's local spacing and normals");
     }
-    completed.packed = packPointAttributes(completed.spacing.local, normals);
-    return completed;
 }
 
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {

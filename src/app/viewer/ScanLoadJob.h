@@ -13,6 +13,7 @@
 #include "app/viewer/BackgroundJob.h"
 #include "core/Coloring.h"
 #include "core/LocalSpacing.h"
+#include "core/Spacing.h"
 #include "io/ScanLoader.h"
 #include "lod/NodeCache.h"
 #include "render/GpuPointCloud.h"
@@ -26,13 +27,16 @@ struct PreparedScan {
     std::string source;
     LoadedScan scan;
     PointSpacing spacing;  // estimatePointSpacing's result (h = 0: the renderer picks one)
+    /// A scan loaded whole, provisional: `spacing` is h alone, from this sample, which
+    /// completeSpacing goes on from.
+    SpacingSample sample;
     std::vector<glm::vec3> normals;  // normalsFor(cloud, auto): empty where none are estimated
     PackedPointAttributes packed;    // the local spacing and `normals` as the GPU reads them
     /// The points' colours as the viewer shows them under `coloredBy` (pointColors), where the
     /// job knew how it colours them; else empty, and the viewer colours them itself.
     std::vector<Rgba8> shownColors;
     std::optional<std::pair<Coloring, UpAxis>> coloredBy;
-    /// A scan loaded whole, with h from a sample only: its local spacing and normals come after
+    /// A scan loaded whole, with h from `sample` only: its local spacing and normals come after
     /// its first picture (completeSpacing).
     bool provisional = false;
     /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
@@ -47,9 +51,11 @@ struct CompletedSpacing {
     PointSpacing spacing;
     PackedPointAttributes packed;
 };
-/// Estimates them for `cloud` (read, not changed, while the render thread draws it); nullopt
-/// where `cancelled` turned true meanwhile.
+/// Estimates them for `cloud` from its spacing `sample` (read, not changed, while the render
+/// thread draws it: h stays the sample's); nullopt where `cancelled` turned true meanwhile.
+/// Throws subscan::Error where memory runs out.
 std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
+                                                const SpacingSample& sample,
                                                 const std::function<bool()>& cancelled);
 
 /// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as

@@ -172,8 +172,7 @@ int Viewer::run() {
                            "and normals {}\n",
                            status_.scanSource, timeOf(status_.firstPictureSeconds),
                            timeOf(status_.viewCompleteSeconds));
-            }
-            if (unattended_ && streamed_) {
+            } else if (unattended_) {
                 const lod::CachedNodeSource::Usage cache = streamed_->usage();
                 fmt::print(stderr,
                            "subscan: {}: first picture {} after opening, the view's nodes {}; "
@@ -416,10 +415,10 @@ void Viewer::flyWithKeys(double seconds) {
 void Viewer::startLoading(const std::string& source, bool reopening) {
     // Replacing a running job cancels it (its destructor waits for the thread); so does
     // dropping a view's, whose nodes belong to the scan on screen.
+    // A whole scan's completion goes on: the load may fail and leave its scan on screen (show()
+    // stops it before the scan goes).
     loading_ = std::make_unique<ScanLoadJob>(source, settings_.streaming);
     refining_.reset();
-    completing_.reset();
-    status_.completingSpacing = false;
     status_.streamingView = false;
     reopening_ = reopening;
     openedLod_ = settings_.streaming.lod;
@@ -499,8 +498,9 @@ void Viewer::finishCompleting() {
         std::move(completing_);
     status_.completingSpacing = false;
     try {
-        std::optional<CompletedSpacing> completed = job->take();
-        if (!completed || !renderer_) {
+        const std::optional<CompletedSpacing> completed = job->take();
+        // Evenly spaced and too large for normals: nothing to add to the picture.
+        if (!completed || (completed->spacing.local.empty() && completed->packed.normals.empty())) {
             return;
         }
         // Interactive: the provisional picture fades into the completed one.
@@ -541,8 +541,6 @@ void Viewer::finishLoading() {
 }
 
 void Viewer::show(PreparedScan prepared, bool newScan) {
-    // Its work reads the scan on screen, which this replaces.
-    completing_.reset();
     const bool provisional = prepared.provisional;
     for (const std::string& warning : prepared.scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
@@ -593,14 +591,17 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
         }
         renderer_ = std::move(renderer);
     }
+    // A whole scan's completion reads the scan on screen, which this replaces (where the
+    // renderer took the new one: else the old stays, and so does its completion).
+    completing_.reset();
     scan_ = std::move(scan);
     scanColors_ = std::move(fileColors);
     status_.completingSpacing = provisional;
     if (provisional) {
-        const PointCloud* shown = scan_.get();
         completing_ = std::make_unique<BackgroundJob<std::optional<CompletedSpacing>>>(
-            prepared.source, [shown](const std::function<bool()>& cancelled) {
-                return completeSpacing(*shown, cancelled);
+            prepared.source, [shown = scan_.get(), sample = std::move(prepared.sample)](
+                                 const std::function<bool()>& cancelled) {
+                return completeSpacing(*shown, sample, cancelled);
             });
     }
     scanUp_ = up;

@@ -112,13 +112,16 @@ class Viewer {
     /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
     /// start afresh), or another set of the streamed scan's nodes (the view stays).
     void show(PreparedScan prepared, bool newScan);
-    /// An unattended run (script, frame limit) is waiting for a scan that opens again or for a
-    /// streamed view's nodes: its frames show what is there meanwhile but do not count, so
-    /// every counted frame shows what `subscan render` would.
+    /// An unattended run (script, frame limit) is waiting for a scan that opens again, for a
+    /// streamed view's nodes or for a whole scan's local spacing and normals: its frames show
+    /// what is there meanwhile but do not count, so every counted frame shows what `subscan
+    /// render` would.
     bool awaitingScan() const;
-    /// A cross-fade to a streamed view's new nodes is under way: frames are drawn until it ends.
+    /// A cross-fade to a streamed view's new nodes, or to a whole scan's complete picture, is
+    /// under way: frames are drawn until it ends.
     bool fading() const;
-    /// After a frame was shown: when the scan's first picture and its view's nodes came.
+    /// After a frame was shown: when the scan's first picture came, and its view's nodes (a
+    /// whole scan: its local spacing and normals).
     void recordOpeningTimes();
     /// The camera whose nodes a streamed scan should load next: the view, where it is not the
     /// one last refined for and no load runs.
@@ -169,7 +172,7 @@ class Viewer {
     bool unattended_;
     GlfwContext context_;
     ImGuiSession imgui_;
-    CrossFade crossFade_;  // from a streamed view's nodes to the next ones
+    CrossFade crossFade_;  // from a picture to the next nodes' or the complete scan's
     ViewerPanel panel_;
     RenderSettings settings_;  // as the panel shows them
     AppliedScattering scattering_;

@@ -29,8 +29,10 @@ TEST(ScanLoadJobTest, AWholeScanComesProvisionalAndCompletesWithTheSameH) {
     EXPECT_TRUE(prepared.spacing.local.empty());
     EXPECT_TRUE(prepared.normals.empty());
     EXPECT_TRUE(prepared.packed.localSpacing.halves.empty());
+    EXPECT_EQ(prepared.spacing.global, sampleSpacing(cloud).h);
 
-    const std::optional<CompletedSpacing> completed = completeSpacing(cloud, [] { return false; });
+    const std::optional<CompletedSpacing> completed =
+        completeSpacing(cloud, prepared.sample, [] { return false; });
     ASSERT_TRUE(completed);
     // What the whole scan's renderer would estimate at once, and h unchanged: the picture does
     // not jump to another h when the rest arrives.
@@ -41,7 +43,7 @@ TEST(ScanLoadJobTest, AWholeScanComesProvisionalAndCompletesWithTheSameH) {
     EXPECT_EQ(completed->packed.normals, packNormals(normalsFor(cloud, NormalSource::Auto)));
     EXPECT_EQ(completed->packed.normals.size(), cloud.size());  // estimated: it has none
 
-    EXPECT_FALSE(completeSpacing(cloud, [] { return true; }));
+    EXPECT_FALSE(completeSpacing(cloud, prepared.sample, [] { return true; }));
 }
 
 }  // namespace
