@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -100,7 +101,8 @@ Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& 
 
 }  // namespace
 
-std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
+std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h,
+                                            const std::function<bool()>& cancelled) {
     const std::vector<glm::vec3>& positions = cloud.positions;
     std::vector<glm::vec4> spacing(positions.size(), glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     if (positions.size() < 2 || !(h > 0.0)) {
@@ -114,7 +116,14 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
     // the file's order, 0.53-0.56 s in the tree's).
     std::vector<NearestIndices> nearest(positions.size());
     constexpr std::size_t kQueriesPerBlock = 4096;
+    std::atomic<bool> stopped{false};
     inParallelBlocks(positions.size(), kQueriesPerBlock, [&](std::size_t query) {
+        constexpr std::size_t kCancelCheckEvery = 1 << 14;
+        if (cancelled && (stopped.load(std::memory_order_relaxed) ||
+                          (query % kCancelCheckEvery == 0 && cancelled()))) {
+            stopped.store(true, std::memory_order_relaxed);
+            return;
+        }
         const std::size_t i = tree.vAcc[query];
         Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
         if (!std::isfinite(found.spacingNeighbour)) {
@@ -123,6 +132,9 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h) {
         spacing[i] = glm::vec4(found.across, found.spacingNeighbour);
         nearest[i] = found.nearest;
     });
+    if (stopped) {
+        return spacing;
+    }
     // The median over the point and its nearest neighbours: a point on a boundary (a
     // silhouette, a scan's edge) finds its 4th neighbour farther than inside, though the
     // points there lie no farther apart; most of its neighbours lie inside.
@@ -174,14 +186,15 @@ namespace {
 /// `h` and, by the rule of kAlwaysLocalSpacingPoints, the local spacing; `sampledNearest`
 /// gives sampled nearest distances when a large cloud needs them.
 template <class SampledNearest>
-PointSpacing withLocalSpacing(const PointCloud& cloud, double h, SampledNearest&& sampledNearest) {
+PointSpacing withLocalSpacing(const PointCloud& cloud, double h, SampledNearest&& sampledNearest,
+                              const std::function<bool()>& cancelled = {}) {
     PointSpacing spacing;
     spacing.global = h;
     if (!(h > 0.0) || !std::isfinite(h)) {
         return spacing;
     }
     if (cloud.size() <= kAlwaysLocalSpacingPoints || spacingVaries(sampledNearest())) {
-        spacing.local = estimateLocalSpacing(cloud, h);
+        spacing.local = estimateLocalSpacing(cloud, h, cancelled);
     }
     return spacing;
 }
@@ -196,8 +209,10 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud, std::optional<double>
     return withLocalSpacing(cloud, *global, [&] { return sampledNearestDistances(cloud); });
 }
 
-PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample) {
-    return withLocalSpacing(cloud, sample.h, [&] { return sample.nearest; });
+PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample,
+                                  const std::function<bool()>& cancelled) {
+    return withLocalSpacing(
+        cloud, sample.h, [&] { return sample.nearest; }, cancelled);
 }
 
 PointSpacing estimatePointSpacing(const PointCloud& cloud, std::span<const float> levelSpacing) {

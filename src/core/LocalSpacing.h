@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <span>
 #include <vector>
@@ -25,7 +26,10 @@ namespace subscan {
 ///        (the direction to the nearest neighbour); else 0.
 /// The reconstruction takes, per pixel, the larger of w and the across vector projected into
 /// the picture: an across gap seen end-on, as from the scanner itself, is small on screen.
-std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h);
+/// `cancelled` (may be empty) is asked now and then, from any thread; once it says yes the
+/// work stops and the result is incomplete.
+std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h,
+                                            const std::function<bool()>& cancelled = {});
 
 /// Whether the cloud's spacing varies a lot: the 90th percentile of `sampledNearest`
 /// (sampledNearestDistances) over its 10th above kVaryingSpacingRatio.
@@ -54,7 +58,9 @@ PointSpacing estimatePointSpacing(const PointCloud& cloud,
                                   std::optional<double> global = std::nullopt);
 /// The same from sampleSpacing's result: its distances decide whether a large cloud's
 /// spacing varies, so that no second search is needed.
-PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample);
+/// `cancelled` as estimateLocalSpacing takes it.
+PointSpacing estimatePointSpacing(const PointCloud& cloud, const SpacingSample& sample,
+                                  const std::function<bool()>& cancelled = {});
 /// A streamed view's (LoadedScan::levelSpacing, one per point, or empty: the same as above):
 /// each point's w is at least its level's spacing over that of the level most points lie on,
 /// times the lower quartile of those points' estimates (1 without estimates, for clouds above

@@ -59,7 +59,7 @@ std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
                                                 const std::function<bool()>& cancelled) {
     try {
         CompletedSpacing completed;
-        completed.spacing = estimatePointSpacing(cloud, sample);
+        completed.spacing = estimatePointSpacing(cloud, sample, cancelled);
         if (cancelled()) {
             return std::nullopt;
         }

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <random>
 #include <span>
@@ -126,6 +127,24 @@ TEST(LocalSpacingTest, RandomPointsMatchABruteForceReference) {
     EXPECT_GT(snapped, 1000);
     EXPECT_LT(snapped, 1490);
     EXPECT_GT(lines, 5);
+}
+
+TEST(LocalSpacingTest, CancellingStopsTheEstimate) {
+    // The viewer estimates a scan's local spacing after its first picture and drops the work
+    // when another scan replaces it: the estimate asks, and stops at the first yes.
+    const PointCloud cloud = randomPlane(40000, 3);
+    std::atomic<int> asked{0};
+    const std::vector<glm::vec4> stopped = estimateLocalSpacing(cloud, 0.01, [&] {
+        ++asked;
+        return true;
+    });
+    EXPECT_GE(asked.load(), 1);
+    // Points the stopped work never reached keep the placeholder (w = 1, no across vector);
+    // the finished estimate gives most of them another w.
+    const std::vector<glm::vec4> finished = estimateLocalSpacing(cloud, 0.01, [] { return false; });
+    ASSERT_EQ(stopped.size(), cloud.size());
+    EXPECT_NE(stopped, finished);
+    EXPECT_EQ(finished, estimateLocalSpacing(cloud, 0.01));
 }
 
 TEST(LocalSpacingTest, AnEvenGridHasTheGlobalSpacingAndNoLines) {
