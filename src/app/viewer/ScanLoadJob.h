@@ -36,8 +36,10 @@ struct PreparedScan {
     /// job knew how it colours them; else empty, and the viewer colours them itself.
     std::vector<Rgba8> shownColors;
     std::optional<std::pair<Coloring, UpAxis>> coloredBy;
-    /// A scan loaded whole, with h from `sample` only: its local spacing and normals come after
-    /// its first picture (completeSpacing).
+    /// `spacing` is h alone (and a streamed scan's levels' spacing), without the local spacing's
+    /// neighbour search: a scan loaded whole (h from `sample`) gets the rest after its first
+    /// picture (completeSpacing), a streamed one with the nodes of its view, which it shows
+    /// only until then (the overview, a view's partial sets).
     bool provisional = false;
     /// A COPC file or EPT dataset streamed by its levels of detail: the scan holds `nodes` of
     /// it (the overview when first opened, then the nodes a view shows). Null: loaded whole.
@@ -58,6 +60,10 @@ std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
                                                 const SpacingSample& sample,
                                                 const std::function<bool()>& cancelled);
 
+/// Gives `prepared` (a streamed scan's nodes) h and its levels' spacing only, packed for the
+/// GPU: PreparedScan::provisional.
+void prepareProvisionally(PreparedScan& prepared);
+
 /// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as
 /// Renderer::prepareNormals does for `auto` (streamedNormals(auto) for a streamed scan), and
 /// packs them for the GPU, here off the render thread. Returns false where `cancelled` turned
@@ -66,9 +72,9 @@ bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& can
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)
 /// while a big file is decoded; a COPC file or EPT dataset only its overview (topLevels), which
-/// StreamedViewJob refines, through a lod::CachedNodeSource that every later view shares. A scan
-/// loaded whole comes provisional (h from a sample, no local spacing or normals): its first
-/// picture shows while completeSpacing estimates the rest.
+/// StreamedViewJob refines, through a lod::CachedNodeSource that every later view shares. Both
+/// come provisional: a scan loaded whole (h from a sample, no local spacing or normals) shows
+/// while completeSpacing estimates the rest, the overview until the view's nodes come.
 /// Destroying an unfinished job cancels it at the reader's next progress report and waits for the
 /// thread.
 class ScanLoadJob {

@@ -68,9 +68,7 @@ std::optional<PreparedScan> StreamedViewJob::prepare(std::vector<std::size_t> no
     prepared.nodes = std::move(nodes);
     if (provisional) {
         // No normals either way: a streamed view estimates none (streamedNormals).
-        prepared.spacing = withLevelSpacing(PointSpacing{sampleSpacing(prepared.scan.cloud).h, {}},
-                                            prepared.scan.levelSpacing);
-        prepared.packed = packPointAttributes(prepared.spacing.local, {});
+        prepareProvisionally(prepared);
     } else if (!prepareForRenderer(prepared, cancelled)) {
         return std::nullopt;
     }

@@ -596,8 +596,10 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     completing_.reset();
     scan_ = std::move(scan);
     scanColors_ = std::move(fileColors);
-    status_.completingSpacing = provisional;
-    if (provisional) {
+    // A streamed scan's provisional nodes stay only until its view's come (refineStreamedView).
+    shownProvisional_ = provisional;
+    status_.completingSpacing = provisional && !prepared.streamed;
+    if (status_.completingSpacing) {
         completing_ = std::make_unique<BackgroundJob<std::optional<CompletedSpacing>>>(
             prepared.source, [shown = scan_.get(), sample = std::move(prepared.sample)](
                                  const std::function<bool()>& cancelled) {
@@ -699,8 +701,11 @@ void Viewer::refineStreamedView() {
     refinedBudget_ = settings_.streaming.pointBudget;
     const std::uint64_t budget =
         lod::pointBudgetFor(settings_.streaming.pointBudget, context_.capabilities().software);
+    // Nodes shown provisionally are loaded again, with their spacing, where the view selects
+    // just them.
     refining_ = std::make_unique<StreamedViewJob>(
-        streamed_, status_.scanSource, *camera, budget, streamedNodes_,
+        streamed_, status_.scanSource, *camera, budget,
+        shownProvisional_ ? std::vector<std::size_t>{} : streamedNodes_,
         std::pair(status_.coloring, scanUp_), partialViewPoints(budget));
     status_.streamingView = true;
 }

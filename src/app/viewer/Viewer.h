@@ -203,6 +203,7 @@ class Viewer {
     std::shared_ptr<const lod::CachedNodeSource> streamed_;
     std::vector<std::size_t> streamedNodes_;
     std::unique_ptr<StreamedViewJob> refining_;
+    bool shownProvisional_ = false;  // the nodes on screen are PreparedScan::provisional
     /// A scan loaded whole: its local spacing and normals, estimated after its provisional
     /// first picture (reads scan_: declared after it, so that it goes first).
     std::unique_ptr<BackgroundJob<std::optional<CompletedSpacing>>> completing_;
