@@ -93,11 +93,13 @@ TEST(StreamedViewJobTest, TheJobOffersItsFirstNodesOnTheWayToTheWholeView) {
     EXPECT_EQ(partial->nodes, std::vector<std::size_t>(whole.begin(), whole.begin() + ends.back()));
     EXPECT_EQ(partial->scan.cloud.size(), partial->scan.levelSpacing.size());
     EXPECT_GT(partial->spacing.global, 0.0);  // provisional, but usable
-    EXPECT_FALSE(job.takePartial());          // taken
+    EXPECT_TRUE(partial->provisional);
+    EXPECT_FALSE(job.takePartial());  // taken
     std::optional<PreparedScan> result = job.take();
     ASSERT_TRUE(result);
     EXPECT_EQ(result->nodes, whole);
     EXPECT_GT(result->scan.cloud.size(), partial->scan.cloud.size());
+    EXPECT_FALSE(result->provisional);
     // Each set comes coloured as the viewer asked and packed for the GPU, off its thread.
     for (const PreparedScan* prepared : {&*partial, &*result}) {
         EXPECT_EQ(prepared->coloredBy, coloredBy);
@@ -123,6 +125,30 @@ TEST(StreamedViewJobTest, TheJobOffersItsFirstNodesOnTheWayToTheWholeView) {
     ASSERT_TRUE(uncoloured);
     EXPECT_FALSE(uncoloured->coloredBy);
     EXPECT_TRUE(uncoloured->shownColors.empty());
+}
+
+TEST(StreamedViewJobTest, AViewOfTheNodesShownLoadsNothingUnlessTheyWereProvisional) {
+    const auto source =
+        std::make_shared<lod::CachedNodeSource>(std::make_shared<SmallOctree>(), 1 << 20);
+    const Camera camera = orbitCamera(source->info().bounds, OrbitView{}, 320, 240, 45.0);
+    const std::vector<std::size_t> view = lod::selectNodes(*source, camera, 1000);
+    const auto finish = [](StreamedViewJob& job) {
+        for (int wait = 0; wait < 10'000 && !job.finished(); ++wait) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+        EXPECT_TRUE(job.finished());
+        return job.take();
+    };
+    // The viewer passes the nodes on screen, or none where they were shown provisionally (the
+    // overview, a partial set): then the same nodes come again, with their spacing.
+    const std::pair coloredBy(Coloring::Height, UpAxis::Z);
+    StreamedViewJob same(source, "small octree", camera, 1000, view, coloredBy);
+    EXPECT_FALSE(finish(same));
+    StreamedViewJob again(source, "small octree", camera, 1000, {}, coloredBy);
+    const std::optional<PreparedScan> prepared = finish(again);
+    ASSERT_TRUE(prepared);
+    EXPECT_EQ(prepared->nodes, view);
+    EXPECT_FALSE(prepared->provisional);
 }
 
 }  // namespace
