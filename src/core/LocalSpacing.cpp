@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -116,22 +115,16 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h,
     // the file's order, 0.53-0.56 s in the tree's).
     std::vector<NearestIndices> nearest(positions.size());
     constexpr std::size_t kQueriesPerBlock = 4096;
-    std::atomic<bool> stopped{false};
-    inParallelBlocks(positions.size(), kQueriesPerBlock, [&](std::size_t query) {
-        constexpr std::size_t kCancelCheckEvery = 1 << 14;
-        if (cancelled && (stopped.load(std::memory_order_relaxed) ||
-                          (query % kCancelCheckEvery == 0 && cancelled()))) {
-            stopped.store(true, std::memory_order_relaxed);
-            return;
-        }
-        const std::size_t i = tree.vAcc[query];
-        Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
-        if (!std::isfinite(found.spacingNeighbour)) {
-            found.nearest.fill(static_cast<std::uint32_t>(i));
-        }
-        spacing[i] = glm::vec4(found.across, found.spacingNeighbour);
-        nearest[i] = found.nearest;
-    });
+    const bool stopped = inParallelBlocksUntil(
+        positions.size(), kQueriesPerBlock, cancelled, [&](std::size_t query) {
+            const std::size_t i = tree.vAcc[query];
+            Neighbourhood found = neighbourhoodOf(tree, positions, positions[i]);
+            if (!std::isfinite(found.spacingNeighbour)) {
+                found.nearest.fill(static_cast<std::uint32_t>(i));
+            }
+            spacing[i] = glm::vec4(found.across, found.spacingNeighbour);
+            nearest[i] = found.nearest;
+        });
     if (stopped) {
         return spacing;
     }

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -88,17 +87,10 @@ std::vector<glm::vec3> estimateNormals(const PointCloud& cloud,
     const PositionsAdaptor adaptor{positions};
     const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     constexpr std::size_t kMostNeighbours = kNormalNeighbourhoods.back();
-    std::atomic<bool> stopped{false};
     // In the tree's own order, which keeps each thread's queries close together: its nodes stay
     // in the cache (10 % faster on the Happy Buddha than the file's order).
     constexpr std::size_t kQueriesPerBlock = 4096;  // neighbours in the tree's order share nodes
-    inParallelBlocks(positions.size(), kQueriesPerBlock, [&](std::size_t query) {
-        constexpr std::size_t kCancelCheckEvery = 1 << 14;
-        if (cancelled && (stopped.load(std::memory_order_relaxed) ||
-                          (query % kCancelCheckEvery == 0 && cancelled()))) {
-            stopped.store(true, std::memory_order_relaxed);
-            return;
-        }
+    inParallelBlocksUntil(positions.size(), kQueriesPerBlock, cancelled, [&](std::size_t query) {
         const std::size_t i = tree.vAcc[query];
         std::array<std::uint32_t, kMostNeighbours> indices{};
         std::array<float, kMostNeighbours> squared{};

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <functional>
 #include <thread>
 #include <vector>
 
@@ -47,6 +48,25 @@ void inParallelBlocks(std::size_t count, std::size_t block, const Work& work) {
         workers.emplace_back(take);
     }
     take();
+}
+
+/// inParallelBlocks that stops once `cancelled` (may be empty) says yes: asked, from any thread,
+/// every 16,384 indices, so that a caller waiting on it (a job being dropped) waits little.
+/// Returns whether it stopped; the work is then incomplete.
+template <class Work>
+bool inParallelBlocksUntil(std::size_t count, std::size_t block,
+                           const std::function<bool()>& cancelled, const Work& work) {
+    constexpr std::size_t kCancelCheckEvery = 1 << 14;
+    std::atomic<bool> stopped{false};
+    inParallelBlocks(count, block, [&](std::size_t i) {
+        if (cancelled && (stopped.load(std::memory_order_relaxed) ||
+                          (i % kCancelCheckEvery == 0 && cancelled()))) {
+            stopped.store(true, std::memory_order_relaxed);
+            return;
+        }
+        work(i);
+    });
+    return stopped;
 }
 
 }  // namespace subscan

@@ -82,13 +82,10 @@ void prepareProvisionally(PreparedScan& prepared) {
 
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled) {
     prepared.spacing = estimatePointSpacing(prepared.scan.cloud, prepared.scan.levelSpacing);
-    prepared.normals = normalsFor(
-        prepared.scan.cloud,
-        prepared.streamed ? streamedNormals(NormalSource::Auto) : NormalSource::Auto, cancelled);
     if (cancelled()) {
         return false;
     }
-    prepared.packed = packPointAttributes(prepared.spacing.local, prepared.normals);
+    prepared.packed = packPointAttributes(prepared.spacing.local, {});
     return true;
 }
 

@@ -8,8 +8,6 @@
 #include <utility>
 #include <vector>
 
-#include <glm/vec3.hpp>
-
 #include "app/viewer/BackgroundJob.h"
 #include "core/Coloring.h"
 #include "core/LocalSpacing.h"
@@ -22,7 +20,8 @@
 namespace subscan::viewer {
 
 /// A scan as the viewer needs it: the cloud for the GPU upload, its spacing (h and the local
-/// spacing) and normals, all made off the render thread.
+/// spacing), all made off the render thread; a scan loaded whole gets its local spacing and
+/// normals later (completeSpacing), a streamed one estimates no normals (streamedNormals).
 struct PreparedScan {
     std::string source;
     LoadedScan scan;
@@ -30,8 +29,7 @@ struct PreparedScan {
     /// A scan loaded whole, provisional: `spacing` is h alone, from this sample, which
     /// completeSpacing goes on from.
     SpacingSample sample;
-    std::vector<glm::vec3> normals;  // normalsFor(cloud, auto): empty where none are estimated
-    PackedPointAttributes packed;    // the local spacing and `normals` as the GPU reads them
+    PackedPointAttributes packed;  // the local spacing as the GPU reads it
     /// The points' colours as the viewer shows them under `coloredBy` (pointColors), where the
     /// job knew how it colours them; else empty, and the viewer colours them itself.
     std::vector<Rgba8> shownColors;
@@ -64,10 +62,9 @@ std::optional<CompletedSpacing> completeSpacing(const PointCloud& cloud,
 /// GPU: PreparedScan::provisional.
 void prepareProvisionally(PreparedScan& prepared);
 
-/// Estimates what the renderer needs of `prepared`'s cloud (spacing, normals), as
-/// Renderer::prepareNormals does for `auto` (streamedNormals(auto) for a streamed scan), and
-/// packs them for the GPU, here off the render thread. Returns false where `cancelled` turned
-/// true meanwhile.
+/// Estimates the spacing of `prepared` (a streamed view's nodes: h, the local spacing and the
+/// levels' spacing) and packs it for the GPU, here off the render thread; no normals, as
+/// streamedNormals(auto) says. Returns false where `cancelled` turned true meanwhile.
 bool prepareForRenderer(PreparedScan& prepared, const std::function<bool()>& cancelled);
 
 /// Loads a scan on a thread of its own so that the window keeps drawing (with a progress bar)

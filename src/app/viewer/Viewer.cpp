@@ -584,12 +584,8 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     if (renderer_) {
         renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.packed);
     } else {
-        auto renderer =
+        renderer_ =
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
-        if (!prepared.normals.empty()) {
-            renderer->setPointNormals(prepared.normals);
-        }
-        renderer_ = std::move(renderer);
     }
     // A whole scan's completion reads the scan on screen, which this replaces (where the
     // renderer took the new one: else the old stays, and so does its completion).

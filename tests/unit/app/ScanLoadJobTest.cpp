@@ -27,7 +27,7 @@ TEST(ScanLoadJobTest, AWholeScanComesProvisionalAndCompletesWithTheSameH) {
     ASSERT_FALSE(cloud.hasNormals());
     EXPECT_TRUE(prepared.provisional);
     EXPECT_TRUE(prepared.spacing.local.empty());
-    EXPECT_TRUE(prepared.normals.empty());
+    EXPECT_TRUE(prepared.packed.normals.empty());
     EXPECT_TRUE(prepared.packed.localSpacing.halves.empty());
     EXPECT_EQ(prepared.spacing.global, sampleSpacing(cloud).h);
 
