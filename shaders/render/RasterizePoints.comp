@@ -3,24 +3,30 @@
 // point, ties broken by the smaller point index, so every path gives the same winner.
 //   STAGE_DEPTH    one thread per point: 32-bit atomicMin of the depth bits, straight into the
 //                  "depth" image (viewed as r32ui; cleared to +inf, whose bits are the largest)
-//   STAGE_INDEX    one thread per point: among points at the winning depth, atomicMin of index
+//   STAGE_INDEX    one thread per point: among points at the winning depth, atomicMin of
+//                  index, and with BLEND_COLORS or BLEND_NORMALS the blend's sums below
 //   STAGE_INT64    one thread per point: one 64-bit atomicMin of depthBits << 32 | index
 //                  (DEPTH and INT64 also mark the point's 4x4 sub-cell of its pixel, hidden or
 //                  not, when the surface places its outline by them: surface.fill.w)
-//   STAGE_BLEND    one thread per point: a point within the relative depth raster.colorBlend
-//                  of its pixel's nearest adds its linear colour (fixed point) and 1 to the
-//                  pixel's sums (Schuetz et al. 2021's high-quality shading)
+//   STAGE_BLEND    one thread per point, after INT64 (whose nearest is known only then): with
+//                  BLEND_COLORS a point within the relative depth raster.colorBlend of its
+//                  pixel's nearest adds its linear colour (fixed point) and 1 to the pixel's
+//                  sums (Schuetz et al. 2021's high-quality shading); with BLEND_NORMALS one
+//                  within raster.normalBlend pixel widths behind the nearest its view-space
+//                  normal, facing the eye and weighted by its cosine towards it, to the
+//                  pixel's normal sums
 //   STAGE_RESOLVE  one thread per pixel of the cloud's projected bounding box: the winner's
-//                  linear colour, or with USE_BLEND the mean of the sums (and with USE_INT64
+//                  linear colour, or with BLEND_COLORS the mean of the sums (and with USE_INT64
 //                  the winner's depth) into images cleared before; alpha: the winner's local
 //                  spacing on screen in units of h's (1 without local spacing); with the
 //                  points' own normals (SurfaceParams.normals.z) the winner's normal in view
-//                  space, facing the eye, into "pointNormals" (0 where it has none)
+//                  space, facing the eye, or with BLEND_NORMALS the normalised sum, into
+//                  "pointNormals" (0 where it has none)
 // Positive IEEE floats order like their bit patterns, so depth bits compare as uints. Points
 // are read as buffer textures and the 32-bit path keeps its per-pixel words in images rather
 // than storage buffers: on llvmpipe a texel fetch or image load is a vector gather, a storage
 // buffer load one guarded scalar load per lane.
-#if STAGE_INT64 || ((STAGE_RESOLVE || STAGE_BLEND) && USE_INT64)
+#if USE_INT64
 #extension GL_ARB_gpu_shader_int64 : require
 #extension GL_NV_shader_atomic_int64 : require
 #endif
@@ -46,12 +52,10 @@ layout(binding = SUBSCAN_IMAGE_OUT0, r32ui) uniform uimage2D depthBits;
 #elif STAGE_INDEX
 layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D depthBits;
 layout(binding = SUBSCAN_IMAGE_OUT2, r32ui) uniform uimage2D pointIndex;
-#elif STAGE_BLEND && !USE_INT64
-layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D depthBits;
 #elif STAGE_RESOLVE && !USE_INT64
 layout(binding = SUBSCAN_IMAGE_IN0, r32ui) readonly uniform uimage2D pointIndex;
 #endif
-#if STAGE_INT64 || ((STAGE_RESOLVE || STAGE_BLEND) && USE_INT64)
+#if USE_INT64
 layout(std430, binding = SUBSCAN_SSBO_DEPTH_INDEX) buffer DepthIndex {
     uint64_t depthIndex[];
 };
@@ -61,10 +65,25 @@ layout(std430, binding = SUBSCAN_SSBO_OCCUPANCY) buffer Occupancy {
     uint occupancy[];
 };
 #endif
-#if STAGE_BLEND || (STAGE_RESOLVE && USE_BLEND)
+#if BLEND_COLORS
 layout(std430, binding = SUBSCAN_SSBO_COLOR_SUMS) buffer ColorSums {
     uvec4 colorSums[];
 };
+#endif
+#if BLEND_NORMALS
+layout(std430, binding = SUBSCAN_SSBO_NORMAL_SUMS) buffer NormalSums {
+    int normalSums[];  // x, y, z per pixel
+};
+#endif
+#if BLEND_NORMALS || STAGE_RESOLVE
+layout(binding = SUBSCAN_TEXELS_POINT_NORMALS) uniform usamplerBuffer pointNormals;
+
+/// Chunk point `local`'s normal in view space, turned to face the eye: a normal's sign is
+/// arbitrary where no sensor oriented it, and the side seen is the side shaded. 0 for none.
+vec3 viewNormal(uint local, vec3 viewPosition) {
+    vec3 normal = mat3(frame.viewFromCloud) * unpackNormal(texelFetch(pointNormals, int(local)).r);
+    return dot(normal, towardsEye(viewPosition)) < 0.0 ? -normal : normal;
+}
 #endif
 
 #if STAGE_RESOLVE
@@ -75,7 +94,6 @@ layout(binding = SUBSCAN_IMAGE_OUT0, r32f) writeonly uniform image2D outDepth;
 layout(binding = SUBSCAN_IMAGE_OUT1, rgba16f) writeonly uniform image2D outColor;
 layout(binding = SUBSCAN_IMAGE_OUT2, rgba16f) writeonly uniform image2D outNormal;
 layout(binding = SUBSCAN_TEXELS_LOCAL_SPACING) uniform samplerBuffer localSpacing;
-layout(binding = SUBSCAN_TEXELS_POINT_NORMALS) uniform usamplerBuffer pointNormals;
 layout(std430, binding = SUBSCAN_SSBO_ACROSS_LINES) writeonly buffer AcrossLines {
     uint acrossLines[];
 };
@@ -105,14 +123,6 @@ vec3 spacingOnScreen(uint local) {
     return vec3(min(max(spacing.w, acrossLength), 6.0e4), axis);
 }
 
-/// Chunk point `local`'s normal in view space, turned to face the eye: a normal's sign is
-/// arbitrary where no sensor oriented it, and the side seen is the side shaded.
-vec3 viewNormal(uint local) {
-    vec3 normal = mat3(frame.viewFromCloud) * unpackNormal(texelFetch(pointNormals, int(local)).r);
-    vec3 viewPosition = viewPositionOfPoint(local);
-    return dot(normal, towardsEye(viewPosition)) < 0.0 ? -normal : normal;
-}
-
 void main() {
     ivec2 pixel = dispatchTexel();
     if (any(greaterThanEqual(pixel, imageSizeOfFrame())) || !insideRegion(pixel)) {
@@ -131,7 +141,7 @@ void main() {
 #if USE_INT64
     imageStore(outDepth, pixel, vec4(uintBitsToFloat(uint(key >> 32))));
 #endif
-#if USE_BLEND
+#if BLEND_COLORS
     // The winner is among the points summed: the count is at least 1.
     uvec4 sums = colorSums[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)];
     vec3 color = vec3(sums.rgb) / (float(sums.a) * SUBSCAN_COLOR_SUM_SCALE);
@@ -147,12 +157,54 @@ void main() {
     }
     imageStore(outColor, pixel, vec4(color, spacingRatio));
     if (surface.normals.z > 0.5) {
-        imageStore(outNormal, pixel, vec4(viewNormal(winner - raster.firstPoint), 0.0));
+#if BLEND_NORMALS
+        // The points summed face the eye, so their sum is 0 only where none had a normal.
+        uint first = 3u * (uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x));
+        vec3 sum = vec3(normalSums[first], normalSums[first + 1u], normalSums[first + 2u]);
+        vec3 normal = dot(sum, sum) > 0.0 ? normalize(sum) : vec3(0.0);
+#else
+        uint local = winner - raster.firstPoint;
+        vec3 normal = viewNormal(local, viewPositionOfPoint(local));
+#endif
+        imageStore(outNormal, pixel, vec4(normal, 0.0));
     }
 }
 
 #else
 layout(local_size_x = SUBSCAN_POINTS_GROUP_SIZE) in;
+
+#if BLEND_COLORS || BLEND_NORMALS
+/// Adds chunk point `local` (at `viewPosition`, `depth`) to pixel `linear`'s sums where it
+/// lies within the blends' depths behind the pixel's `nearest`.
+void addToSums(uint local, vec3 viewPosition, uint linear, float depth, float nearest) {
+#if BLEND_COLORS
+    if (depth <= nearest * (1.0 + raster.colorBlend)) {
+        uvec3 fixedPoint =
+            uvec3(round(unpackColor(texelFetch(colors, int(local)).r) * SUBSCAN_COLOR_SUM_SCALE));
+        atomicAdd(colorSums[linear].r, fixedPoint.r);
+        atomicAdd(colorSums[linear].g, fixedPoint.g);
+        atomicAdd(colorSums[linear].b, fixedPoint.b);
+        atomicAdd(colorSums[linear].a, 1u);
+    }
+#endif
+#if BLEND_NORMALS
+    // A pixel width at the nearest's depth: the depth range the pixel's front surface spans
+    // at 45 degrees.
+    if (depth <= nearest + raster.normalBlend.x * projectiveDepth(nearest) / frame.depthRange.z) {
+        // Weighted by the cosine towards the eye: a point stands for a piece of surface whose
+        // area on screen is that cosine times its own, so the mean is over the pixel's visible
+        // surface, as its supersampled truth averages it, and a rim's grazing points count
+        // little.
+        vec3 facing = viewNormal(local, viewPosition);
+        facing *= dot(facing, towardsEye(viewPosition));
+        ivec3 normal = ivec3(round(facing * SUBSCAN_NORMAL_SUM_SCALE));
+        atomicAdd(normalSums[3u * linear], normal.x);
+        atomicAdd(normalSums[3u * linear + 1u], normal.y);
+        atomicAdd(normalSums[3u * linear + 2u], normal.z);
+    }
+#endif
+}
+#endif
 
 void main() {
     uint local = gl_GlobalInvocationID.x;
@@ -188,25 +240,17 @@ void main() {
         imageAtomicMin(depthBits, pixel, bits);
     }
 #elif STAGE_INDEX
-    if (imageLoad(depthBits, pixel).r == bits) {
+    uint nearestBits = imageLoad(depthBits, pixel).r;
+    if (nearestBits == bits) {
         imageAtomicMin(pointIndex, pixel, index);
     }
+#if BLEND_COLORS || BLEND_NORMALS
+    addToSums(local, viewPosition, linear, depth, uintBitsToFloat(nearestBits));
+#endif
 #elif STAGE_INT64
     atomicMin(depthIndex[linear], (uint64_t(bits) << 32) | uint64_t(index));
 #elif STAGE_BLEND
-#if USE_INT64
-    float nearest = uintBitsToFloat(uint(depthIndex[linear] >> 32));
-#else
-    float nearest = uintBitsToFloat(imageLoad(depthBits, pixel).r);
-#endif
-    if (depth <= nearest * (1.0 + raster.colorBlend)) {
-        uvec3 fixedPoint =
-            uvec3(round(unpackColor(texelFetch(colors, int(local)).r) * SUBSCAN_COLOR_SUM_SCALE));
-        atomicAdd(colorSums[linear].r, fixedPoint.r);
-        atomicAdd(colorSums[linear].g, fixedPoint.g);
-        atomicAdd(colorSums[linear].b, fixedPoint.b);
-        atomicAdd(colorSums[linear].a, 1u);
-    }
+    addToSums(local, viewPosition, linear, depth, uintBitsToFloat(uint(depthIndex[linear] >> 32)));
 #endif
 }
 #endif

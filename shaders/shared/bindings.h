@@ -57,6 +57,8 @@ using mat4 = glm::mat4;
 #define SUBSCAN_SSBO_POINT_BOUNDS 10  // ivec4: min x, min y, max x, max y of occupied texels
 #define SUBSCAN_SSBO_FILL_REACH 11    // uint per texel, all levels: per direction, 4 bits of level
 #define SUBSCAN_SSBO_COLOR_SUMS 12    // uvec4 per pixel: fixed-point linear RGB sums, point count
+#define SUBSCAN_SSBO_NORMAL_SUMS 20   // 3 int per pixel, with the normal blend: fixed-point
+                                      // sums of the view-space normals facing the eye
 #define SUBSCAN_SSBO_CLEAR 13         // uint words GpuClear fills (its own binding: no pass's)
 #define SUBSCAN_SSBO_OCCUPANCY 14     // uint per pixel: which of its 4x4 sub-cells hold points
 #define SUBSCAN_SSBO_POINT_CENTROIDS 15  // uint per texel, levels >= 1: where in the texel its
@@ -149,11 +151,16 @@ struct RasterParams {
     uint pointCount;   // points in this chunk
     uint pixelCount;   // width * height
     float colorBlend;  // points within this relative depth of a pixel's nearest share its colour
+    vec4 normalBlend;  // x: points within this many pixel widths behind a pixel's nearest
+                       // share their normal (with the points' own normals), yzw unused
 };
 // Fixed-point units per 1.0 of linear colour in SUBSCAN_SSBO_COLOR_SUMS: 2^14, so that the
 // darkest 8-bit sRGB step (3e-4) is 5 units, and 2^32 / 2^14 = 262144 white points per pixel
 // fit before a sum overflows.
 #define SUBSCAN_COLOR_SUM_SCALE 16384.0
+// Fixed-point units per 1.0 of a normal's component in SUBSCAN_SSBO_NORMAL_SUMS: 2^12 keeps a
+// unit normal's direction within 0.02 degrees, and 2^31 / 2^12 = 524288 points per pixel fit.
+#define SUBSCAN_NORMAL_SUM_SCALE 4096.0
 
 // DrawPoints (GL_POINTS baselines).
 struct DrawParams {
@@ -244,7 +251,7 @@ static_assert(sizeof(ShadeParams) == 3 * 16 + 3 * SUBSCAN_MAX_LIGHTS * 16 + 16 +
                                          SUBSCAN_MAX_LIGHTS * 64 + 16 +
                                          SUBSCAN_MAX_PROFILE_GAUSSIANS * 16 + 16);
 static_assert(sizeof(FrameParams) == 2 * 64 + 4 * 16);
-static_assert(sizeof(RasterParams) == 16);
+static_assert(sizeof(RasterParams) == 32);
 static_assert(sizeof(DrawParams) == 16);
 static_assert(SUBSCAN_TEXELS_POINT_NORMALS >= SUBSCAN_TEXTURES_LIGHT_MAPS &&
               SUBSCAN_TEXELS_POINT_NORMALS < SUBSCAN_TEXTURES_LIGHT_MAPS + SUBSCAN_MAX_LIGHTS &&

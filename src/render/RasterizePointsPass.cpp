@@ -1,5 +1,6 @@
 #include "render/RasterizePointsPass.h"
 
+#include <cstdint>
 #include <limits>
 
 #include <fmt/format.h>
@@ -12,14 +13,23 @@ namespace {
 
 enum class RasterStage { Depth, Index, Int64, Blend, Resolve };
 
-std::string stageDefines(RasterStage stage, bool useInt64, bool useBlend = false) {
+/// What the blend's sums hold: the colours, the normals, or both.
+struct Blended {
+    bool colors = false;
+    bool normals = false;
+
+    bool any() const { return colors || normals; }
+};
+
+std::string stageDefines(RasterStage stage, bool useInt64, Blended blended = {}) {
     return fmt::format(
         "#define STAGE_DEPTH {}\n#define STAGE_INDEX {}\n#define STAGE_INT64 {}\n"
         "#define STAGE_BLEND {}\n#define STAGE_RESOLVE {}\n#define USE_INT64 {}\n"
-        "#define USE_BLEND {}\n",
+        "#define BLEND_COLORS {}\n#define BLEND_NORMALS {}\n",
         int(stage == RasterStage::Depth), int(stage == RasterStage::Index),
         int(stage == RasterStage::Int64), int(stage == RasterStage::Blend),
-        int(stage == RasterStage::Resolve), int(useInt64), int(useBlend));
+        int(stage == RasterStage::Resolve), int(useInt64), int(blended.colors),
+        int(blended.normals));
 }
 
 constexpr std::string_view kShader = "render/RasterizePoints.comp";
@@ -40,12 +50,19 @@ RasterizePointsPass::RasterizePointsPass(const ShaderSources& sources,
     }
 }
 
-const RasterizePointsPass::BlendPrograms& RasterizePointsPass::blendPrograms(bool int64) {
-    std::optional<BlendPrograms>& programs = int64 ? blend64_ : blend32_;
+const RasterizePointsPass::BlendPrograms& RasterizePointsPass::blendPrograms(bool int64,
+                                                                             bool colors,
+                                                                             bool normals) {
+    std::optional<BlendPrograms>& programs =
+        blendPrograms_[std::size_t(int64) * 4 + std::size_t(colors) * 2 + std::size_t(normals)];
     if (!programs) {
-        programs.emplace(BlendPrograms{
-            Program::compute(sources_, kShader, stageDefines(RasterStage::Blend, int64)),
-            Program::compute(sources_, kShader, stageDefines(RasterStage::Resolve, int64, true))});
+        // The 32-bit path sums in its index stage, which reads the nearest depth anyway.
+        const Blended blended{colors, normals};
+        const RasterStage sums = int64 ? RasterStage::Blend : RasterStage::Index;
+        programs.emplace(
+            BlendPrograms{Program::compute(sources_, kShader, stageDefines(sums, int64, blended)),
+                          Program::compute(sources_, kShader,
+                                           stageDefines(RasterStage::Resolve, int64, blended))});
     }
     return *programs;
 }
@@ -55,8 +72,14 @@ std::string_view RasterizePointsPass::shaderPath() {
 }
 
 std::vector<std::string> RasterizePointsPass::int64VariantDefines() {
-    return {stageDefines(RasterStage::Int64, true), stageDefines(RasterStage::Resolve, true),
-            stageDefines(RasterStage::Blend, true), stageDefines(RasterStage::Resolve, true, true)};
+    std::vector<std::string> defines{stageDefines(RasterStage::Int64, true),
+                                     stageDefines(RasterStage::Resolve, true)};
+    for (const Blended blended :
+         {Blended{true, false}, Blended{false, true}, Blended{true, true}}) {
+        defines.push_back(stageDefines(RasterStage::Blend, true, blended));
+        defines.push_back(stageDefines(RasterStage::Resolve, true, blended));
+    }
+    return defines;
 }
 
 RasterPath RasterizePointsPass::resolvePath(RasterPath requested,
@@ -83,7 +106,8 @@ void RasterizePointsPass::runPerChunk(const Program& program, FrameContext& fram
                                static_cast<std::size_t>(frame.camera.height);
     for (const GpuPointCloud::Chunk& chunk : frame.cloud.chunks()) {
         params_.set({chunk.firstPoint, chunk.pointCount, static_cast<std::uint32_t>(pixels),
-                     frame.settings.raster.colorBlend});
+                     frame.settings.raster.colorBlend,
+                     glm::vec4(frame.settings.raster.normalBlend, 0.0f, 0.0f, 0.0f)});
         params_.bind(SUBSCAN_UBO_PASS);
         chunk.positions.bindTexels(SUBSCAN_TEXELS_POSITIONS, TextureFormat::R32F);
         chunk.colors.bindTexels(SUBSCAN_TEXELS_COLORS, TextureFormat::R32UI);
@@ -145,23 +169,40 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     if (pointNormals && !frame.cloud.hasNormals()) {
         throw Error("the settings ask for the points' normals, but the cloud has none");
     }
+    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
     if (placesOutlineBySubpixels(frame.settings)) {
         // Which 4x4 sub-cells of each pixel hold points (FillRemoval.glsl's outline).
-        Buffer& occupancy = frame.resources.ensureBuffer(
-            "occupancy", static_cast<std::size_t>(width) * static_cast<std::size_t>(height) *
-                             sizeof(std::uint32_t));
+        Buffer& occupancy =
+            frame.resources.ensureBuffer("occupancy", pixels * sizeof(std::uint32_t));
         frame.fill(occupancy, 0u);
         occupancy.bindStorage(SUBSCAN_SSBO_OCCUPANCY);
     }
+    const Blended blended{frame.settings.raster.colorBlend > 0.0f,
+                          pointNormals && frame.settings.raster.normalBlend > 0.0f};
+    if (blended.colors) {
+        // Every point near its pixel's nearest adds to the pixel's sums; the resolve divides.
+        Buffer& sums =
+            frame.resources.ensureBuffer("colorSums", pixels * 4 * sizeof(std::uint32_t));
+        frame.fill(sums, 0u);
+        sums.bindStorage(SUBSCAN_SSBO_COLOR_SUMS);
+    }
+    if (blended.normals) {
+        Buffer& sums =
+            frame.resources.ensureBuffer("normalSums", pixels * 3 * sizeof(std::int32_t));
+        frame.fill(sums, 0u);
+        sums.bindStorage(SUBSCAN_SSBO_NORMAL_SUMS);
+    }
     if (int64) {
-        const std::size_t pixels =
-            static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
         Buffer& depthIndex =
             frame.resources.ensureBuffer("depthIndex", pixels * sizeof(std::uint64_t));
         frame.fill(depthIndex, kEmptyIndex);  // both halves all ones: no depth, no point
         depthIndex.bindStorage(SUBSCAN_SSBO_DEPTH_INDEX);
         runPerChunk(int64Stage_, frame, false);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        if (blended.any()) {
+            runPerChunk(blendPrograms(true, blended.colors, blended.normals).sums, frame, false);
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
         depth.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     } else {
         Texture& pointIndex =
@@ -172,27 +213,11 @@ void RasterizePointsPass::execute(FrameContext& frame) {
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
         depth.bindImageBits(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
         pointIndex.bindImage(SUBSCAN_IMAGE_OUT2, GL_READ_WRITE);
-        runPerChunk(indexStage_, frame, false);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        runPerChunk(blended.any() ? blendPrograms(false, blended.colors, blended.normals).sums
+                                  : indexStage_,
+                    frame, false);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         pointIndex.bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    }
-    const bool blend = frame.settings.raster.colorBlend > 0.0f;
-    if (blend) {
-        // Every point near its pixel's nearest adds to the pixel's sums; the resolve divides.
-        const std::size_t pixels =
-            static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-        Buffer& sums =
-            frame.resources.ensureBuffer("colorSums", pixels * 4 * sizeof(std::uint32_t));
-        frame.fill(sums, 0u);
-        sums.bindStorage(SUBSCAN_SSBO_COLOR_SUMS);
-        if (!int64) {
-            depth.bindImageBits(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-        }
-        runPerChunk(blendPrograms(int64).sums, frame, false);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        if (!int64) {
-            frame.resources.texture("pointIndex").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-        }
     }
     color.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
     if (pointNormals) {
@@ -202,15 +227,12 @@ void RasterizePointsPass::execute(FrameContext& frame) {
     }
     if (frame.settings.surface.localSpacing) {
         // Read only where a point won its pixel, which the resolve writes: nothing to clear.
-        frame.resources
-            .ensureBuffer("acrossLines", static_cast<std::size_t>(width) *
-                                             static_cast<std::size_t>(height) *
-                                             sizeof(std::uint32_t))
+        frame.resources.ensureBuffer("acrossLines", pixels * sizeof(std::uint32_t))
             .bindStorage(SUBSCAN_SSBO_ACROSS_LINES);
     }
-    runPerChunk(blend   ? blendPrograms(int64).resolve
-                : int64 ? resolve64_
-                        : resolve32_,
+    runPerChunk(blended.any() ? blendPrograms(int64, blended.colors, blended.normals).resolve
+                : int64       ? resolve64_
+                              : resolve32_,
                 frame, true);
     // The storage bit for the sub-pixel cells, which fill removal reads.
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -17,7 +18,9 @@ namespace subscan {
 /// (RGBA16F linear). One 64-bit atomicMin pass where the driver has 64-bit atomics, else two
 /// 32-bit passes (depth, then index among points at that depth); both give the same winner.
 /// With RasterSettings::colorBlend > 0 the colour is instead the mean of the points within that
-/// relative depth of the winner (Schuetz et al. 2021): a sum pass after the depth is known.
+/// relative depth of the winner (Schuetz et al. 2021): a sum pass after the depth is known;
+/// with RasterSettings::normalBlend > 0 and the points' own normals, the same pass sums their
+/// normals within that depth.
 /// Its per-pixel words live in the frame's resources ("depthIndex" or "pointIndex"), so one
 /// pass serves views of any size (the camera's, the lights').
 class RasterizePointsPass final : public RenderPass {
@@ -51,11 +54,10 @@ class RasterizePointsPass final : public RenderPass {
     };
 
     void runPerChunk(const Program& program, FrameContext& frame, bool perPixel);
-    const BlendPrograms& blendPrograms(bool int64);
+    const BlendPrograms& blendPrograms(bool int64, bool colors, bool normals);
 
     const ShaderSources& sources_;
-    std::optional<BlendPrograms> blend32_;
-    std::optional<BlendPrograms> blend64_;
+    std::array<std::optional<BlendPrograms>, 8> blendPrograms_;  // by int64, colours, normals
 
     Program depthStage_;
     Program indexStage_;

@@ -114,13 +114,14 @@ void to_json(nlohmann::json& json, const RasterSettings& settings) {
         {"stage_level", settings.stageLevel},
         {"resolution", toString(settings.resolution)},
         {"color_blend", settings.colorBlend},
+        {"normal_blend", settings.normalBlend},
     };
 }
 
 void from_json(const nlohmann::json& json, RasterSettings& settings) {
     rejectUnknownKeys(json, "raster",
                       {"mode", "raster_path", "point_size", "background_srgb", "timing", "clears",
-                       "stage", "stage_level", "resolution", "color_blend"});
+                       "stage", "stage_level", "resolution", "color_blend", "normal_blend"});
     readEnum(json, "mode", settings.mode, kModes, "render mode");
     readEnum(json, "raster_path", settings.path, kPaths, "raster path");
     readSetting(json, "point_size", settings.pointSize, 1.0f, 64.0f);
@@ -131,6 +132,7 @@ void from_json(const nlohmann::json& json, RasterSettings& settings) {
     readSetting(json, "stage_level", settings.stageLevel, 0, SUBSCAN_MAX_PYRAMID_LEVELS - 1);
     readEnum(json, "resolution", settings.resolution, kResolutions, "resolution");
     readSetting(json, "color_blend", settings.colorBlend, 0.0f, 1.0f);
+    readSetting(json, "normal_blend", settings.normalBlend, 0.0f, 16.0f);
 }
 
 void to_json(nlohmann::json& json, const TemporalSettings& settings) {

@@ -56,6 +56,10 @@ struct RasterSettings {
     // nearest (Schuetz et al. 2021), so it no longer depends on which of them wins; 0: the
     // nearest point's colour.
     float colorBlend = 0.0f;
+    // > 0, with the points' own normals: a pixel's normal is the mean of its points' within
+    // this many pixel widths (at the nearest's depth) behind the nearest, so it no longer
+    // depends on which of them wins, and covers the pixel as its supersampled truth does.
+    float normalBlend = 1.0f;
 
     bool operator==(const RasterSettings&) const = default;
 };

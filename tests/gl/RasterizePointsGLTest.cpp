@@ -61,18 +61,16 @@ struct Reference {
     std::vector<double> depth;
 };
 
-/// The CPU reference: projects the stored (float, cloud-relative) positions in double with the
-/// pixel convention of docs/cli.md.
-Reference rasterizeOnCpu(const PointCloud& cloud, const Camera& camera) {
-    const std::size_t pixels = static_cast<std::size_t>(camera.width * camera.height);
-    Reference reference{std::vector<std::uint32_t>(pixels, kEmpty),
-                        std::vector<double>(pixels, std::numeric_limits<double>::infinity())};
+/// Calls visit(point, view-space position, pixel) for every point of `cloud` within the
+/// camera's near and far planes and image: the stored (float, cloud-relative) positions
+/// projected in double with the pixel convention of docs/cli.md, in the points' order.
+template <typename Visit>
+void forEachPointOnScreen(const PointCloud& cloud, const Camera& camera, Visit visit) {
     const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
     const glm::dmat4 projection = camera.projection();
     for (std::uint32_t i = 0; i < cloud.size(); ++i) {
         const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(cloud.positions[i]), 1.0);
-        const double depth = -view.z;
-        if (depth < camera.nearPlane || depth > camera.farPlane) {
+        if (-view.z < camera.nearPlane || -view.z > camera.farPlane) {
             continue;
         }
         const glm::dvec4 clip = projection * view;
@@ -81,13 +79,22 @@ Reference rasterizeOnCpu(const PointCloud& cloud, const Camera& camera) {
         if (x < 0 || y < 0 || x >= camera.width || y >= camera.height) {
             continue;
         }
-        const std::size_t pixel =
-            static_cast<std::size_t>(y) * camera.width + static_cast<std::size_t>(x);
-        if (depth < reference.depth[pixel]) {  // equal depth keeps the earlier (smaller) index
-            reference.depth[pixel] = depth;
+        visit(i, glm::dvec3(view),
+              static_cast<std::size_t>(y) * camera.width + static_cast<std::size_t>(x));
+    }
+}
+
+/// The CPU reference of the nearest point per pixel.
+Reference rasterizeOnCpu(const PointCloud& cloud, const Camera& camera) {
+    const std::size_t pixels = static_cast<std::size_t>(camera.width * camera.height);
+    Reference reference{std::vector<std::uint32_t>(pixels, kEmpty),
+                        std::vector<double>(pixels, std::numeric_limits<double>::infinity())};
+    forEachPointOnScreen(cloud, camera, [&](std::uint32_t i, glm::dvec3 view, std::size_t pixel) {
+        if (-view.z < reference.depth[pixel]) {  // equal depth keeps the earlier (smaller) index
+            reference.depth[pixel] = -view.z;
             reference.winner[pixel] = i;
         }
-    }
+    });
     return reference;
 }
 
@@ -126,6 +133,19 @@ PointCloud testCloud(const Camera& camera, std::uint32_t seed) {
     add(pointAtPixel(camera, 6.5, 6.5, 25.0));                  // beyond far
     std::vector<std::string> warnings;
     return builder.finish(warnings);
+}
+
+/// Gives every point a random direction, half of them facing away from the eye (a normal's sign
+/// is arbitrary without a sensor), but every ninth point none.
+void giveRandomNormals(PointCloud& cloud, std::uint32_t seed) {
+    std::mt19937 random(seed);
+    std::normal_distribution<float> gauss(0.0f, 1.0f);
+    cloud.normals.resize(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        cloud.normals[i] =
+            i % 9 == 0 ? glm::vec3(0.0f)
+                       : glm::normalize(glm::vec3(gauss(random), gauss(random), gauss(random)));
+    }
 }
 
 /// Checks the last frame against `reference` (empty pixels: +inf and no colour) and returns
@@ -279,16 +299,7 @@ TEST_P(RasterPathGLTest, PointNormalsAreTheWinnersFacingTheEye) {
     const Camera camera = smallCamera();
     PointCloud cloud = testCloud(camera, 3);
     const Reference reference = rasterizeOnCpu(cloud, camera);
-    // Random directions, half of them facing away from the eye (a normal's sign is arbitrary
-    // without a sensor), and some points without a normal.
-    std::mt19937 random(6);
-    std::normal_distribution<float> gauss(0.0f, 1.0f);
-    cloud.normals.resize(cloud.size());
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        cloud.normals[i] =
-            i % 9 == 0 ? glm::vec3(0.0f)
-                       : glm::normalize(glm::vec3(gauss(random), gauss(random), gauss(random)));
-    }
+    giveRandomNormals(cloud, 6);
     for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
         SCOPED_TRACE(chunk ? "chunks of 97" : "one chunk");
         Renderer renderer(context, cloud, std::nullopt, chunk);
@@ -296,6 +307,7 @@ TEST_P(RasterPathGLTest, PointNormalsAreTheWinnersFacingTheEye) {
         RenderSettings settings;
         settings.raster.path = GetParam();
         settings.raster.mode = RenderMode::Surface;
+        settings.raster.normalBlend = 0.0f;  // the winner's own normal
         renderer.render(camera, settings, FrameOutputs::Everything);
         const std::vector<float> normals =
             renderer.resources().texture("pointNormals").readFloats();
@@ -322,6 +334,75 @@ TEST_P(RasterPathGLTest, PointNormalsAreTheWinnersFacingTheEye) {
         }
         EXPECT_GT(flipped, 100);  // both orientations occur
         EXPECT_GT(none, 20);      // and points without a normal
+    }
+}
+
+TEST_P(RasterPathGLTest, NormalBlendAveragesTheNormalsNearTheNearest) {
+    // Per pixel: the normalised sum of the normals (each facing the eye, weighted by its
+    // cosine towards the eye) of the points within raster.normalBlend pixel widths behind the
+    // nearest, at the nearest's depth. 10 pixel widths are 0.4 m at 1 m and 2 m at 5 m, so
+    // some of a pixel's ~4 points, spread over 4.5 m, fall inside and some outside.
+    GlContext& context = test::glTestContext();
+    if (GetParam() == RasterPath::Int64 && !context.capabilities().int64Atomics) {
+        GTEST_SKIP() << context.capabilities().renderer << " has no 64-bit atomics";
+    }
+    const Camera camera = smallCamera();
+    PointCloud cloud = testCloud(camera, 4);
+    const Reference reference = rasterizeOnCpu(cloud, camera);
+    giveRandomNormals(cloud, 9);
+    constexpr float kBlend = 10.0f;
+    const double focal = 0.5 * camera.height / std::tan(0.5 * glm::radians(camera.fovyDegrees));
+    const std::size_t pixels = reference.winner.size();
+    std::vector<glm::dvec3> sums(pixels, glm::dvec3(0.0));
+    std::vector<int> counts(pixels, 0);
+    std::vector<int> inPixel(pixels, 0);
+    const glm::dmat3 viewFromCloud(camera.viewFromCloud(cloud.origin));
+    forEachPointOnScreen(cloud, camera, [&](std::uint32_t i, glm::dvec3 view, std::size_t pixel) {
+        ++inPixel[pixel];
+        const double nearest = reference.depth[pixel];
+        if (-view.z <= nearest + kBlend * nearest / focal) {
+            const glm::dvec3 normal =
+                viewFromCloud * glm::dvec3(unpackNormal(packNormal(cloud.normals[i])));
+            const double cosine = glm::dot(normal, glm::normalize(-view));
+            sums[pixel] += std::abs(cosine) * (cosine < 0.0 ? -normal : normal);
+            ++counts[pixel];
+        }
+    });
+    int blended = 0, windowed = 0;
+    for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+        blended += counts[pixel] > 1 ? 1 : 0;
+        windowed += counts[pixel] >= 1 && counts[pixel] < inPixel[pixel] ? 1 : 0;
+    }
+    ASSERT_GT(blended, 20) << "the test should blend pixels of several points";
+    ASSERT_GT(windowed, 20) << "the test should leave points beyond the window out";
+
+    Renderer renderer(context, cloud);
+    for (const float colorBlend : {0.0f, 0.02f}) {
+        SCOPED_TRACE(colorBlend > 0.0f ? "colours blended too" : "normals only");
+        RenderSettings settings;
+        settings.raster.path = GetParam();
+        settings.raster.mode = RenderMode::Surface;
+        settings.raster.normalBlend = kBlend;
+        settings.raster.colorBlend = colorBlend;
+        renderer.render(camera, settings, FrameOutputs::Everything);
+        const std::vector<float> normals =
+            renderer.resources().texture("pointNormals").readFloats();
+        for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+            if (counts[pixel] == 0) {
+                continue;
+            }
+            const double length = glm::length(sums[pixel]);
+            const glm::dvec3 expected = length > 0.0 ? sums[pixel] / length : glm::dvec3(0.0);
+            // RGBA16F's 11 significant bits (1e-3), plus the fixed point: each component of
+            // each normal summed rounds by up to half of 1/4096, which moves the sum's
+            // direction by at most that over the sum's length per point summed.
+            const double tolerance =
+                1e-3 + (length > 0.0 ? counts[pixel] * std::sqrt(3.0) * 0.5 / 4096 / length : 0);
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(normals[4 * pixel + c], expected[c], tolerance)
+                    << "pixel " << pixel << " of " << counts[pixel] << " points";
+            }
+        }
     }
 }
 
@@ -388,24 +469,12 @@ TEST(RasterizePointsGLTest, ColorBlendAveragesThePointsNearTheNearest) {
     const std::size_t pixels = reference.winner.size();
     std::vector<glm::dvec3> sums(pixels, glm::dvec3(0.0));
     std::vector<int> counts(pixels, 0);
-    const glm::dmat4 viewFromCloud = camera.viewFromCloud(cloud.origin);
-    const glm::dmat4 projection = camera.projection();
-    for (std::uint32_t i = 0; i < cloud.size(); ++i) {
-        const glm::dvec4 view = viewFromCloud * glm::dvec4(glm::dvec3(cloud.positions[i]), 1.0);
-        const glm::dvec4 clip = projection * view;
-        const double x = std::floor((clip.x / clip.w + 1.0) * 0.5 * camera.width);
-        const double y = std::floor((1.0 - clip.y / clip.w) * 0.5 * camera.height);
-        if (-view.z < camera.nearPlane || -view.z > camera.farPlane || x < 0 || y < 0 ||
-            x >= camera.width || y >= camera.height) {
-            continue;
-        }
-        const std::size_t pixel =
-            static_cast<std::size_t>(y) * camera.width + static_cast<std::size_t>(x);
+    forEachPointOnScreen(cloud, camera, [&](std::uint32_t i, glm::dvec3 view, std::size_t pixel) {
         if (-view.z <= reference.depth[pixel] * (1.0 + kBlend)) {
             sums[pixel] += glm::dvec3(linearColor(cloud.colors[i]));
             ++counts[pixel];
         }
-    }
+    });
 
     Renderer renderer(context, cloud);
     RenderSettings settings;
