@@ -78,12 +78,14 @@ layout(std430, binding = SUBSCAN_SSBO_NORMAL_SUMS) buffer NormalSums {
 #if BLEND_NORMALS || STAGE_RESOLVE
 layout(binding = SUBSCAN_TEXELS_POINT_NORMALS) uniform usamplerBuffer pointNormals;
 
-/// Chunk point `local`'s normal in view space, turned to face the eye: a normal's sign is
-/// arbitrary where no sensor oriented it, and the side seen is the side shaded. 0 for none.
-vec3 viewNormal(uint local, vec3 viewPosition) {
-    vec3 normal = mat3(frame.viewFromCloud) * unpackNormal(texelFetch(pointNormals, int(local)).r);
-    return dot(normal, towardsEye(viewPosition)) < 0.0 ? -normal : normal;
+/// Chunk point `local`'s normal in view space, 0 for none. Its sign is arbitrary where no
+/// sensor oriented it: the side seen is the side shaded, so users turn it to face the eye.
+vec3 viewNormal(uint local) {
+    return mat3(frame.viewFromCloud) * unpackNormal(texelFetch(pointNormals, int(local)).r);
 }
+#endif
+#if STAGE_BLEND && !(USE_INT64 && (BLEND_COLORS || BLEND_NORMALS))
+#error "STAGE_BLEND is the 64-bit path's sum pass: the 32-bit path sums in STAGE_INDEX"
 #endif
 
 #if STAGE_RESOLVE
@@ -128,8 +130,9 @@ void main() {
     if (any(greaterThanEqual(pixel, imageSizeOfFrame())) || !insideRegion(pixel)) {
         return;
     }
+    uint linear = uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x);  // the pixel's word
 #if USE_INT64
-    uint64_t key = depthIndex[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)];
+    uint64_t key = depthIndex[linear];
     uint winner = uint(key & 0xFFFFFFFFul);
 #else
     uint winner = imageLoad(pointIndex, pixel).r;
@@ -143,7 +146,7 @@ void main() {
 #endif
 #if BLEND_COLORS
     // The winner is among the points summed: the count is at least 1.
-    uvec4 sums = colorSums[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)];
+    uvec4 sums = colorSums[linear];
     vec3 color = vec3(sums.rgb) / (float(sums.a) * SUBSCAN_COLOR_SUM_SCALE);
 #else
     vec3 color = unpackColor(texelFetch(colors, int(winner - raster.firstPoint)).r);
@@ -152,19 +155,19 @@ void main() {
     if (surface.spacing.x > 0.5) {
         vec3 spacing = spacingOnScreen(winner - raster.firstPoint);
         spacingRatio = spacing.x;
-        acrossLines[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)] =
-            packHalf2x16(spacing.yz);
+        acrossLines[linear] = packHalf2x16(spacing.yz);
     }
     imageStore(outColor, pixel, vec4(color, spacingRatio));
     if (surface.normals.z > 0.5) {
 #if BLEND_NORMALS
         // The points summed face the eye, so their sum is 0 only where none had a normal.
-        uint first = 3u * (uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x));
-        vec3 sum = vec3(normalSums[first], normalSums[first + 1u], normalSums[first + 2u]);
+        vec3 sum = vec3(normalSums[3u * linear], normalSums[3u * linear + 1u],
+                        normalSums[3u * linear + 2u]);
         vec3 normal = dot(sum, sum) > 0.0 ? normalize(sum) : vec3(0.0);
 #else
         uint local = winner - raster.firstPoint;
-        vec3 normal = viewNormal(local, viewPositionOfPoint(local));
+        vec3 normal = viewNormal(local);
+        normal = dot(normal, towardsEye(viewPositionOfPoint(local))) < 0.0 ? -normal : normal;
 #endif
         imageStore(outNormal, pixel, vec4(normal, 0.0));
     }
@@ -195,12 +198,12 @@ void addToSums(uint local, vec3 viewPosition, uint linear, float depth, float ne
         // area on screen is that cosine times its own, so the mean is over the pixel's visible
         // surface, as its supersampled truth averages it, and a rim's grazing points count
         // little.
-        vec3 facing = viewNormal(local, viewPosition);
-        facing *= dot(facing, towardsEye(viewPosition));
-        ivec3 normal = ivec3(round(facing * SUBSCAN_NORMAL_SUM_SCALE));
-        atomicAdd(normalSums[3u * linear], normal.x);
-        atomicAdd(normalSums[3u * linear + 1u], normal.y);
-        atomicAdd(normalSums[3u * linear + 2u], normal.z);
+        vec3 normal = viewNormal(local);
+        vec3 weighted = normal * dot(normal, towardsEye(viewPosition));  // faces the eye
+        ivec3 fixedPoint = ivec3(round(weighted * SUBSCAN_NORMAL_SUM_SCALE));
+        atomicAdd(normalSums[3u * linear], fixedPoint.x);
+        atomicAdd(normalSums[3u * linear + 1u], fixedPoint.y);
+        atomicAdd(normalSums[3u * linear + 2u], fixedPoint.z);
     }
 #endif
 }

@@ -104,7 +104,8 @@ std::vector<PassTiming> LightMaps::update(const GpuPointCloud& cloud, const Boun
     std::vector<PassTiming> timings;
     for (std::size_t i = 0; i < count; ++i) {
         const Key key{towardsLightInWorld(lights[i], camera.view),
-                      settings.shading.lightMapResolution, settings.surface, settings.raster.path};
+                      settings.shading.lightMapResolution, settings.surface, settings.raster.path,
+                      settings.raster.normalBlend};
         if (maps_[i].texture.id() != 0 && keys_[i] == key) {
             continue;
         }

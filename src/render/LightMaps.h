@@ -85,6 +85,7 @@ class LightMaps {
         int resolution = 0;
         SurfaceSettings surface;
         RasterPath path = RasterPath::Auto;
+        float normalBlend = 0.0f;  // the normals a map keeps
         bool operator==(const Key&) const = default;
     };
 

@@ -18,9 +18,9 @@ namespace subscan {
 /// (RGBA16F linear). One 64-bit atomicMin pass where the driver has 64-bit atomics, else two
 /// 32-bit passes (depth, then index among points at that depth); both give the same winner.
 /// With RasterSettings::colorBlend > 0 the colour is instead the mean of the points within that
-/// relative depth of the winner (Schuetz et al. 2021): a sum pass after the depth is known;
-/// with RasterSettings::normalBlend > 0 and the points' own normals, the same pass sums their
-/// normals within that depth.
+/// relative depth of the winner (Schuetz et al. 2021), and with RasterSettings::normalBlend > 0
+/// and the points' own normals the normal the mean of theirs within that many pixel widths: the
+/// 32-bit path sums them in its index stage, the 64-bit one in a pass after its own.
 /// Its per-pixel words live in the frame's resources ("depthIndex" or "pointIndex"), so one
 /// pass serves views of any size (the camera's, the lights').
 class RasterizePointsPass final : public RenderPass {
@@ -47,7 +47,8 @@ class RasterizePointsPass final : public RenderPass {
     std::vector<std::uint32_t> readWinners(const FrameResources& resources) const;
 
   private:
-    /// The colour-blending stages, compiled on first use.
+    /// The stages that sum and resolve the blends (the 32-bit path's sums are its index
+    /// stage), compiled on first use.
     struct BlendPrograms {
         Program sums;
         Program resolve;

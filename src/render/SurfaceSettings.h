@@ -11,10 +11,10 @@
 namespace subscan {
 
 /// Where the surface's normals come from (DESIGN.md §5 step 5): the points' own (the file's, or
-/// estimated once by PCA of their neighbours; the rasterizer keeps the nearest point's and
-/// pull-push carries them into the gaps), or the paper's, rebuilt from the filled depth for every
-/// view. Auto: the points' where the renderer has them, else the screen's. The renderer
-/// resolves Auto before its passes see the settings.
+/// estimated once by PCA of their neighbours; the rasterizer blends a pixel's nearest ones,
+/// RasterSettings::normalBlend, and pull-push carries them into the gaps), or the paper's, rebuilt
+/// from the filled depth for every view. Auto: the points' where the renderer has them, else the
+/// screen's. The renderer resolves Auto before its passes see the settings.
 enum class NormalSource { Auto, Points, Screen };
 /// Names as the CLI and JSON spell them; the parser throws subscan::Error listing the choices.
 std::string toString(NormalSource source);

@@ -650,9 +650,13 @@ TEST(LightMapsGLTest, MapsAreRebuiltOnlyWhenTheirLightOrItsSettingsChange) {
     renderer.render(camera, settings);
     EXPECT_EQ(maps.builds(), 5u) << "a surface setting reshapes both maps";
 
+    settings.raster.normalBlend = 2.0f;
+    renderer.render(camera, settings);
+    EXPECT_EQ(maps.builds(), 7u) << "the maps keep the blended normals";
+
     settings.shading.lightMapResolution = 128;
     renderer.render(camera, settings);
-    EXPECT_EQ(maps.builds(), 7u);
+    EXPECT_EQ(maps.builds(), 9u);
     EXPECT_EQ(std::max(maps.maps()[0].camera.width, maps.maps()[0].camera.height),
               128 + 2 * kLightMapMargin);
 
@@ -661,18 +665,18 @@ TEST(LightMapsGLTest, MapsAreRebuiltOnlyWhenTheirLightOrItsSettingsChange) {
     settings.raster.mode = RenderMode::Points;
     settings.shading.shadows = true;
     renderer.render(camera, settings);
-    EXPECT_EQ(maps.builds(), 7u) << "frames without shadows build no map";
+    EXPECT_EQ(maps.builds(), 9u) << "frames without shadows build no map";
 
     // A light fixed to the view turns with the camera: its map follows, the other's stays.
     settings.raster.mode = RenderMode::Surface;
     settings.shading.lights[1].space = LightSpace::View;
     settings.shading.lights[1].direction = glm::vec3(-0.5f, 0.5f, 0.7f);
     renderer.render(camera, settings);
-    EXPECT_EQ(maps.builds(), 8u);
+    EXPECT_EQ(maps.builds(), 10u);
     renderer.render(camera, settings);
-    EXPECT_EQ(maps.builds(), 8u);
+    EXPECT_EQ(maps.builds(), 10u);
     renderer.render(lookingAt({0.9, 1.2, 1.4}, {0.1, 0.0, 0.0}, {0.0, 1.0, 0.0}), settings);
-    EXPECT_EQ(maps.builds(), 9u);
+    EXPECT_EQ(maps.builds(), 11u);
 }
 
 TEST(LightMapsGLTest, ALightFixedToTheViewShadesLikeTheSameLightInTheScene) {

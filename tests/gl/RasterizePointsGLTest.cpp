@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
@@ -183,6 +184,54 @@ std::size_t expectMatchesReference(Renderer& renderer, const PointCloud& cloud,
     return covered;
 }
 
+/// Per pixel, what a blend sums: its points' values (colours, or normals) and their count.
+struct BlendSums {
+    std::vector<glm::dvec3> sums;
+    std::vector<int> counts;
+
+    int pixelsOfSeveral() const {
+        return static_cast<int>(
+            std::count_if(counts.begin(), counts.end(), [](int count) { return count > 1; }));
+    }
+};
+
+/// The colour blend's sums: the linear colours of the points within `blend` relative depth of
+/// their pixel's nearest.
+BlendSums blendColorsOnCpu(const PointCloud& cloud, const Camera& camera,
+                           const Reference& reference, float blend) {
+    const std::size_t pixels = reference.winner.size();
+    BlendSums blended{std::vector<glm::dvec3>(pixels, glm::dvec3(0.0)),
+                      std::vector<int>(pixels, 0)};
+    forEachPointOnScreen(cloud, camera, [&](std::uint32_t i, glm::dvec3 view, std::size_t pixel) {
+        if (-view.z <= reference.depth[pixel] * (1.0 + blend)) {
+            blended.sums[pixel] += glm::dvec3(linearColor(cloud.colors[i]));
+            ++blended.counts[pixel];
+        }
+    });
+    return blended;
+}
+
+/// Checks the last frame's depth and colours against the colour blend's sums.
+void expectBlendedColors(Renderer& renderer, const Reference& reference, const BlendSums& blended) {
+    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
+    const std::vector<float> color = renderer.resources().texture("color").readFloats();
+    for (std::size_t pixel = 0; pixel < reference.winner.size(); ++pixel) {
+        const int count = blended.counts[pixel];
+        if (count == 0) {
+            EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
+            continue;
+        }
+        EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel]);
+        for (int c = 0; c < 3; ++c) {
+            // Fixed point of 1/16384 per point, then RGBA16F's 11 significant bits: dark
+            // colours keep their 8-bit steps (the darkest, 3e-4, is 5 units).
+            const double expected = blended.sums[pixel][c] / count;
+            EXPECT_NEAR(color[4 * pixel + c], expected, 1.0 / 16384 + expected / 1024)
+                << "pixel " << pixel << " of " << count << " points";
+        }
+    }
+}
+
 /// The compute path under test, run whole and in chunks of 97 points.
 class RasterPathGLTest : public ::testing::TestWithParam<RasterPath> {};
 
@@ -341,7 +390,8 @@ TEST_P(RasterPathGLTest, NormalBlendAveragesTheNormalsNearTheNearest) {
     // Per pixel: the normalised sum of the normals (each facing the eye, weighted by its
     // cosine towards the eye) of the points within raster.normalBlend pixel widths behind the
     // nearest, at the nearest's depth. 10 pixel widths are 0.4 m at 1 m and 2 m at 5 m, so
-    // some of a pixel's ~4 points, spread over 4.5 m, fall inside and some outside.
+    // some of a pixel's ~4 points, spread over 4.5 m, fall inside and some outside. The
+    // colour blend alongside takes the same stage's other sums.
     GlContext& context = test::glTestContext();
     if (GetParam() == RasterPath::Int64 && !context.capabilities().int64Atomics) {
         GTEST_SKIP() << context.capabilities().renderer << " has no 64-bit atomics";
@@ -351,56 +401,67 @@ TEST_P(RasterPathGLTest, NormalBlendAveragesTheNormalsNearTheNearest) {
     const Reference reference = rasterizeOnCpu(cloud, camera);
     giveRandomNormals(cloud, 9);
     constexpr float kBlend = 10.0f;
-    const double focal = 0.5 * camera.height / std::tan(0.5 * glm::radians(camera.fovyDegrees));
+    constexpr float kColorBlend = 0.02f;
+    const double focal = camera.focalLengthPixels();
     const std::size_t pixels = reference.winner.size();
-    std::vector<glm::dvec3> sums(pixels, glm::dvec3(0.0));
-    std::vector<int> counts(pixels, 0);
+    BlendSums normals{std::vector<glm::dvec3>(pixels, glm::dvec3(0.0)),
+                      std::vector<int>(pixels, 0)};
     std::vector<int> inPixel(pixels, 0);
     const glm::dmat3 viewFromCloud(camera.viewFromCloud(cloud.origin));
     forEachPointOnScreen(cloud, camera, [&](std::uint32_t i, glm::dvec3 view, std::size_t pixel) {
         ++inPixel[pixel];
-        const double nearest = reference.depth[pixel];
-        if (-view.z <= nearest + kBlend * nearest / focal) {
+        const double edge = reference.depth[pixel] * (1.0 + kBlend / focal);
+        // The GPU compares float depths: no point may lie within their rounding of the edge.
+        ASSERT_GT(std::abs(-view.z - edge), 1e-5 * edge) << "point " << i;
+        if (-view.z <= edge) {
             const glm::dvec3 normal =
                 viewFromCloud * glm::dvec3(unpackNormal(packNormal(cloud.normals[i])));
             const double cosine = glm::dot(normal, glm::normalize(-view));
-            sums[pixel] += std::abs(cosine) * (cosine < 0.0 ? -normal : normal);
-            ++counts[pixel];
+            normals.sums[pixel] += std::abs(cosine) * (cosine < 0.0 ? -normal : normal);
+            ++normals.counts[pixel];
         }
     });
-    int blended = 0, windowed = 0;
+    int windowed = 0;
     for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
-        blended += counts[pixel] > 1 ? 1 : 0;
-        windowed += counts[pixel] >= 1 && counts[pixel] < inPixel[pixel] ? 1 : 0;
+        windowed += normals.counts[pixel] >= 1 && normals.counts[pixel] < inPixel[pixel] ? 1 : 0;
     }
-    ASSERT_GT(blended, 20) << "the test should blend pixels of several points";
+    ASSERT_GT(normals.pixelsOfSeveral(), 20) << "the test should blend pixels of several points";
     ASSERT_GT(windowed, 20) << "the test should leave points beyond the window out";
+    const BlendSums colors = blendColorsOnCpu(cloud, camera, reference, kColorBlend);
 
-    Renderer renderer(context, cloud);
-    for (const float colorBlend : {0.0f, 0.02f}) {
-        SCOPED_TRACE(colorBlend > 0.0f ? "colours blended too" : "normals only");
-        RenderSettings settings;
-        settings.raster.path = GetParam();
-        settings.raster.mode = RenderMode::Surface;
-        settings.raster.normalBlend = kBlend;
-        settings.raster.colorBlend = colorBlend;
-        renderer.render(camera, settings, FrameOutputs::Everything);
-        const std::vector<float> normals =
-            renderer.resources().texture("pointNormals").readFloats();
-        for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
-            if (counts[pixel] == 0) {
-                continue;
+    for (const std::size_t chunk : {std::size_t{0}, std::size_t{97}}) {
+        Renderer renderer(context, cloud, std::nullopt, chunk);
+        for (const float colorBlend : {0.0f, kColorBlend}) {
+            SCOPED_TRACE(fmt::format("{}, {}", chunk ? "chunks of 97" : "one chunk",
+                                     colorBlend > 0.0f ? "colours blended too" : "normals only"));
+            RenderSettings settings;
+            settings.raster.path = GetParam();
+            settings.raster.mode = RenderMode::Surface;
+            settings.raster.normalBlend = kBlend;
+            settings.raster.colorBlend = colorBlend;
+            renderer.render(camera, settings, FrameOutputs::Everything);
+            const std::vector<float> image =
+                renderer.resources().texture("pointNormals").readFloats();
+            for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+                const int count = normals.counts[pixel];
+                if (count == 0) {
+                    continue;
+                }
+                const double length = glm::length(normals.sums[pixel]);
+                const glm::dvec3 expected =
+                    length > 0.0 ? normals.sums[pixel] / length : glm::dvec3(0.0);
+                // RGBA16F's 11 significant bits (1e-3), plus the fixed point: each component of
+                // each normal summed rounds by up to half of 1/4096, an error E of the sum S
+                // that turns its normalised direction by at most 2 |E| / |S|.
+                const double tolerance =
+                    1e-3 + (length > 0.0 ? 2.0 * count * std::sqrt(3.0) * 0.5 / 4096 / length : 0);
+                for (int c = 0; c < 3; ++c) {
+                    EXPECT_NEAR(image[4 * pixel + c], expected[c], tolerance)
+                        << "pixel " << pixel << " of " << count << " points";
+                }
             }
-            const double length = glm::length(sums[pixel]);
-            const glm::dvec3 expected = length > 0.0 ? sums[pixel] / length : glm::dvec3(0.0);
-            // RGBA16F's 11 significant bits (1e-3), plus the fixed point: each component of
-            // each normal summed rounds by up to half of 1/4096, which moves the sum's
-            // direction by at most that over the sum's length per point summed.
-            const double tolerance =
-                1e-3 + (length > 0.0 ? counts[pixel] * std::sqrt(3.0) * 0.5 / 4096 / length : 0);
-            for (int c = 0; c < 3; ++c) {
-                EXPECT_NEAR(normals[4 * pixel + c], expected[c], tolerance)
-                    << "pixel " << pixel << " of " << counts[pixel] << " points";
+            if (colorBlend > 0.0f) {
+                expectBlendedColors(renderer, reference, colors);
             }
         }
     }
@@ -466,39 +527,14 @@ TEST(RasterizePointsGLTest, ColorBlendAveragesThePointsNearTheNearest) {
     const PointCloud cloud = testCloud(camera, 2);
     const Reference reference = rasterizeOnCpu(cloud, camera);
     constexpr float kBlend = 0.02f;
-    const std::size_t pixels = reference.winner.size();
-    std::vector<glm::dvec3> sums(pixels, glm::dvec3(0.0));
-    std::vector<int> counts(pixels, 0);
-    forEachPointOnScreen(cloud, camera, [&](std::uint32_t i, glm::dvec3 view, std::size_t pixel) {
-        if (-view.z <= reference.depth[pixel] * (1.0 + kBlend)) {
-            sums[pixel] += glm::dvec3(linearColor(cloud.colors[i]));
-            ++counts[pixel];
-        }
-    });
+    const BlendSums expected = blendColorsOnCpu(cloud, camera, reference, kBlend);
+    EXPECT_GT(expected.pixelsOfSeveral(), 20) << "the test should blend pixels of several points";
 
     Renderer renderer(context, cloud);
     RenderSettings settings;
     settings.raster.colorBlend = kBlend;
     renderer.render(camera, settings);
-    const std::vector<float> depth = renderer.resources().texture("depth").readFloats();
-    const std::vector<float> color = renderer.resources().texture("color").readFloats();
-    int blended = 0;
-    for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
-        if (counts[pixel] == 0) {
-            EXPECT_TRUE(std::isinf(depth[pixel])) << "pixel " << pixel;
-            continue;
-        }
-        blended += counts[pixel] > 1 ? 1 : 0;
-        EXPECT_NEAR(depth[pixel], reference.depth[pixel], 1e-5 * reference.depth[pixel]);
-        for (int c = 0; c < 3; ++c) {
-            // Fixed point of 1/16384 per point, then RGBA16F's 11 significant bits: dark
-            // colours keep their 8-bit steps (the darkest, 3e-4, is 5 units).
-            const double expected = sums[pixel][c] / counts[pixel];
-            EXPECT_NEAR(color[4 * pixel + c], expected, 1.0 / 16384 + expected / 1024)
-                << "pixel " << pixel << " of " << counts[pixel] << " points";
-        }
-    }
-    EXPECT_GT(blended, 20) << "the test should blend pixels of several points";
+    expectBlendedColors(renderer, reference, expected);
 }
 
 TEST(RasterizePointsGLTest, AFarFrameAfterACloseOneKeepsNothingOfIt) {

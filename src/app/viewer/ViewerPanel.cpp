@@ -395,11 +395,13 @@ void ViewerPanel::drawView(RenderSettings& settings, Navigation& navigation,
             "0: a pixel shows its nearest point's colour. Above 0: the mean colour of its points "
             "within that share of the nearest's depth, so colours stop flickering as points "
             "trade places.");
-        ImGui::SliderFloat("normal blend (px)", &raster.normalBlend, 0.0f, 8.0f, "%.1f");
-        helpTooltip(
-            "With the points' normals, 0: a pixel shows its nearest point's normal. Above 0: the "
-            "mean normal of its points within that many pixel widths behind the nearest, so "
-            "shading stops flickering where overlapping scans trade places.");
+        if (settings.surface.normals != NormalSource::Screen) {
+            ImGui::SliderFloat("normal blend (px)", &raster.normalBlend, 0.0f, 8.0f, "%.1f");
+            helpTooltip(
+                "With the points' normals, 0: a pixel shows its nearest point's normal. Above 0: "
+                "the mean normal of its points within that many pixel widths behind the "
+                "nearest, so shading stops flickering where overlapping scans trade places.");
+        }
         choiceCombo<RasterPath>("rasterizer", raster.path, kRasterPaths,
                                 [](RasterPath path) { return toString(path); });
         helpTooltip(status.int64Atomics

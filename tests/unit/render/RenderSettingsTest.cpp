@@ -22,6 +22,7 @@ TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
     settings.timing = TimingMode::FinishAndClock;
     settings.resolution = Resolution::Half;
     settings.colorBlend = 0.01f;
+    settings.normalBlend = 2.5f;
     const RasterSettings back = nlohmann::json(settings).get<RasterSettings>();
     EXPECT_EQ(back, settings);
     EXPECT_EQ(back.mode, settings.mode);
@@ -34,6 +35,9 @@ TEST(RenderSettingsTest, JsonRoundTripAndPartialFiles) {
     const RasterSettings partial = nlohmann::json{{"point_size", 3}}.get<RasterSettings>();
     EXPECT_EQ(partial.pointSize, 3);
     EXPECT_EQ(partial.mode, RasterSettings{}.mode);
+    EXPECT_EQ(partial.normalBlend, 1.0f);  // the measured default (docs/pipeline.md)
+    EXPECT_THROW(nlohmann::json({{"normal_blend", -1.0}}).get<RasterSettings>(), Error);
+    EXPECT_THROW(nlohmann::json({{"normal_blend", 17.0}}).get<RasterSettings>(), Error);
 }
 
 TEST(RenderSettingsTest, TemporalSettingsRoundTripAndRefuseImpossibleValues) {
