@@ -59,6 +59,12 @@ for kind in global local; do
     build/src/subscan render synthetic:outdoor-station --mode surface --view sensor --width 480 --height 360 "${settings[@]}" -o "$tmp/station-$kind.png"
 done
 side_by_side "$tmp/station-global.png" "$tmp/station-local.png" docs/images/local-spacing-station.png
+# The points' normals: the nearest point's per pixel (left) and the mean of a pixel's points'
+# (right, raster.normal_blend), from far enough that a pixel holds several points.
+echo '{"raster": {"normal_blend": 0}}' >"$tmp/nearest.json"
+build/src/subscan render "$scan" --mode surface --width 320 --height 320 --settings "$tmp/nearest.json" -o "$tmp/nearest.png"
+build/src/subscan render "$scan" --mode surface --width 320 --height 320 -o "$tmp/blended.png"
+side_by_side "$tmp/nearest.png" "$tmp/blended.png" docs/images/normal-blend.png
 # The screen-space normals towards the outline: the bunny's mesh (the truth), its vertices'
 # surface with those normals as blended, and with them towards the outline.
 bunny="$data/bun_zipper.ply"
