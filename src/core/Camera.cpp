@@ -133,11 +133,25 @@ BoxFit fitBox(const Bounds& bounds, const glm::dvec3& center, const glm::dmat3& 
 
 }  // namespace
 
+OrbitFrame orbitFrame(UpAxis up) {
+    // The side is +X for all three, so that a frame's right-handed: side x up = front.
+    switch (up) {
+        case UpAxis::Y:
+            return {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
+        case UpAxis::Z:
+            return {{0, 0, 1}, {0, -1, 0}, {1, 0, 0}};
+        case UpAxis::NegativeY:
+            return {{0, -1, 0}, {0, 0, -1}, {1, 0, 0}};
+    }
+    throw Error("unknown up axis");
+}
+
 glm::dvec2 orbitAngles(const glm::dvec3& towardsEye, UpAxis up) {
     const glm::dvec3 direction = glm::normalize(towardsEye);
-    const double along = up == UpAxis::Y ? direction.y : direction.z;
-    const double yaw = up == UpAxis::Y ? std::atan2(direction.x, direction.z)
-                                       : std::atan2(direction.x, -direction.y);
+    const OrbitFrame frame = orbitFrame(up);
+    const double yaw =
+        std::atan2(glm::dot(direction, frame.side), glm::dot(direction, frame.front));
+    const double along = glm::dot(direction, frame.up);
     return glm::degrees(glm::dvec2(yaw, std::asin(std::clamp(along, -1.0, 1.0))));
 }
 
@@ -158,20 +172,15 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
         std::atan(std::tan(halfFovy) * static_cast<double>(width) / static_cast<double>(height));
     const double yaw = glm::radians(orbit.yawDegrees);
     const double pitch = glm::radians(orbit.pitchDegrees);
-    glm::dvec3 direction;  // from the centre towards the eye
-    glm::dvec3 up;
-    if (orbit.up == UpAxis::Y) {
-        direction = {std::sin(yaw) * std::cos(pitch), std::sin(pitch),
-                     std::cos(yaw) * std::cos(pitch)};
-        up = {0, 1, 0};
-    } else {
-        direction = {std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch),
-                     std::sin(pitch)};
-        up = {0, 0, 1};
-    }
+    const OrbitFrame frame = orbitFrame(orbit.up);
+    // From the centre towards the eye.
+    const glm::dvec3 direction = std::sin(yaw) * std::cos(pitch) * frame.side +
+                                 std::sin(pitch) * frame.up +
+                                 std::cos(yaw) * std::cos(pitch) * frame.front;
+    glm::dvec3 up = frame.up;
     // Looking straight down the up axis leaves lookAt without a horizon: tilt the up vector.
     if (std::abs(glm::dot(direction, up)) > 0.9999) {
-        up = orbit.up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+        up = -frame.front;
     }
     constexpr double kMargin = 1.05;
     double distance = kMargin * radius / std::sin(std::min(halfFovy, halfFovx));
@@ -203,8 +212,11 @@ glm::dvec3 pixelCentreDirection(const Camera& camera, int x, int y) {
 }
 
 UpAxis upAxisFor(std::string_view up, std::string_view format) {
+    if (up == "-y") {
+        return UpAxis::NegativeY;
+    }
     if (up != "auto" && up != "y" && up != "z") {
-        throw Error(fmt::format("up '{}' is not auto, y or z", up));
+        throw Error(fmt::format("up '{}' is not auto, y, z or -y", up));
     }
     return up == "z" || (up == "auto" && format == "las") ? UpAxis::Z : UpAxis::Y;
 }

@@ -61,12 +61,24 @@ glm::ivec4 projectedPixelBounds(const Camera& camera, const Bounds& bounds);
 /// perspective camera, scaled to z = −1: the view-space point at linear depth d is d times it.
 glm::dvec3 pixelCentreDirection(const Camera& camera, int x, int y);
 
-enum class UpAxis { Y, Z };
+/// Which way is up in a scan's coordinates. NegativeY: a depth camera's own frame (x right, y
+/// down, z forward), as organised PCDs hold it.
+enum class UpAxis { Y, Z, NegativeY };
 
-/// The up axis `up` ("auto", "y" or "z") names for a scan read as `format` (LoadedScan's and
-/// subscan.Cloud's: "las", "ply", ...): auto is Z for LAS-family files (airborne and
-/// terrestrial LiDAR), Y otherwise. Throws subscan::Error for any other name.
+/// The up axis `up` ("auto", "y", "z" or "-y") names for a scan read as `format` (LoadedScan's
+/// and subscan.Cloud's: "las", "ply", ...): auto is Z for LAS-family files (airborne and
+/// terrestrial LiDAR), Y otherwise (upAxisForScan also looks at an organised grid's camera).
+/// Throws subscan::Error for any other name.
 UpAxis upAxisFor(std::string_view up, std::string_view format);
+
+/// The orbit's directions for an up axis: `up`, and from the orbited point towards the eye at
+/// pitch 0, `front` (yaw 0) and `side` (yaw 90, the picture's right at yaw 0).
+struct OrbitFrame {
+    glm::dvec3 up;
+    glm::dvec3 front;
+    glm::dvec3 side;
+};
+OrbitFrame orbitFrame(UpAxis up);
 
 /// How an orbit without a given distance frames the bounds: their bounding sphere fits the
 /// narrower field of view with 5 % to spare, the same distance from every direction (what the
@@ -76,7 +88,8 @@ UpAxis upAxisFor(std::string_view up, std::string_view format);
 enum class Framing { Sphere, Box };
 
 /// A camera orbiting the middle of `bounds`: yaw turns around the up axis, pitch raises the eye.
-/// Yaw 0, pitch 0 looks at the front: from +Z for Y-up data, from -Y for Z-up data (LiDAR).
+/// Yaw 0, pitch 0 looks at the front: from +Z for Y-up data, from -Y for Z-up data (LiDAR), from
+/// -Z (the depth camera's side) for -Y-up data (orbitFrame).
 struct OrbitView {
     double yawDegrees = 30.0;
     double pitchDegrees = 20.0;

@@ -146,16 +146,17 @@ std::vector<Rgba8> pointColors(const PointCloud& cloud, Coloring coloring, UpAxi
         }
         case Coloring::Height: {
             const int axis = up == UpAxis::Z ? 2 : 1;
+            const float sign = up == UpAxis::NegativeY ? -1.0f : 1.0f;
             std::vector<Rgba8> colors;
             colors.reserve(cloud.size());
             if (cloud.size() == 0) {
                 return colors;
             }
-            const auto [low, high] =
-                percentiles(cloud.size(), [&](std::size_t i) { return cloud.positions[i][axis]; });
+            const auto [low, high] = percentiles(
+                cloud.size(), [&](std::size_t i) { return sign * cloud.positions[i][axis]; });
             const float range = high > low ? high - low : 1.0f;
             for (const glm::vec3& position : cloud.positions) {
-                colors.push_back(viridis((position[axis] - low) / range));
+                colors.push_back(viridis((sign * position[axis] - low) / range));
             }
             return colors;
         }

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 
 #include "core/Error.h"
 
@@ -161,6 +162,26 @@ PinholeFit fitPinhole(const PointCloud& cloud, const OrganisedGrid& grid) {
     return fit;
 }
 
+UpAxis upAxisForScan(std::string_view up, std::string_view format, const PointCloud& cloud,
+                     const OrganisedGrid& grid) {
+    const UpAxis named = upAxisFor(up, format);
+    if (up != "auto" || grid.empty()) {
+        return named;
+    }
+    try {
+        const PinholeFit fit = fitPinhole(cloud, grid);
+        if (fit.rmsErrorPixels > kPinholeToleranceRmsPixels) {
+            return named;
+        }
+        const glm::dvec3 pictureUp(glm::inverse(fit.camera.view) * glm::dvec4(0, 1, 0, 0));
+        return glm::dot(glm::normalize(pictureUp), glm::dvec3(0, -1, 0)) > std::sqrt(0.5)
+                   ? UpAxis::NegativeY
+                   : named;
+    } catch (const Error&) {
+        return named;  // no camera to take it from: as viewFromSensor, the sensor's or none
+    }
+}
+
 Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up, int width,
                     int height, double fovyDegrees) {
     const Bounds framed = framingBounds(cloud);
@@ -178,7 +199,8 @@ Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up
     camera.width = width;
     camera.height = height;
     camera.fovyDegrees = fovyDegrees;
-    glm::dvec3 upVector = up == UpAxis::Y ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
+    const OrbitFrame frame = orbitFrame(up);
+    glm::dvec3 upVector = frame.up;
     glm::dvec3 direction = target - sensor.position;
     if (nearestInBox == sensor.position) {
         // A station inside its scene sees all round: look level, towards the middle's azimuth
@@ -187,11 +209,11 @@ Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up
     }
     if (glm::length(direction) <= 1e-6 * std::max(diagonal, 1e-9)) {
         // At the middle of the points: look at the front.
-        direction = up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+        direction = -frame.front;
     }
     direction = glm::normalize(direction);
     if (std::abs(glm::dot(direction, upVector)) > 0.9999) {
-        upVector = up == UpAxis::Y ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+        upVector = -frame.front;
     }
     camera.view = glm::lookAt(sensor.position, sensor.position + direction, upVector);
     double nearest = std::numeric_limits<double>::infinity();

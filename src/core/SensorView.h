@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -46,6 +47,12 @@ PinholeFit fitPinhole(const PointCloud& cloud, const OrganisedGrid& grid);
 /// The largest RMS reprojection error (pixels) at which a grid is taken for a pinhole camera's
 /// image; a scanner's organised grid (rows of angles, not a pinhole) misses by far more.
 inline constexpr double kPinholeToleranceRmsPixels = 1.0;
+
+/// upAxisFor's axis, except that `auto` for an organised cloud whose grid is a pinhole image
+/// takes -Y where its camera's picture points up along -Y (within 45 degrees): a depth
+/// camera's own frame, which the Y-up default showed upside down and from behind.
+UpAxis upAxisForScan(std::string_view up, std::string_view format, const PointCloud& cloud,
+                     const OrganisedGrid& grid);
 
 /// The view from `sensor`: towards the middle of the points' framing box (level, towards its
 /// azimuth, from a sensor inside the points' bounds: a station amid its scene), `up` kept

@@ -23,7 +23,7 @@ namespace subscan::python {
 
 UpAxis upAxisArgument(const std::string& up, const CloudData& cloud) {
     try {
-        return upAxisFor(up, cloud.format());
+        return upAxisForScan(up, cloud.format(), cloud.cloud(), cloud.grid);
     } catch (const Error& error) {
         throw py::value_error(error.what());
     }
@@ -213,8 +213,8 @@ Bad values raise ValueError with the sentence camera.json's reader gives.
 The camera `subscan render` uses without --camera: orbiting the middle of the cloud's bounds
 (or `center`), `yaw` degrees around the up axis, `pitch` degrees above the horizon, at
 `distance` (default: the box of its points, 0.1 to 99.9 % per axis, fills 95 % of the picture's
-limiting side, centred); up 'auto' is Z for LAS files, else Y. Near and far hug the bounding
-sphere.
+limiting side, centred); up 'auto' is Z for LAS files, -Y for a depth camera's organised grid
+in its own frame, else Y (or 'y', 'z', '-y'). Near and far hug the bounding sphere.
 )doc")
         .def_static("sensor", &sensorView, py::arg("cloud"), py::arg("sensor") = py::none(),
                     py::arg("width") = py::none(), py::arg("height") = py::none(),

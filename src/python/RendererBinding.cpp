@@ -15,6 +15,7 @@
 #include "core/Coloring.h"
 #include "core/Error.h"
 #include "core/NormalEstimation.h"
+#include "core/SensorView.h"
 #include "gpu/GlContext.h"
 #include "python/Bindings.h"
 #include "render/FrameBuffers.h"
@@ -255,7 +256,7 @@ class RendererState {
             cloud = cloud_;
         }
         OrbitView orbit;
-        orbit.up = upAxisFor("auto", cloud->format());
+        orbit.up = upAxisForScan("auto", cloud->format(), cloud->cloud(), cloud->grid);
         orbit.framing = Framing::Box;  // as render frames a scan
         orbit.framed = cloud->framed();
         return orbitCamera(cloud->cloud().bounds, orbit, 1280, 720, 45.0);
@@ -287,7 +288,7 @@ rasterizer even where a GPU exists (`subscan render --software`); color is what 
 colour shows, as `subscan render --color`: 'auto' (the scan's colour where it has one, else
 height for Z-up data, else a uniform grey), 'rgb', 'intensity', 'height', 'uniform' or
 'classification'; up is the axis height runs along, as --up ('auto': z for LAS, LAZ and COPC
-files, y otherwise). close() (or a with-block) frees the GPU memory now.
+files, -y for a depth camera's organised grid in its own frame, y otherwise). close() (or a with-block) frees the GPU memory now.
 )doc")
         .def(py::init<const CloudHandle&, bool, const std::string&, const std::string&>(),
              py::arg("cloud"), py::kw_only(), py::arg("software") = false,

@@ -93,7 +93,7 @@ def test_bad_cameras_raise_value_error(make, message):
     ({"pitch": 91}, "pitch 91 is outside -90..90"),
     ({"fovy": 0.5}, "fovy 0.5 is outside 1..170"),
     ({"distance": -1}, "distance -1 must be positive"),
-    ({"up": "x"}, "up 'x' is not auto, y or z"),
+    ({"up": "x"}, "up 'x' is not auto, y, z or -y"),
     ({"width": 0}, "width 0 is outside 1..65536"),
 ])
 def test_bad_orbits_raise_value_error(sphere, keywords, message):

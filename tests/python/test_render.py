@@ -343,7 +343,7 @@ def test_the_stanford_bunny_default_is_the_cli_one(cli, tmp_path, data_dir):
 
 @pytest.mark.parametrize("keywords, message", [
     ({"color": "plaid"}, "there is no colouring 'plaid'"),
-    ({"up": "x"}, "up 'x' is not auto, y or z"),
+    ({"up": "x"}, "up 'x' is not auto, y, z or -y"),
 ])
 def test_bad_colourings_raise(torus, keywords, message):
     with pytest.raises(ValueError, match=message):

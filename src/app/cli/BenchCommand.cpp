@@ -21,6 +21,7 @@
 #include "app/cli/Commands.h"
 #include "core/CameraPath.h"
 #include "core/Error.h"
+#include "core/SensorView.h"
 #include "gpu/GlContext.h"
 #include "lod/NodeSelection.h"
 #include "lod/NodeSource.h"
@@ -313,7 +314,7 @@ int runBench(const BenchOptions& options) {
         lod::openStreamed(options.source, settings.streaming.lod);
     LoadedScan scan =
         streamed ? lod::loadStreamedOverview(*streamed) : loadScanForCommand(options.source);
-    const UpAxis up = upAxisFor(options.up, scan.format);
+    const UpAxis up = upAxisForScan(options.up, scan.format, scan.cloud, scan.grid);
     // --view sensor: every frame from the sensor, a still camera instead of the path.
     std::optional<Camera> still;
     if (options.sensorView.wanted()) {
@@ -405,8 +406,7 @@ Command addBenchCommand(CLI::App& parent) {
     addResolutionOption(*bench, options->resolution);
     bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
         ->check(CLI::ExistingFile);
-    bench->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
-        ->check(CLI::IsMember({"auto", "y", "z"}));
+    bench->add_option("--up", options->up, kUpAxisHelp)->check(CLI::IsMember(kUpAxisNames));
     options->sensorView.add(*bench);
     options->scattering.add(*bench);
     bench->add_flag("--json", options->json, "Print the results as JSON");

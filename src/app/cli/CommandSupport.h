@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <glm/vec3.hpp>
@@ -17,6 +18,12 @@
 #include "render/ScatteringSettings.h"
 
 namespace subscan::cli {
+
+/// --up's choices and help, as render, view, turntable and bench take it (upAxisForScan).
+inline const std::vector<std::string> kUpAxisNames{"auto", "y", "z", "-y"};
+inline constexpr const char* kUpAxisHelp =
+    "Up axis: auto (z for LAS, -y for a depth camera's organised grid in its own frame, else y) "
+    "| y | z | -y";
 
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".

@@ -5,6 +5,7 @@
 
 #include "core/Coloring.h"
 #include "core/Error.h"
+#include "core/SensorView.h"
 #include "io/CameraJson.h"
 
 namespace subscan::cli {
@@ -58,8 +59,7 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
         .add_option("--distance", distance,
                     "Eye distance from the centre (scene units); default frames the bounds")
         ->check(CLI::PositiveNumber);
-    command.add_option("--up", up, "Up axis: auto (z for LAS, else y) | y | z")
-        ->check(CLI::IsMember({"auto", "y", "z"}));
+    command.add_option("--up", up, kUpAxisHelp)->check(CLI::IsMember(kUpAxisNames));
     sensorView.add(command);
     command
         .add_option("--color", color,
@@ -127,7 +127,7 @@ void FrameOptions::applyColoring(LoadedScan& scan) const {
 }
 
 UpAxis FrameOptions::upAxis(const LoadedScan& scan) const {
-    return upAxisFor(up, scan.format);
+    return upAxisForScan(up, scan.format, scan.cloud, scan.grid);
 }
 
 Camera FrameOptions::camera(const LoadedScan& scan, Framing framing) const {

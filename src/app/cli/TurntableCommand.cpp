@@ -151,8 +151,7 @@ int runTurntable(const TurntableOptions& options) {
     // Each frame turns the scene about the up axis through the bounds' middle: the eye's yaw
     // grows by degrees / frames, as --yaw would.
     const glm::dvec3 centre = scan.cloud.bounds.center();
-    const glm::dvec3 axis =
-        frame.upAxis(scan) == UpAxis::Z ? glm::dvec3(0, 0, 1) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 axis = orbitFrame(frame.upAxis(scan)).up;
     auto cameraAt = [&](int index) {
         const double angle = glm::radians(options.degrees * index / options.frames);
         Camera camera = first;

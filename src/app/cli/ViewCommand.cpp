@@ -46,7 +46,7 @@ viewer::ViewerOptions checkedOptions(const ViewCommandOptions& command) {
     options.exitAfterFrames = command.exitAfterFrames;
     options.screenshotAtExit = command.screenshot;
     if (command.up != "auto") {
-        options.up = command.up == "z" ? UpAxis::Z : UpAxis::Y;
+        options.up = upAxisFor(command.up, "");
     }
     options.coloring = parseColoring(command.color);
     if (!command.settingsFile.empty()) {
@@ -102,8 +102,7 @@ Command addViewCommand(CLI::App& parent) {
                      "Settings JSON, as `subscan render --settings` reads; --mode and "
                      "the scattering options override it")
         ->check(CLI::ExistingFile);
-    view->add_option("--up", options->up, "Up axis: auto (z for LAS, else y) | y | z")
-        ->check(CLI::IsMember({"auto", "y", "z"}));
+    view->add_option("--up", options->up, kUpAxisHelp)->check(CLI::IsMember(kUpAxisNames));
     view->add_option("--color", options->color,
                      "What the points' colour shows: auto | rgb | intensity | height | uniform | "
                      "classification")

@@ -546,7 +546,8 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
     }
     const UpAxis up =
-        newScan ? options_.up.value_or(prepared.scan.format == "las" ? UpAxis::Z : UpAxis::Y)
+        newScan ? options_.up.value_or(upAxisForScan("auto", prepared.scan.format,
+                                                     prepared.scan.cloud, prepared.scan.grid))
                 : scanUp_;
     // Before the cloud moves on: an organised grid's camera is fitted to its points.
     std::optional<std::pair<glm::dvec3, glm::dvec3>> look =

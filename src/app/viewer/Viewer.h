@@ -37,7 +37,7 @@ struct ViewerOptions {
     int width = 1280;    // window size
     int height = 800;
     RenderSettings settings = viewerDefaultSettings();
-    std::optional<UpAxis> up;  // default: Z for LAS, Y otherwise
+    std::optional<UpAxis> up;  // default: upAxisForScan's auto
     Coloring coloring = Coloring::Auto;
     std::vector<ScriptAction> script;
     std::filesystem::path screenshotAtExit;  // empty: none

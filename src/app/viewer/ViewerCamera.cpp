@@ -20,10 +20,6 @@ const OrbitView kDefaultOrbit;
 constexpr double kMinDistanceRadii = 1e-5;
 constexpr double kMaxDistanceRadii = 1e4;
 
-glm::dvec3 upAxisVector(UpAxis up) {
-    return up == UpAxis::Y ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
-}
-
 double focalLengthPixels(int height) {
     return 0.5 * static_cast<double>(height) /
            std::tan(0.5 * glm::radians(ViewerCamera::kFovyDegrees));
@@ -61,10 +57,9 @@ void ViewerCamera::frameAll(int width, int height) {
 glm::dvec3 ViewerCamera::towardsEye() const {
     const double yaw = glm::radians(yawDegrees_);
     const double pitch = glm::radians(pitchDegrees_);
-    if (up_ == UpAxis::Y) {
-        return {std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch)};
-    }
-    return {std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch), std::sin(pitch)};
+    const OrbitFrame frame = orbitFrame(up_);
+    return std::sin(yaw) * std::cos(pitch) * frame.side + std::sin(pitch) * frame.up +
+           std::cos(yaw) * std::cos(pitch) * frame.front;
 }
 
 glm::dvec3 ViewerCamera::eye() const {
@@ -76,7 +71,7 @@ glm::dvec3 ViewerCamera::forward() const {
 }
 
 glm::dvec3 ViewerCamera::right() const {
-    return glm::normalize(glm::cross(forward(), upAxisVector(up_)));
+    return glm::normalize(glm::cross(forward(), orbitFrame(up_).up));
 }
 
 glm::dvec3 ViewerCamera::up() const {
@@ -169,7 +164,7 @@ Camera ViewerCamera::camera(int width, int height) const {
     camera.height = height;
     camera.fovyDegrees = kFovyDegrees;
     const glm::dvec3 eyePosition = eye();
-    camera.view = glm::lookAt(eyePosition, centre_, upAxisVector(up_));
+    camera.view = glm::lookAt(eyePosition, centre_, orbitFrame(up_).up);
     // orbitCamera's depth range, measured from wherever the eye is now: the bounding sphere's
     // middle lies this deep along the line of sight.
     const double toScene =

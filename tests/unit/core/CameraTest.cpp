@@ -7,6 +7,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "core/Camera.h"
+#include "core/Error.h"
 
 namespace subscan {
 namespace {
@@ -116,6 +117,39 @@ TEST(CameraTest, YawZeroLooksAtTheFront) {
     EXPECT_NEAR(zUp.eye().y, -10, 1e-12);
     // Z-up data keeps +Z pointing up in the image: view-space y of (0,0,1) is positive.
     EXPECT_GT((zUp.view * glm::dvec4(0, 0, 1, 0)).y, 0.99);
+}
+
+TEST(CameraTest, NegativeYUpLooksFromTheDepthCamerasSideUpright) {
+    // A depth camera's frame: x right, y down, z forward. Yaw 0 looks from -Z, the side the
+    // camera stood on, with -Y up and +X right in the picture, as the camera saw it.
+    const Bounds bounds = box({-1, -1, 1}, {1, 1, 3});
+    const Camera front = orbitCamera(bounds, {0, 0, 10.0, UpAxis::NegativeY}, 100, 100, 40);
+    const glm::dvec3 eye = front.eye();
+    EXPECT_NEAR(eye.x, 0, 1e-12);  // double-precision lookAt, as above
+    EXPECT_NEAR(eye.y, 0, 1e-12);
+    EXPECT_NEAR(eye.z, 2 - 10, 1e-12);
+    EXPECT_GT((front.view * glm::dvec4(0, -1, 0, 0)).y, 0.99);  // -Y up in the picture
+    EXPECT_GT((front.view * glm::dvec4(1, 0, 0, 0)).x, 0.99);   // +X right
+    // Pitch raises the eye towards -Y; yaw turns it towards +X, as for the other axes.
+    const Camera turned = orbitCamera(bounds, {90, 0, 10.0, UpAxis::NegativeY}, 100, 100, 40);
+    EXPECT_NEAR(turned.eye().x, 10, 1e-9);
+    const Camera raised = orbitCamera(bounds, {0, 90, 10.0, UpAxis::NegativeY}, 100, 100, 40);
+    EXPECT_NEAR(raised.eye().y, -10, 1e-9);
+}
+
+TEST(CameraTest, OrbitAnglesInvertTheOrbitForEveryUpAxis) {
+    const Bounds bounds = box({-1, -1, -1}, {1, 1, 1});
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
+        for (const glm::dvec2 angles : {glm::dvec2(30, 20), glm::dvec2(-135, -50)}) {
+            const Camera camera = orbitCamera(bounds, {angles.x, angles.y, 5.0, up}, 100, 100, 40);
+            const glm::dvec2 back = orbitAngles(camera.eye() - bounds.center(), up);
+            // Angles from double-precision vectors: far below a thousandth of a degree.
+            EXPECT_NEAR(back.x, angles.x, 1e-9) << int(up);
+            EXPECT_NEAR(back.y, angles.y, 1e-9) << int(up);
+        }
+    }
+    EXPECT_EQ(upAxisFor("-y", "pcd"), UpAxis::NegativeY);
+    EXPECT_THROW(upAxisFor("-z", "pcd"), Error);
 }
 
 TEST(CameraTest, FocalLengthMatchesTheProjection) {

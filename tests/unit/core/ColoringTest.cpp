@@ -75,6 +75,10 @@ TEST(ColoringTest, HeightRampsViridisAlongTheUpAxis) {
     const std::vector<Rgba8> zUp = pointColors(cloud, Coloring::Height, UpAxis::Z);
     EXPECT_EQ(zUp[0], yUp[999]);
     EXPECT_EQ(zUp[999], yUp[0]);
+    // With -Y up (a depth camera's frame) the ramp runs against y.
+    const std::vector<Rgba8> yDown = pointColors(cloud, Coloring::Height, UpAxis::NegativeY);
+    EXPECT_EQ(yDown[0], yUp[999]);
+    EXPECT_EQ(yDown[999], yUp[0]);
 }
 
 TEST(ColoringTest, AutoShowsColourElseHeightForZUpElseUniform) {

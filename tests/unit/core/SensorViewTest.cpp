@@ -102,6 +102,23 @@ TEST(SensorViewTest, PinholeFitRecoversTheDepthCamera) {
     }
 }
 
+TEST(SensorViewTest, AutoUpOfADepthCameraInItsOwnFrameIsNegativeY) {
+    // In its own frame (x right, y down) the picture's up is -Y; turned so that its up is +Y
+    // or +Z, or named, the axis is the usual one.
+    const glm::dvec2 principal(40.0, 30.0);
+    const OrganisedScan own = depthCamera({0, 0, 0}, glm::dmat3(1.0), 100.0, principal, 80, 60);
+    EXPECT_EQ(upAxisForScan("auto", "pcd", own.cloud, own.grid), UpAxis::NegativeY);
+    EXPECT_EQ(upAxisForScan("y", "pcd", own.cloud, own.grid), UpAxis::Y);
+    EXPECT_EQ(upAxisForScan("auto", "pcd", own.cloud, {}), UpAxis::Y);  // no grid
+    // Columns: the sensor's x, y (down) and z axes in file coordinates.
+    const glm::dmat3 upright(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
+    const OrganisedScan level = depthCamera({0, 0, 0}, upright, 100.0, principal, 80, 60);
+    EXPECT_EQ(upAxisForScan("auto", "pcd", level.cloud, level.grid), UpAxis::Y);
+    const glm::dmat3 zUp(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+    const OrganisedScan lidar = depthCamera({0, 0, 0}, zUp, 100.0, principal, 80, 60);
+    EXPECT_EQ(upAxisForScan("auto", "las", lidar.cloud, lidar.grid), UpAxis::Z);
+}
+
 TEST(SensorViewTest, AScannersAngularGridIsNoPinholeImage) {
     // A terrestrial scanner's organised grid: columns of azimuth over 120°, rows of elevation;
     // straight lines bend in it, so no pinhole camera sends the points to their cells (by
