@@ -168,8 +168,20 @@ UpAxis upAxisForScan(std::string_view up, std::string_view format, const PointCl
     if (up != "auto" || grid.empty()) {
         return named;
     }
+    // A few thousand points spread over the grid tell its camera's up as well as all of them
+    // would, and callers ask more than once (the camera, the colours): no full fit each time.
+    constexpr std::size_t kFitPoints = 4096;
+    const std::size_t count = std::min(cloud.size(), grid.cellOfPoint.size());
+    const std::size_t stride = std::max<std::size_t>(1, count / kFitPoints);
+    PointCloud sample;
+    sample.origin = cloud.origin;
+    OrganisedGrid sampleGrid{grid.width, grid.height, {}};
+    for (std::size_t i = 0; i < count; i += stride) {
+        sample.positions.push_back(cloud.positions[i]);
+        sampleGrid.cellOfPoint.push_back(grid.cellOfPoint[i]);
+    }
     try {
-        const PinholeFit fit = fitPinhole(cloud, grid);
+        const PinholeFit fit = fitPinhole(sample, sampleGrid);
         if (fit.rmsErrorPixels > kPinholeToleranceRmsPixels) {
             return named;
         }

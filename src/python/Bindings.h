@@ -82,8 +82,8 @@ using SettingsHandle = std::shared_ptr<SettingsData>;
 /// None for the defaults. Throws ValueError (dicts with bad values) or TypeError.
 RenderSettings settingsArgument(const pybind11::handle& argument);
 
-/// The up axis an `up=` argument ("auto", "y" or "z") names for `cloud`, as the CLI's --up
-/// (upAxisFor: auto is Z for LAS-family files); ValueError for any other name.
+/// The up axis an `up=` argument ("auto", "y", "z" or "-y") names for `cloud`, as the CLI's
+/// --up (upAxisForScan); ValueError for any other name.
 UpAxis upAxisArgument(const std::string& up, const CloudData& cloud);
 
 /// A 3-vector from any sequence of 3 finite numbers; ValueError naming `name` otherwise.

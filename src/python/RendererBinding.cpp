@@ -288,7 +288,8 @@ rasterizer even where a GPU exists (`subscan render --software`); color is what 
 colour shows, as `subscan render --color`: 'auto' (the scan's colour where it has one, else
 height for Z-up data, else a uniform grey), 'rgb', 'intensity', 'height', 'uniform' or
 'classification'; up is the axis height runs along, as --up ('auto': z for LAS, LAZ and COPC
-files, -y for a depth camera's organised grid in its own frame, y otherwise). close() (or a with-block) frees the GPU memory now.
+files, -y for a depth camera's organised grid in its own frame, y otherwise). close() (or a
+with-block) frees the GPU memory now.
 )doc")
         .def(py::init<const CloudHandle&, bool, const std::string&, const std::string&>(),
              py::arg("cloud"), py::kw_only(), py::arg("software") = false,

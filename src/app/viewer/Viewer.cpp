@@ -545,10 +545,10 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     for (const std::string& warning : prepared.scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
     }
-    const UpAxis up =
-        newScan ? options_.up.value_or(upAxisForScan("auto", prepared.scan.format,
-                                                     prepared.scan.cloud, prepared.scan.grid))
-                : scanUp_;
+    const UpAxis up = !newScan      ? scanUp_
+                      : options_.up ? *options_.up
+                                    : upAxisForScan("auto", prepared.scan.format,
+                                                    prepared.scan.cloud, prepared.scan.grid);
     // Before the cloud moves on: an organised grid's camera is fitted to its points.
     std::optional<std::pair<glm::dvec3, glm::dvec3>> look =
         newScan ? sensorLook(prepared.scan, up) : sensorLook_;

@@ -56,7 +56,7 @@ ViewerCamera movedCamera(UpAxis up) {
 }
 
 TEST(ViewerCameraTest, ResetIsTheAutoFramedViewOfOrbitCamera) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         ViewerCamera camera = movedCamera(up);
         camera.reset(kWidth, kHeight);
         OrbitView orbit{30.0, 20.0, std::nullopt, up};
@@ -77,7 +77,7 @@ TEST(ViewerCameraTest, ResetIsTheAutoFramedViewOfOrbitCamera) {
 }
 
 TEST(ViewerCameraTest, OrbitKeepsTheCentreAndTheDistanceToIt) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         ViewerCamera camera = movedCamera(up);
         const glm::dvec3 centre = camera.centre();
         const glm::dvec3 eyeBefore = camera.eye();
@@ -119,7 +119,7 @@ TEST(ViewerCameraTest, DraggingRightTurnsTheSceneRight) {
 }
 
 TEST(ViewerCameraTest, PanMovesCentreAndEyeTogetherWithTheCursor) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         ViewerCamera camera = movedCamera(up);
         const glm::dvec3 centreBefore = camera.centre();
         const glm::dvec3 eyeBefore = camera.eye();
@@ -137,7 +137,7 @@ TEST(ViewerCameraTest, PanMovesCentreAndEyeTogetherWithTheCursor) {
 }
 
 TEST(ViewerCameraTest, ZoomMovesTowardsThePointUnderTheCursorAndKeepsItThere) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         ViewerCamera camera = movedCamera(up);
         const Camera before = camera.camera(kWidth, kHeight);
         const glm::dvec2 cursor(250.5, 40.5);
@@ -170,7 +170,7 @@ TEST(ViewerCameraTest, ZoomStopsBeforeReachingTheTarget) {
 }
 
 TEST(ViewerCameraTest, FrameAllContainsTheBoundsFromAnyDirectionAndAspect) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         for (const glm::ivec2 size :
              {glm::ivec2(320, 200), glm::ivec2(200, 320), glm::ivec2(64, 64)}) {
             ViewerCamera camera = movedCamera(up);
@@ -192,7 +192,7 @@ TEST(ViewerCameraTest, FrameAllContainsTheBoundsFromAnyDirectionAndAspect) {
 }
 
 TEST(ViewerCameraTest, SetCentreKeepsTheEyeAndTurnsTowardsThePoint) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         ViewerCamera camera = movedCamera(up);
         const glm::dvec3 eye = camera.eye();
         const glm::dvec3 point = ViewerCamera::unproject(camera.camera(kWidth, kHeight),
@@ -208,7 +208,7 @@ TEST(ViewerCameraTest, SetCentreKeepsTheEyeAndTurnsTowardsThePoint) {
 }
 
 TEST(ViewerCameraTest, LookFromPutsTheEyeThereAndTheTargetInTheMiddle) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         ViewerCamera camera = movedCamera(up);
         const glm::dvec3 eye(0.3, -0.2, 0.4);
         const glm::dvec3 target(-0.1, 0.05, -0.2);
@@ -268,7 +268,7 @@ TEST(ViewerCameraTest, DraggingTheLightTurnsItAroundTheViewsUpAndRightAxes) {
     const double eighth = 45.0 / ViewerCamera::kDegreesPerPixel;
     const double quarter = 2.0 * eighth;
     const double s = std::sqrt(0.5);
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         const ViewerCamera camera = movedCamera(up);
         const glm::dvec3 front = inView(camera, {0, 0, 1});  // from the eye's side
         // Right moves a front light to the right, left to the left; up raises it, down lowers.
@@ -289,7 +289,7 @@ TEST(ViewerCameraTest, DraggingTheLightTurnsItAroundTheViewsUpAndRightAxes) {
 }
 
 TEST(ViewerCameraTest, DraggingTheLightKeepsElevationAcrossAndStopsShortOfThePoles) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         const ViewerCamera camera = movedCamera(up);
         const glm::dvec3 light = glm::normalize(inView(camera, {-0.3, 0.5, 0.8}));
         // Across: the height above the view's horizon stays; back again: where it was.
@@ -314,7 +314,7 @@ TEST(ViewerCameraTest, DraggingTheLightKeepsElevationAcrossAndStopsShortOfThePol
 }
 
 TEST(ViewerCameraTest, TheDefaultLightComesFromTheUpperLeftOnTheEyesSide) {
-    for (const UpAxis up : {UpAxis::Y, UpAxis::Z}) {
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
         const ViewerCamera camera = movedCamera(up);
         expectNear(camera.defaultLightDirection(),
                    inView(camera, glm::dvec3(-1.0, 1.0, 1.0) / std::sqrt(3.0)), 1e-12);

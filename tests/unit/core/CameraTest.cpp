@@ -1,5 +1,6 @@
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_transform.hpp>
@@ -135,6 +136,22 @@ TEST(CameraTest, NegativeYUpLooksFromTheDepthCamerasSideUpright) {
     EXPECT_NEAR(turned.eye().x, 10, 1e-9);
     const Camera raised = orbitCamera(bounds, {0, 90, 10.0, UpAxis::NegativeY}, 100, 100, 40);
     EXPECT_NEAR(raised.eye().y, -10, 1e-9);
+}
+
+TEST(CameraTest, OrbitsAboutYAndZKeepTheirDirections) {
+    // The directions from the centre towards the eye, written out for Y and Z up as they were
+    // before the orbit's frames were shared with -Y: every picture of those scans unchanged.
+    const Bounds bounds = box({-1, -1, -1}, {1, 1, 1});
+    const double yaw = glm::radians(-70.0), pitch = glm::radians(35.0);
+    const glm::dvec3 yUp(std::sin(yaw) * std::cos(pitch), std::sin(pitch),
+                         std::cos(yaw) * std::cos(pitch));
+    const glm::dvec3 zUp(std::sin(yaw) * std::cos(pitch), -std::cos(yaw) * std::cos(pitch),
+                         std::sin(pitch));
+    for (const auto& [up, direction] : {std::pair{UpAxis::Y, yUp}, std::pair{UpAxis::Z, zUp}}) {
+        const Camera camera = orbitCamera(bounds, {-70, 35, 4.0, up}, 100, 100, 40);
+        // Double-precision lookAt, as above.
+        EXPECT_LT(glm::length(camera.eye() - 4.0 * direction), 1e-12) << int(up);
+    }
 }
 
 TEST(CameraTest, OrbitAnglesInvertTheOrbitForEveryUpAxis) {

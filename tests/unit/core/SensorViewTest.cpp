@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -114,9 +115,15 @@ TEST(SensorViewTest, AutoUpOfADepthCameraInItsOwnFrameIsNegativeY) {
     const glm::dmat3 upright(glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::dvec3(0, 0, -1));
     const OrganisedScan level = depthCamera({0, 0, 0}, upright, 100.0, principal, 80, 60);
     EXPECT_EQ(upAxisForScan("auto", "pcd", level.cloud, level.grid), UpAxis::Y);
+    // Only -Y is taken from the camera: one whose picture points up along +Z keeps Y.
     const glm::dmat3 zUp(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
     const OrganisedScan lidar = depthCamera({0, 0, 0}, zUp, 100.0, principal, 80, 60);
-    EXPECT_EQ(upAxisForScan("auto", "las", lidar.cloud, lidar.grid), UpAxis::Z);
+    EXPECT_EQ(upAxisForScan("auto", "pcd", lidar.cloud, lidar.grid), UpAxis::Y);
+    // A grid that is no pinhole image (here its cells shuffled) keeps the named axis.
+    OrganisedScan shuffled = own;
+    std::mt19937 random(3);
+    std::shuffle(shuffled.grid.cellOfPoint.begin(), shuffled.grid.cellOfPoint.end(), random);
+    EXPECT_EQ(upAxisForScan("auto", "pcd", shuffled.cloud, shuffled.grid), UpAxis::Y);
 }
 
 TEST(SensorViewTest, AScannersAngularGridIsNoPinholeImage) {
