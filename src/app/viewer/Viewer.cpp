@@ -906,6 +906,7 @@ void Viewer::drawPanel() {
     status_.windowFps = ImGui::GetIO().Framerate;
     PanelRequests requests;
     if (showPanel_) {
+        status_.newLightDirection = glm::vec3(camera_.defaultLightDirection());
         requests = panel_.draw(settings_, navigation_, redrawEveryFrame_, status_);
     }
     imgui_.endFrame();

@@ -188,7 +188,7 @@ PanelRequests ViewerPanel::draw(RenderSettings& settings, Navigation& navigation
             drawSurface(settings.surface);
         }
         if (ImGui::CollapsingHeader("Shading")) {
-            drawShading(settings.shading);
+            drawShading(settings.shading, status.newLightDirection);
         }
         if (ImGui::CollapsingHeader("Subsurface scattering")) {
             drawScattering(settings.scattering);
@@ -476,7 +476,7 @@ void ViewerPanel::drawSurface(SurfaceSettings& surface) {
         "picture, faster when the scan covers part of the window).");
 }
 
-void ViewerPanel::drawShading(ShadingSettings& shading) {
+void ViewerPanel::drawShading(ShadingSettings& shading, const glm::vec3& newLightDirection) {
     ImGui::ColorEdit3("head light", &shading.headLight.x, kRadiance);
     ImGui::ColorEdit3("ambient", &shading.ambient.x, kRadiance);
     ImGui::SliderFloat("specular", &shading.specular, 0.0f, 1.0f, "%.3f");
@@ -513,7 +513,7 @@ void ViewerPanel::drawShading(ShadingSettings& shading) {
     }
     ImGui::BeginDisabled(shading.lights.size() >= SUBSCAN_MAX_LIGHTS);
     if (ImGui::Button("Add a directional light")) {
-        shading.lights.push_back({glm::vec3(-0.5f, 0.8f, 0.4f), glm::vec3(1.0f)});
+        shading.lights.push_back({newLightDirection, glm::vec3(1.0f)});
     }
     ImGui::EndDisabled();
 

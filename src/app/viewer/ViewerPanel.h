@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 
 #include "core/Coloring.h"
 #include "gpu/PassTimer.h"
@@ -52,6 +53,9 @@ struct PanelStatus {
     std::string message;  // the last notice or error, shown at the bottom
     bool messageIsError = false;
     std::string scatteringRefusal;  // AppliedScattering::refusal(): shown while it lasts
+    // Where a light added now comes from: the upper left of the view, whatever the up axis
+    // (ViewerCamera::defaultLightDirection), in the scene's coordinates.
+    glm::vec3 newLightDirection{-0.5f, 0.8f, 0.4f};
 };
 
 /// The scattering settings the pipeline renders with. The panel edits the viewer's settings
@@ -108,7 +112,7 @@ class ViewerPanel {
     void drawView(RenderSettings& settings, Navigation& navigation, const PanelStatus& status,
                   PanelRequests& requests);
     void drawSurface(SurfaceSettings& surface);
-    void drawShading(ShadingSettings& shading);
+    void drawShading(ShadingSettings& shading, const glm::vec3& newLightDirection);
     void drawScattering(ScatteringSettings& scattering);
     void drawFiles(PanelRequests& requests);
 
