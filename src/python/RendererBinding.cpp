@@ -15,7 +15,6 @@
 #include "core/Coloring.h"
 #include "core/Error.h"
 #include "core/NormalEstimation.h"
-#include "core/SensorView.h"
 #include "gpu/GlContext.h"
 #include "python/Bindings.h"
 #include "render/FrameBuffers.h"
@@ -61,14 +60,13 @@ class RendererState {
   public:
     RendererState(const CloudHandle& cloud, bool software, const std::string& color,
                   const std::string& up)
-        : cloud_(cloud) {
+        : cloud_(cloud), up_(upAxisArgument(up, *cloud)) {
         Coloring coloring;
         try {
             coloring = parseColoring(color);
         } catch (const Error& error) {
             throw py::value_error(error.what());
         }
-        const UpAxis upAxis = upAxisArgument(up, *cloud);
         const py::gil_scoped_release release;
         // The colours `subscan render --color` draws (FrameOptions::applyColoring), made before
         // any GL object, so that a colouring the cloud cannot give leaves nothing to free; the
@@ -77,7 +75,7 @@ class RendererState {
         const bool ownColors =
             cloud->cloud().hasColors() && (coloring == Coloring::Auto || coloring == Coloring::Rgb);
         if (!ownColors) {
-            colors = pointColors(cloud->cloud(), coloring, upAxis);
+            colors = pointColors(cloud->cloud(), coloring, up_);
         }
         HeadlessContextOptions options;
         options.preferHardware = !software;
@@ -246,7 +244,8 @@ class RendererState {
             throw Error("the renderer is closed");
         }
     }
-    /// `subscan render`'s camera without --camera and options: 1280×720, yaw 30°, pitch 20°.
+    /// `subscan render`'s camera without --camera and options but --up (the renderer's `up`):
+    /// 1280×720, yaw 30°, pitch 20°.
     Camera defaultCamera() {
         CloudHandle cloud;
         {
@@ -256,13 +255,14 @@ class RendererState {
             cloud = cloud_;
         }
         OrbitView orbit;
-        orbit.up = upAxisForScan("auto", cloud->format(), cloud->cloud(), cloud->grid);
+        orbit.up = up_;
         orbit.framing = Framing::Box;  // as render frames a scan
         orbit.framed = cloud->framed();
         return orbitCamera(cloud->cloud().bounds, orbit, 1280, 720, 45.0);
     }
 
     CloudHandle cloud_;  // outlives renderer_, which may read its points in place
+    UpAxis up_;          // the axis `up` names: the colours' height and the default camera's
     std::mutex mutex_;   // one call at a time; the GIL is released while a call works
     std::unique_ptr<GlContext> context_;
     std::unique_ptr<Renderer> renderer_;

@@ -121,6 +121,12 @@ def test_default_camera_and_mode_are_the_cli_orbit_and_surface(cli, tmp_path, to
     np.testing.assert_array_equal(renderer.render(), read_png(tmp_path / "cli.png")[:, :, :3])
 
 
+def test_default_camera_takes_the_renderers_up_axis(cli, tmp_path, torus):
+    cli("render", SCAN, "-o", tmp_path / "cli.png", "--mode", "surface", "--up", "z")
+    with subscan.Renderer(torus, up="z") as renderer:
+        np.testing.assert_array_equal(renderer.render(), read_png(tmp_path / "cli.png")[:, :, :3])
+
+
 def test_timings_name_the_passes(renderer, camera):
     renderer.render(camera, mode="surface")
     timings = renderer.timings()
