@@ -37,12 +37,13 @@ PreparedScan ScanLoadJob::load(const std::function<bool()>& cancelled) {
             prepared.streamed = std::make_shared<lod::CachedNodeSource>(
                 std::move(opened), streaming_.nodeCacheMegabytes << 20);
             prepared.scan = lod::loadStreamedOverview(*prepared.streamed, &prepared.nodes);
-            // Shown only until the view's own nodes come: the local spacing's neighbour search
-            // took 131-136 ms of Autzen 60 x 60's first picture (0.8-1.0 s).
-            prepareProvisionally(prepared);
-            return prepared;
+        } else {
+            prepared.scan = loadScan(source_, reportProgress);
         }
-        prepared.scan = loadScan(source_, reportProgress);
+        // Both show at once: a survey's overview only until the view's own nodes come (the
+        // local spacing's neighbour search took 131-136 ms of Autzen 60 x 60's first picture,
+        // 0.8-1.0 s); a whole scan until its spacing and normals are complete (the viewer's
+        // completeSpacing).
         prepareProvisionally(prepared);
         return prepared;
     } catch (const LoadCancelled&) {

@@ -490,6 +490,12 @@ bool Viewer::awaitingScan() const {
                            (streamed_ && (refining_ || dueRefinement())));
 }
 
+void Viewer::fadeFromScreen() {
+    // A fade still running starts over from what it shows now, not from its older picture.
+    const Texture& image = renderer_->resources().texture("image");
+    crossFade_.start(crossFade_.active(image, glfwGetTime()) ? crossFade_.blended() : image);
+}
+
 void Viewer::finishCompleting() {
     if (!completing_ || !completing_->finished()) {
         return;
@@ -505,9 +511,7 @@ void Viewer::finishCompleting() {
         }
         // Interactive: the provisional picture fades into the completed one.
         if (!unattended_ && renderedImage_) {
-            const Texture& image = renderer_->resources().texture("image");
-            const double now = glfwGetTime();
-            crossFade_.start(crossFade_.active(image, now) ? crossFade_.blended() : image);
+            fadeFromScreen();
         }
         renderer_->replaceCloud(*scan_, completed->spacing, PointMemory::Borrow, completed->packed);
         status_.spacing = renderer_->spacing();
@@ -566,9 +570,7 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     // Interactive: what was on screen fades into the new nodes' picture (unattended runs show
     // what `render` would at once).
     if (!newScan && !unattended_ && renderer_ && renderedImage_) {
-        const Texture& image = renderer_->resources().texture("image");
-        const double now = glfwGetTime();
-        crossFade_.start(crossFade_.active(image, now) ? crossFade_.blended() : image);
+        fadeFromScreen();
     } else {
         crossFade_.stop();
     }

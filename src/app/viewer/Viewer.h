@@ -109,6 +109,8 @@ class Viewer {
     void finishLoading();
     /// Hands the renderer a whole scan's completed spacing and normals once they are estimated.
     void finishCompleting();
+    /// Starts the cross-fade from the picture on screen (interactive hand-overs).
+    void fadeFromScreen();
     /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
     /// start afresh), or another set of the streamed scan's nodes (the view stays).
     void show(PreparedScan prepared, bool newScan);
