@@ -72,7 +72,32 @@ std::vector<std::uint32_t> displayColors(const PointCloud& cloud) {
 
 GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
                              std::size_t maxChunkPoints, PointMemory memory)
-    : size_(cloud.size()), origin_(cloud.origin) {
+    : GpuPointCloud(GpuPointCloudUpload(cloud, {}, capabilities, maxChunkPoints, memory).take()) {}
+
+GpuPointCloudUpload::GpuPointCloudUpload(const PointCloud& cloud, PackedPointAttributes packed,
+                                         const GlCapabilities& capabilities,
+                                         std::size_t maxChunkPoints, PointMemory memory)
+    : packed_(std::move(packed)) {
+    const std::size_t size = cloud.size();
+    if (packed_.normals.empty() && cloud.hasNormals()) {
+        packed_.normals = packNormals(cloud.normals);
+    }
+    const std::vector<glm::u16vec4>& spacing = packed_.localSpacing.halves;
+    if (!spacing.empty() && spacing.size() != size) {
+        throw Error(fmt::format("local spacing for {} points given to a cloud of {}",
+                                spacing.size(), size));
+    }
+    if (!packed_.normals.empty() && packed_.normals.size() != size) {
+        throw Error(
+            fmt::format("{} normals given to a cloud of {} points", packed_.normals.size(), size));
+    }
+    cloud_.size_ = size;
+    cloud_.origin_ = cloud.origin;
+    cloud_.hasLocalSpacing_ = !spacing.empty();
+    cloud_.sparseSpacingRatio_ =
+        cloud_.hasLocalSpacing_ ? packed_.localSpacing.sparseSpacingRatio : 1.0f;
+    cloud_.hasNormals_ = !packed_.normals.empty();
+
     // A chunk must fit one buffer texture (positions are the larger one: 3 texels a point) and
     // one dispatch.
     const std::size_t byTexture = capabilities.maxTextureBufferTexels / 3;
@@ -88,43 +113,89 @@ GpuPointCloud::GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capa
     // The scan's own colours are uploaded as they are (an RGBA8 byte quadruple is the packed
     // uint32 on a little-endian machine): a copy of 40 MB for 10 M points saved.
     static_assert(std::endian::native == std::endian::little);
-    std::vector<std::uint32_t> converted;
-    if (!cloud.hasColors()) {
-        converted = displayColors(cloud);
-    }
     const bool ownColors = cloud.hasColors();
+    if (!ownColors) {
+        converted_ = displayColors(cloud);
+    }
+    const auto* positions = reinterpret_cast<const std::byte*>(cloud.positions.data());
     const auto* colors = ownColors ? reinterpret_cast<const std::byte*>(cloud.colors.data())
-                                   : reinterpret_cast<const std::byte*>(converted.data());
-    // Borrowed where asked and the driver allows, else copied (`converted` dies with this
-    // constructor: always copied).
-    const auto buffer = [&](const void* data, std::size_t bytes, bool mayBorrow,
+                                   : reinterpret_cast<const std::byte*>(converted_.data());
+    const auto* halves = reinterpret_cast<const std::byte*>(spacing.data());
+    const auto* normals = reinterpret_cast<const std::byte*>(packed_.normals.data());
+    // Borrowed where asked and the driver allows (the cloud's own arrays only: what this
+    // object holds goes with it), else made and copied to by advance().
+    const auto buffer = [&](std::size_t chunk, Buffer GpuPointCloud::Chunk::*member,
+                            const std::byte* source, std::size_t bytes, bool mayBorrow,
                             const char* label) {
         if (mayBorrow && memory == PointMemory::Borrow) {
-            if (Buffer inPlace = Buffer::borrowing(data, bytes, label)) {
+            if (Buffer inPlace = Buffer::borrowing(source, bytes, label)) {
                 return inPlace;
             }
         }
-        return Buffer(bytes, data, label);
+        copies_.push_back({chunk, member, source, bytes, 0, label});
+        return Buffer();
     };
-    for (std::size_t first = 0; first < size_; first += chunkPoints) {
+    using Chunk = GpuPointCloud::Chunk;
+    for (std::size_t first = 0; first < size; first += chunkPoints) {
+        const std::size_t index = cloud_.chunks_.size();
         Chunk chunk;
         chunk.firstPoint = static_cast<std::uint32_t>(first);
-        chunk.pointCount = static_cast<std::uint32_t>(std::min(chunkPoints, size_ - first));
-        try {
-            chunk.positions = buffer(&cloud.positions[first], chunk.pointCount * 3 * sizeof(float),
-                                     true, "points.positions");
-            chunk.colors =
-                buffer(colors + first * sizeof(std::uint32_t),
-                       chunk.pointCount * sizeof(std::uint32_t), ownColors, "points.colors");
-        } catch (const Error& error) {
-            throw Error(fmt::format("the GPU cannot hold the {} points ({:.0f} MB): {}", size_,
-                                    static_cast<double>(bytes()) / 1e6, error.what()));
+        chunk.pointCount = static_cast<std::uint32_t>(std::min(chunkPoints, size - first));
+        const std::size_t count = chunk.pointCount;
+        chunk.positions = buffer(index, &Chunk::positions, positions + first * 3 * sizeof(float),
+                                 count * 3 * sizeof(float), true, "points.positions");
+        chunk.colors = buffer(index, &Chunk::colors, colors + first * sizeof(std::uint32_t),
+                              count * sizeof(std::uint32_t), ownColors, "points.colors");
+        if (cloud_.hasLocalSpacing_) {
+            chunk.localSpacing =
+                buffer(index, &Chunk::localSpacing, halves + first * sizeof(glm::u16vec4),
+                       count * sizeof(glm::u16vec4), false, "points.localSpacing");
         }
-        chunks_.push_back(std::move(chunk));
+        if (cloud_.hasNormals_) {
+            chunk.normals = buffer(index, &Chunk::normals, normals + first * sizeof(std::uint32_t),
+                                   count * sizeof(std::uint32_t), false, "points.normals");
+        }
+        cloud_.chunks_.push_back(std::move(chunk));
     }
-    if (cloud.hasNormals()) {
-        setNormals(cloud.normals);
+}
+
+bool GpuPointCloudUpload::advance(std::size_t bytes) {
+    while (bytes > 0 && !finished()) {
+        Copy& copy = copies_[next_];
+        Buffer& target = cloud_.chunks_[copy.chunk].*copy.buffer;
+        // Made with its first slice: making one costs about as much as filling it (llvmpipe
+        // clears it: 290 ms for 280 MB), so the steps share that too.
+        if (copy.copied == 0) {
+            try {
+                target = Buffer(copy.bytes, nullptr, copy.label);
+            } catch (const Error& error) {
+                throw Error(fmt::format("the GPU cannot hold the {} points ({:.0f} MB): {}",
+                                        cloud_.size(), static_cast<double>(cloud_.bytes()) / 1e6,
+                                        error.what()));
+            }
+        }
+        const std::size_t slice = std::min(bytes, copy.bytes - copy.copied);
+        target.upload(copy.copied, slice, copy.source + copy.copied);
+        copy.copied += slice;
+        bytes -= slice;
+        if (copy.copied == copy.bytes) {
+            ++next_;
+        }
     }
+    return finished();
+}
+
+std::size_t GpuPointCloudUpload::bytesLeft() const {
+    std::size_t left = 0;
+    for (std::size_t i = next_; i < copies_.size(); ++i) {
+        left += copies_[i].bytes - copies_[i].copied;
+    }
+    return left;
+}
+
+GpuPointCloud GpuPointCloudUpload::take() && {
+    advance(bytesLeft());
+    return std::move(cloud_);
 }
 
 bool GpuPointCloud::borrowsPositions() const {

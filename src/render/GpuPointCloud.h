@@ -63,7 +63,8 @@ class GpuPointCloud {
     };
 
     /// `maxChunkPoints` 0 = as large as the driver allows; tests pass small values to exercise
-    /// chunking. Throws subscan::Error when the GPU cannot hold the cloud.
+    /// chunking. Throws subscan::Error when the GPU cannot hold the cloud. Uploads everything
+    /// at once (GpuPointCloudUpload: in steps).
     GpuPointCloud(const PointCloud& cloud, const GlCapabilities& capabilities,
                   std::size_t maxChunkPoints = 0, PointMemory memory = PointMemory::Copy);
 
@@ -106,6 +107,49 @@ class GpuPointCloud {
     float sparseSpacingRatio_ = 1.0f;
     bool hasNormals_ = false;
     static constexpr std::size_t kLocalSpacingBytes = 4 * sizeof(std::uint16_t);
+
+    friend class GpuPointCloudUpload;
+    GpuPointCloud() = default;
+};
+
+/// A GpuPointCloud filled a bounded number of bytes at a time. Borrowed buffers are made at
+/// once (they read the cloud in place and copy nothing); advance() makes the others and copies
+/// to them in slices. The viewer copies a streamed view's points so over several frames while the
+/// nodes before them stay on screen: a GPU's budget of 10 M points is some 240 MB, which would hold
+/// up one frame for tens of milliseconds. `cloud` stays alive and unchanged until take().
+class GpuPointCloudUpload {
+  public:
+    /// The cloud as GpuPointCloud's constructor takes it, with `packed`'s local spacing and
+    /// normals (none given: the cloud's own normals). Throws subscan::Error when `packed` has
+    /// another number of entries; advance() and take() when the GPU cannot hold the points.
+    GpuPointCloudUpload(const PointCloud& cloud, PackedPointAttributes packed,
+                        const GlCapabilities& capabilities, std::size_t maxChunkPoints = 0,
+                        PointMemory memory = PointMemory::Copy);
+
+    /// Copies up to `bytes` more; true once everything is on the GPU.
+    bool advance(std::size_t bytes);
+    bool finished() const { return next_ == copies_.size(); }
+    std::size_t bytesLeft() const;
+    /// The cloud, every byte copied (advanced here where some are left).
+    GpuPointCloud take() &&;
+
+  private:
+    /// One buffer's contents still to copy from the cloud (or from packed_, converted_).
+    struct Copy {
+        std::size_t chunk = 0;
+        Buffer GpuPointCloud::Chunk::*buffer = nullptr;
+        const std::byte* source = nullptr;
+        std::size_t bytes = 0;
+        std::size_t copied = 0;  // the buffer is made with the first slice
+        const char* label = "";
+    };
+
+    GpuPointCloud cloud_;
+    // Sources of copies: their arrays stay where they are when this object moves.
+    PackedPointAttributes packed_;
+    std::vector<std::uint32_t> converted_;  // displayColors() where the cloud has no colours
+    std::vector<Copy> copies_;
+    std::size_t next_ = 0;  // copies_[next_] is the one under way
 };
 
 /// A unit normal as the GPU reads it (SUBSCAN_TEXELS_POINT_NORMALS): its octahedral map

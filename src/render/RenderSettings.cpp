@@ -159,11 +159,14 @@ void to_json(nlohmann::json& json, const StreamingSettings& settings) {
         {"lod", nameOf(lod::kLodModeNames, settings.lod)},
         {"point_budget", settings.pointBudget},
         {"node_cache_megabytes", settings.nodeCacheMegabytes},
+        {"upload_megabytes_per_frame", settings.uploadMegabytesPerFrame},
     };
 }
 
 void from_json(const nlohmann::json& json, StreamingSettings& settings) {
-    rejectUnknownKeys(json, "streaming", {"lod", "point_budget", "node_cache_megabytes"});
+    rejectUnknownKeys(
+        json, "streaming",
+        {"lod", "point_budget", "node_cache_megabytes", "upload_megabytes_per_frame"});
     readEnum(json, "lod", settings.lod, lod::kLodModeNames, "level-of-detail mode");
     // 2^40 points: more than any survey a machine of today holds.
     readSetting(json, "point_budget", settings.pointBudget, std::uint64_t{0},
@@ -172,6 +175,9 @@ void from_json(const nlohmann::json& json, StreamingSettings& settings) {
     // machine's memory.
     readSetting(json, "node_cache_megabytes", settings.nodeCacheMegabytes, std::uint64_t{16},
                 std::uint64_t{1} << 20);
+    // At least a MiB: an upload must go on. 2^20 MiB (1 TiB): every view in one frame.
+    readSetting(json, "upload_megabytes_per_frame", settings.uploadMegabytesPerFrame,
+                std::uint64_t{1}, std::uint64_t{1} << 20);
 }
 
 void to_json(nlohmann::json& json, const RenderSettings& settings) {

@@ -92,6 +92,12 @@ struct StreamingSettings {
     /// points of position, colour, intensity and class): 512 holds some 25 views and keeps the
     /// viewer within 1.5 GB (bench/README.md).
     std::uint64_t nodeCacheMegabytes = 512;
+    /// What the viewer copies of a view's new nodes to the GPU in one frame, in MiB; the nodes
+    /// before them show until all have arrived. 32 MiB takes about 3 ms over PCIe 3.0 x16 (12
+    /// GB/s), a fifth of a 60 Hz frame: a GPU budget's 10 M points with their local spacing
+    /// (some 240 MB) arrive in 8 frames. llvmpipe reads positions and colours in place and
+    /// copies 12 bytes a point: its 1 M-point views arrive in one.
+    std::uint64_t uploadMegabytesPerFrame = 32;
 
     bool operator==(const StreamingSettings&) const = default;
 };

@@ -89,19 +89,24 @@ void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing
 }
 
 void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
-                            PointMemory memory, const PackedPointAttributes& packed) {
+                            PointMemory memory, PackedPointAttributes packed) {
+    replaceCloud(cloud, spacing, startUpload(cloud, memory, std::move(packed)));
+}
+
+GpuPointCloudUpload Renderer::startUpload(const PointCloud& cloud, PointMemory memory,
+                                          PackedPointAttributes packed) const {
+    return GpuPointCloudUpload(cloud, std::move(packed), context_.capabilities(), maxChunkPoints_,
+                               memory);
+}
+
+void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
+                            GpuPointCloudUpload upload) {
     // Everything that can fail (the uploads) first, on the side: a failure leaves the renderer
     // as it was, reading the old points.
-    GpuPointCloud uploaded(cloud, context_.capabilities(), maxChunkPoints_, memory);
+    GpuPointCloud uploaded = std::move(upload).take();
     ResolutionChooser chooser(cloud);
-    if (!packed.localSpacing.halves.empty()) {
-        uploaded.setLocalSpacing(packed.localSpacing);
-    }
     if (!spacing.local.empty()) {
         chooser.setLocalSpacing(spacing.local);
-    }
-    if (!packed.normals.empty()) {
-        uploaded.setNormals(packed.normals);
     }
     cloud_ = std::move(uploaded);
     resolutionChooser_ = std::move(chooser);

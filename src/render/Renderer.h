@@ -91,7 +91,16 @@ class Renderer {
     /// that local spacing, which `packed` must hold), e.g. off the render thread, where the
     /// viewer packs them; no normals in `packed`: the cloud's own.
     void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing, PointMemory memory,
-                      const PackedPointAttributes& packed);
+                      PackedPointAttributes packed);
+    /// An upload of `cloud` (with `packed`, as the overload above takes it) for this renderer's
+    /// driver and chunks, which the caller advances a bounded number of bytes at a time (the
+    /// viewer: a frame's worth) and then gives replaceCloud. Throws as replaceCloud does.
+    GpuPointCloudUpload startUpload(const PointCloud& cloud, PointMemory memory,
+                                    PackedPointAttributes packed) const;
+    /// replaceCloud with the points of `upload` (startUpload's, for `cloud`): what it has not
+    /// copied yet is copied now.
+    void replaceCloud(const PointCloud& cloud, const PointSpacing& spacing,
+                      GpuPointCloudUpload upload);
 
     /// Throws subscan::Error for impossible requests (image larger than the GPU allows, a
     /// forced raster path the driver lacks) and GL errors inside a pass.

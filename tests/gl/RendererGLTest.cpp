@@ -68,5 +68,42 @@ TEST(RendererGLTest, AReplacedCloudRendersAsARendererMadeForIt) {
     EXPECT_GT(differingChannels(torusPicture, expected), static_cast<int>(expected.size()) / 20);
 }
 
+TEST(RendererGLTest, ACloudUploadedInStepsShowsOnlyOnceItIsTaken) {
+    GlContext& context = test::glTestContext();
+    const PointCloud torus = makeSyntheticScene("torus");
+    const PointCloud sculpture = makeSyntheticScene("sculpture");
+    const RenderSettings settings = shadowedSurface();
+    const Camera view = orbitCamera(sculpture.bounds, OrbitView{}, kWidth, kHeight, 45.0);
+    const PointSpacing spacing = estimatePointSpacing(sculpture);
+
+    Renderer made(context, sculpture, spacing);
+    made.render(view, settings);
+    const std::vector<std::uint8_t> expected = made.readImage();
+
+    // The frames in between without the temporal filter, whose jitter moves each frame.
+    RenderSettings still = settings;
+    still.temporal.enabled = false;
+    Renderer replaced(context, torus, estimatePointSpacing(torus));
+    replaced.render(view, still);
+    const std::vector<std::uint8_t> torusPicture = replaced.readImage();
+    GpuPointCloudUpload upload =
+        replaced.startUpload(sculpture, PointMemory::Copy, packPointAttributes(spacing.local, {}));
+    // Frames while the points upload (a quarter at a time) still show the torus.
+    const std::size_t quarter = upload.bytesLeft() / 4 + 1;
+    for (int step = 0; step < 3; ++step) {
+        EXPECT_FALSE(upload.advance(quarter));
+        replaced.render(view, still);
+        EXPECT_EQ(differingChannels(replaced.readImage(), torusPicture), 0) << step;
+    }
+    EXPECT_TRUE(upload.advance(quarter));
+    replaced.replaceCloud(sculpture, spacing, std::move(upload));
+    EXPECT_EQ(replaced.gpuCloud().size(), sculpture.size());
+    EXPECT_EQ(replaced.gpuCloud().hasLocalSpacing(), made.gpuCloud().hasLocalSpacing());
+    replaced.render(view, settings);
+    // As above: the same passes over the same points.
+    EXPECT_EQ(differingChannels(replaced.readImage(), expected), 0);
+    EXPECT_GT(differingChannels(torusPicture, expected), static_cast<int>(expected.size()) / 20);
+}
+
 }  // namespace
 }  // namespace subscan

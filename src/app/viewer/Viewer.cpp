@@ -134,6 +134,7 @@ int Viewer::run() {
         finishLoading();
         finishCompleting();
         refineStreamedView();
+        continueArrival();
 
         const double now = glfwGetTime();
         const double seconds = now - lastFrameTime_;
@@ -471,7 +472,8 @@ void Viewer::recordOpeningTimes() {
     if (status_.firstPictureSeconds == 0.0) {
         status_.firstPictureSeconds = seconds;
     }
-    if ((streamed_ ? viewNodesShown_ : !completing_) && status_.viewCompleteSeconds == 0.0) {
+    if ((streamed_ ? viewNodesShown_ && !arriving_ : !completing_) &&
+        status_.viewCompleteSeconds == 0.0) {
         status_.viewCompleteSeconds = seconds;
     }
 }
@@ -486,7 +488,7 @@ bool Viewer::levelsOfDetailChanged() const {
 }
 
 bool Viewer::awaitingScan() const {
-    return unattended_ && (loading_ || completing_ || levelsOfDetailChanged() ||
+    return unattended_ && (loading_ || completing_ || arriving_ || levelsOfDetailChanged() ||
                            (streamed_ && (refining_ || dueRefinement())));
 }
 
@@ -504,7 +506,7 @@ void Viewer::finishCompleting() {
         std::move(completing_);
     status_.completingSpacing = false;
     try {
-        const std::optional<CompletedSpacing> completed = job->take();
+        std::optional<CompletedSpacing> completed = job->take();
         // Evenly spaced and too large for normals: nothing to add to the picture.
         if (!completed || (completed->spacing.local.empty() && completed->packed.normals.empty())) {
             return;
@@ -513,7 +515,8 @@ void Viewer::finishCompleting() {
         if (!unattended_ && renderedImage_) {
             fadeFromScreen();
         }
-        renderer_->replaceCloud(*scan_, completed->spacing, PointMemory::Borrow, completed->packed);
+        renderer_->replaceCloud(*scan_, completed->spacing, PointMemory::Borrow,
+                                std::move(completed->packed));
         status_.spacing = renderer_->spacing();
         renderedCamera_.reset();
         renderedImage_ = false;
@@ -545,28 +548,71 @@ void Viewer::finishLoading() {
 }
 
 void Viewer::show(PreparedScan prepared, bool newScan) {
-    const bool provisional = prepared.provisional;
     for (const std::string& warning : prepared.scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", prepared.source, warning);
     }
-    const UpAxis up = !newScan      ? scanUp_
-                      : options_.up ? *options_.up
-                                    : upAxisForScan("auto", prepared.scan.format,
-                                                    prepared.scan.cloud, prepared.scan.grid);
+    Arrival arrival;
+    arrival.newScan = newScan;
+    arrival.up = !newScan      ? scanUp_
+                 : options_.up ? *options_.up
+                               : upAxisForScan("auto", prepared.scan.format, prepared.scan.cloud,
+                                               prepared.scan.grid);
     // Before the cloud moves on: an organised grid's camera is fitted to its points.
-    std::optional<std::pair<glm::dvec3, glm::dvec3>> look =
-        newScan ? sensorLook(prepared.scan, up) : sensorLook_;
+    arrival.look = newScan ? sensorLook(prepared.scan, arrival.up) : sensorLook_;
     // A scan opened again (another streaming.lod) keeps the view and the colouring.
     const bool keepView = !newScan || reopening_;
-    const Coloring coloring = keepView ? status_.coloring : options_.coloring;
-    std::vector<Rgba8> fileColors;
-    if (prepared.coloredBy == std::pair(coloring, up)) {
-        fileColors = std::move(prepared.scan.cloud.colors);
+    arrival.coloring = keepView ? status_.coloring : options_.coloring;
+    if (prepared.coloredBy == std::pair(arrival.coloring, arrival.up)) {
+        arrival.fileColors = std::move(prepared.scan.cloud.colors);
         prepared.scan.cloud.colors = std::move(prepared.shownColors);
     } else {
-        fileColors = prepared.scan.cloud.colors;
-        prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, coloring, up);
+        arrival.fileColors = prepared.scan.cloud.colors;
+        prepared.scan.cloud.colors = pointColors(prepared.scan.cloud, arrival.coloring, arrival.up);
     }
+    // The renderer reads the points where they are (no copy where the driver allows): the
+    // scan stays at its address until the renderer reads another.
+    arrival.scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
+    arrival.prepared = std::move(prepared);
+    // Another set of a streamed scan's nodes goes to the GPU a frame's worth at a time while
+    // the nodes before them stay on screen (continueArrival); it replaces a set still on its
+    // way. A new scan goes on screen at once: there is nothing else to show.
+    arriving_.reset();
+    status_.uploadingBytes = 0;
+    if (!newScan && renderer_) {
+        arrival.upload = renderer_->startUpload(*arrival.scan, PointMemory::Borrow,
+                                                std::move(arrival.prepared.packed));
+        arriving_ = std::make_unique<Arrival>(std::move(arrival));
+        status_.uploadingBytes = arriving_->upload->bytesLeft();
+        return;
+    }
+    putOnScreen(std::move(arrival));
+}
+
+void Viewer::continueArrival() {
+    if (!arriving_) {
+        return;
+    }
+    try {
+        const std::size_t bytes = settings_.streaming.uploadMegabytesPerFrame << 20;
+        if (!arriving_->upload->advance(bytes)) {
+            status_.uploadingBytes = arriving_->upload->bytesLeft();
+            return;
+        }
+        status_.uploadingBytes = 0;
+        putOnScreen(std::move(*std::exchange(arriving_, nullptr)));
+    } catch (const Error& error) {
+        arriving_.reset();
+        status_.uploadingBytes = 0;
+        fail(error.what());
+    }
+}
+
+void Viewer::putOnScreen(Arrival arrival) {
+    PreparedScan& prepared = arrival.prepared;
+    const bool newScan = arrival.newScan;
+    const bool provisional = prepared.provisional;
+    // The colouring the panel shows now, which may have changed while the nodes uploaded.
+    const Coloring wanted = status_.coloring;
     // Interactive: what was on screen fades into the new nodes' picture (unattended runs show
     // what `render` would at once).
     if (!newScan && !unattended_ && renderer_ && renderedImage_) {
@@ -574,18 +620,19 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     } else {
         crossFade_.stop();
     }
-    // The renderer reads the points where they are (no copy where the driver allows): the
-    // scan stays at its address until the renderer reads another. One renderer for every scan
-    // and view (its passes compiled and images made once); a failure to take the new points
-    // keeps the old ones on screen, where they are.
-    auto scan = std::make_unique<PointCloud>(std::move(prepared.scan.cloud));
+    // One renderer for every scan and view (its passes compiled and images made once); a
+    // failure to take the new points keeps the old ones on screen, where they are.
+    std::unique_ptr<PointCloud> scan = std::move(arrival.scan);
     if (!renderer_) {
         // The first scan: the warmed-up renderer where there is one (a failure here ends the
         // program, as nothing is on screen).
         renderer_ = std::move(warmRenderer_);
     }
-    if (renderer_) {
-        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow, prepared.packed);
+    if (renderer_ && arrival.upload) {
+        renderer_->replaceCloud(*scan, prepared.spacing, std::move(*arrival.upload));
+    } else if (renderer_) {
+        renderer_->replaceCloud(*scan, prepared.spacing, PointMemory::Borrow,
+                                std::move(prepared.packed));
     } else {
         renderer_ =
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
@@ -594,7 +641,7 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     // renderer took the new one: else the old stays, and so does its completion).
     completing_.reset();
     scan_ = std::move(scan);
-    scanColors_ = std::move(fileColors);
+    scanColors_ = std::move(arrival.fileColors);
     // A streamed scan's provisional nodes stay only until its view's come (refineStreamedView).
     shownProvisional_ = provisional;
     status_.completingSpacing = provisional && !prepared.streamed;
@@ -605,11 +652,11 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
                 return completeSpacing(*shown, sample, cancelled);
             });
     }
-    scanUp_ = up;
-    sensorLook_ = std::move(look);
+    scanUp_ = arrival.up;
+    sensorLook_ = std::move(arrival.look);
     streamed_ = std::move(prepared.streamed);
     streamedNodes_ = std::move(prepared.nodes);
-    status_.coloring = coloring;
+    status_.coloring = arrival.coloring;
     const PointCloud& cloud = *scan_;
     status_.points = cloud.size();
     status_.spacing = renderer_->spacing();
@@ -621,6 +668,9 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     renderedCamera_.reset();
     renderedImage_ = false;
     if (!newScan) {
+        if (wanted != arrival.coloring) {
+            applyColoring(wanted);
+        }
         return;
     }
     refining_.reset();
@@ -633,7 +683,7 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     status_.loadMilliseconds = prepared.scan.loadMilliseconds;
     if (!reopening_) {
         const glm::ivec2 size = viewportSize();
-        camera_ = ViewerCamera(bounds_, up, std::max(size.x, 1), std::max(size.y, 1),
+        camera_ = ViewerCamera(bounds_, arrival.up, std::max(size.x, 1), std::max(size.y, 1),
                                framingBounds(cloud));
     }
     shownLod_ = openedLod_;
@@ -701,11 +751,13 @@ void Viewer::refineStreamedView() {
     const std::uint64_t budget =
         lod::pointBudgetFor(settings_.streaming.pointBudget, context_.capabilities().software);
     // Nodes shown provisionally are loaded again, with their spacing, where the view selects
-    // just them.
-    refining_ = std::make_unique<StreamedViewJob>(
-        streamed_, status_.scanSource, *camera, budget,
-        shownProvisional_ ? std::vector<std::size_t>{} : streamedNodes_,
-        std::pair(status_.coloring, scanUp_), partialViewPoints(budget));
+    // just them. Nodes on their way to the GPU count as shown: they will be.
+    const bool provisional = arriving_ ? arriving_->prepared.provisional : shownProvisional_;
+    const std::vector<std::size_t>& shown = arriving_ ? arriving_->prepared.nodes : streamedNodes_;
+    refining_ = std::make_unique<StreamedViewJob>(streamed_, status_.scanSource, *camera, budget,
+                                                  provisional ? std::vector<std::size_t>{} : shown,
+                                                  std::pair(status_.coloring, scanUp_),
+                                                  partialViewPoints(budget));
     status_.streamingView = true;
 }
 

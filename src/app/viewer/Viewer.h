@@ -111,9 +111,28 @@ class Viewer {
     void finishCompleting();
     /// Starts the cross-fade from the picture on screen (interactive hand-overs).
     void fadeFromScreen();
+    /// A prepared scan on its way to the screen: its points (where the renderer reads them),
+    /// their own colours and how show() coloured them.
+    struct Arrival {
+        PreparedScan prepared;  // its cloud moved to `scan`
+        std::unique_ptr<PointCloud> scan;
+        std::vector<Rgba8> fileColors;
+        Coloring coloring = Coloring::Auto;
+        UpAxis up = UpAxis::Y;
+        std::optional<std::pair<glm::dvec3, glm::dvec3>> look;  // sensorLook_'s
+        bool newScan = false;
+        /// Another set of a streamed scan's nodes: their upload (reads `scan`, declared before
+        /// it so that it goes last).
+        std::optional<GpuPointCloudUpload> upload;
+    };
     /// Puts a prepared scan on screen: a new one (`newScan`: its colouring, sensor and camera
-    /// start afresh), or another set of the streamed scan's nodes (the view stays).
+    /// start afresh) at once, or another set of the streamed scan's nodes (the view stays) once
+    /// continueArrival() has uploaded it.
     void show(PreparedScan prepared, bool newScan);
+    /// Uploads streaming.upload_megabytes_per_frame more of the nodes on their way, and puts
+    /// them on screen once all are on the GPU.
+    void continueArrival();
+    void putOnScreen(Arrival arrival);
     /// An unattended run (script, frame limit) is waiting for a scan that opens again, for a
     /// streamed view's nodes or for a whole scan's local spacing and normals: its frames show
     /// what is there meanwhile but do not count, so every counted frame shows what `subscan
@@ -205,7 +224,8 @@ class Viewer {
     std::shared_ptr<const lod::CachedNodeSource> streamed_;
     std::vector<std::size_t> streamedNodes_;
     std::unique_ptr<StreamedViewJob> refining_;
-    bool shownProvisional_ = false;  // the nodes on screen are PreparedScan::provisional
+    bool shownProvisional_ = false;      // the nodes on screen are PreparedScan::provisional
+    std::unique_ptr<Arrival> arriving_;  // the next set of nodes, while it uploads
     /// A scan loaded whole: its local spacing and normals, estimated after its provisional
     /// first picture (reads scan_: declared after it, so that it goes first).
     std::unique_ptr<BackgroundJob<std::optional<CompletedSpacing>>> completing_;

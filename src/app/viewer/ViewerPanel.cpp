@@ -259,6 +259,10 @@ void ViewerPanel::drawScan(const PanelStatus& status, StreamingSettings& streami
                                status.streamedNodesInAll,
                                groupedThousands(status.streamedPointsInAll).c_str(),
                                status.streamingView ? "; loading the view's nodes" : "");
+            if (status.uploadingBytes > 0) {
+                ImGui::Text("uploading the next nodes: %.0f MiB left",
+                            status.uploadingBytes / 1048576.0);
+            }
             ImGui::Text("node cache: %.0f of %.0f MiB", status.nodeCacheBytes / 1048576.0,
                         status.nodeCacheBudgetBytes / 1048576.0);
             helpTooltip(

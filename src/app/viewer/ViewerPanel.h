@@ -34,6 +34,7 @@ struct PanelStatus {
     std::size_t streamedNodesInAll = 0;
     std::uint64_t streamedPointsInAll = 0;
     bool streamingView = false;
+    std::size_t uploadingBytes = 0;    // of the view's nodes, still to copy to the GPU
     std::uint64_t nodeCacheBytes = 0;  // decoded nodes kept (lod::CachedNodeSource)
     std::uint64_t nodeCacheBudgetBytes = 0;
     // Seconds from opening the scan (the command's start, or choosing another file) to its

@@ -63,10 +63,13 @@ TEST(RenderSettingsTest, StreamingSettingsRoundTripAndRefuseImpossibleValues) {
     settings.streaming.pointBudget = 2'500'000;
     EXPECT_EQ(settings.streaming.nodeCacheMegabytes, 512u);
     settings.streaming.nodeCacheMegabytes = 100;
+    EXPECT_EQ(settings.streaming.uploadMegabytesPerFrame, 32u);
+    settings.streaming.uploadMegabytesPerFrame = 8;
     const nlohmann::json json = settings;
     EXPECT_EQ(json["streaming"]["lod"], "off");
     EXPECT_EQ(json["streaming"]["point_budget"], 2'500'000);
     EXPECT_EQ(json["streaming"]["node_cache_megabytes"], 100);
+    EXPECT_EQ(json["streaming"]["upload_megabytes_per_frame"], 8);
     EXPECT_EQ(json.get<RenderSettings>(), settings);
     const auto refusal = [](const nlohmann::json& streaming) {
         return test::errorMessage([&] {
@@ -80,6 +83,8 @@ TEST(RenderSettingsTest, StreamingSettingsRoundTripAndRefuseImpossibleValues) {
     EXPECT_THAT(refusal({{"budget", 5}}), ::testing::HasSubstr("budget"));
     EXPECT_THAT(refusal({{"node_cache_megabytes", 4}}),
                 ::testing::HasSubstr("'node_cache_megabytes'"));
+    EXPECT_THAT(refusal({{"upload_megabytes_per_frame", 0}}),
+                ::testing::HasSubstr("'upload_megabytes_per_frame'"));
     EXPECT_EQ(lod::pointBudgetFor(0, true), lod::kSoftwarePointBudget);
     EXPECT_EQ(lod::pointBudgetFor(0, false), lod::kHardwarePointBudget);
     EXPECT_EQ(lod::pointBudgetFor(5, true), 5u);
