@@ -129,6 +129,7 @@ class GpuPointCloudUpload {
     /// Copies up to `bytes` more; true once everything is on the GPU.
     bool advance(std::size_t bytes);
     bool finished() const { return next_ == copies_.size(); }
+    std::size_t size() const { return cloud_.size(); }
     std::size_t bytesLeft() const;
     /// The cloud, every byte copied (advanced here where some are left).
     GpuPointCloud take() &&;

@@ -103,6 +103,10 @@ void Renderer::replaceCloud(const PointCloud& cloud, const PointSpacing& spacing
                             GpuPointCloudUpload upload) {
     // Everything that can fail (the uploads) first, on the side: a failure leaves the renderer
     // as it was, reading the old points.
+    if (upload.size() != cloud.size()) {
+        throw Error(fmt::format("an upload of {} points given for a cloud of {}", upload.size(),
+                                cloud.size()));
+    }
     GpuPointCloud uploaded = std::move(upload).take();
     ResolutionChooser chooser(cloud);
     if (!spacing.local.empty()) {

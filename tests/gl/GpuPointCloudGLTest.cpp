@@ -2,6 +2,7 @@
 // for byte, what one upload holds, and each step copies no more than it was given.
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -73,22 +74,31 @@ TEST(GpuPointCloudGLTest, AnUploadInStepsHoldsWhatOneUploadHolds) {
     whole.setLocalSpacing(scene.packed.localSpacing);
     whole.setNormals(scene.packed.normals);
 
-    GpuPointCloudUpload upload(scene.cloud, scene.packed, context.capabilities(), kChunkPoints);
+    GpuPointCloudUpload started(scene.cloud, scene.packed, context.capabilities(), kChunkPoints);
     // Positions (12 bytes a point), colours (4), local spacing (8) and normals (4): copied, not
     // borrowed (PointMemory::Copy).
     const std::size_t total = kPoints * (12 + 4 + 8 + 4);
-    EXPECT_EQ(upload.bytesLeft(), total);
-    // A step that does not divide a buffer's size: slices cross the buffers' ends.
+    EXPECT_EQ(started.bytesLeft(), total);
+    // A step that does not divide a buffer's size: slices cross the buffers' ends. Halfway the
+    // upload moves, as the viewer moves it into its pending nodes: what it copies from (its
+    // own colours and attributes) must move with it.
     constexpr std::size_t kStep = 1000;
+    std::optional<GpuPointCloudUpload> moved;
+    GpuPointCloudUpload* upload = &started;
     std::size_t steps = 0;
     for (bool done = false; !done; ++steps) {
-        const std::size_t before = upload.bytesLeft();
-        done = upload.advance(kStep);
-        EXPECT_EQ(before - upload.bytesLeft(), std::min(kStep, before));
+        if (steps == total / kStep / 2) {
+            moved.emplace(std::move(started));
+            upload = &*moved;
+        }
+        const std::size_t before = upload->bytesLeft();
+        done = upload->advance(kStep);
+        EXPECT_EQ(before - upload->bytesLeft(), std::min(kStep, before));
     }
+    ASSERT_TRUE(moved.has_value());
     EXPECT_EQ(steps, (total + kStep - 1) / kStep);
-    EXPECT_TRUE(upload.finished());
-    const GpuPointCloud stepped = std::move(upload).take();
+    EXPECT_TRUE(moved->finished());
+    const GpuPointCloud stepped = std::move(*moved).take();
 
     EXPECT_EQ(stepped.size(), kPoints);
     EXPECT_EQ(stepped.chunks().size(), (kPoints + kChunkPoints - 1) / kChunkPoints);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -402,6 +403,11 @@ TEST_F(ViewerTest, AStreamedSurveyShowsTheNodesItsViewSelects) {
                                        "240", "--hide-panel", "--script", script.string(),
                                        "--exit-after-frames", kFrameLimit, "--settings", settings});
     ASSERT_EQ(result.exitCode, 0) << result.err;
+    // The view's 4 MB at 1 MiB a frame: at least 4 frames uploaded (1 at the default 32 MiB).
+    std::smatch uploads;
+    ASSERT_TRUE(std::regex_search(result.err, uploads, std::regex("(\\d+) frames uploaded")))
+        << result.err;
+    EXPECT_GE(std::stoi(uploads[1]), 4) << result.err;
     // The overview alone (164,000 of the 518,862 points) differs in 5 to 6 % of the pixels
     // (measured).
     for (const std::string shot : {"framed", "near"}) {

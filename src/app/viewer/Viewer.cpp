@@ -178,10 +178,11 @@ int Viewer::run() {
                 fmt::print(stderr,
                            "subscan: {}: first picture {} after opening, the view's nodes {}; "
                            "node cache {:.0f} of {:.0f} MiB, {} node loads read the file, {} "
-                           "did not\n",
+                           "did not; {} frames uploaded nodes\n",
                            status_.scanSource, timeOf(status_.firstPictureSeconds),
                            timeOf(status_.viewCompleteSeconds), cache.bytes / 1048576.0,
-                           streamed_->byteBudget() / 1048576.0, cache.misses, cache.hits);
+                           streamed_->byteBudget() / 1048576.0, cache.misses, cache.hits,
+                           uploadFrames_);
             }
             return 0;
         }
@@ -210,7 +211,8 @@ void Viewer::installCallbacks() {
 void Viewer::waitForEvents() {
     if (loading_ || refining_ || completing_ || dueRefinement()) {
         glfwWaitEventsTimeout(kLoadingWaitSeconds);
-    } else if (unattended_ || flying_ || frameIsStale() || fading()) {
+    } else if (unattended_ || flying_ || arriving_ || frameIsStale() || fading()) {
+        // An upload under way goes on at every frame, not every idle wait.
         // A change made while drawing the last frame (the panel, a script) shows at once.
         glfwPollEvents();
     } else {
@@ -576,9 +578,8 @@ void Viewer::show(PreparedScan prepared, bool newScan) {
     // Another set of a streamed scan's nodes goes to the GPU a frame's worth at a time while
     // the nodes before them stay on screen (continueArrival); it replaces a set still on its
     // way. A new scan goes on screen at once: there is nothing else to show.
-    arriving_.reset();
-    status_.uploadingBytes = 0;
     if (!newScan && renderer_) {
+        arriving_.reset();
         arrival.upload = renderer_->startUpload(*arrival.scan, PointMemory::Borrow,
                                                 std::move(arrival.prepared.packed));
         arriving_ = std::make_unique<Arrival>(std::move(arrival));
@@ -592,6 +593,7 @@ void Viewer::continueArrival() {
     if (!arriving_) {
         return;
     }
+    ++uploadFrames_;
     try {
         const std::size_t bytes = settings_.streaming.uploadMegabytesPerFrame << 20;
         if (!arriving_->upload->advance(bytes)) {
@@ -601,18 +603,22 @@ void Viewer::continueArrival() {
         status_.uploadingBytes = 0;
         putOnScreen(std::move(*std::exchange(arriving_, nullptr)));
     } catch (const Error& error) {
-        arriving_.reset();
-        status_.uploadingBytes = 0;
+        dropArrival();
         fail(error.what());
     }
+}
+
+void Viewer::dropArrival() {
+    arriving_.reset();
+    status_.uploadingBytes = 0;
+    // The view the dropped nodes were for loads again.
+    refinedCamera_.reset();
 }
 
 void Viewer::putOnScreen(Arrival arrival) {
     PreparedScan& prepared = arrival.prepared;
     const bool newScan = arrival.newScan;
     const bool provisional = prepared.provisional;
-    // The colouring the panel shows now, which may have changed while the nodes uploaded.
-    const Coloring wanted = status_.coloring;
     // Interactive: what was on screen fades into the new nodes' picture (unattended runs show
     // what `render` would at once).
     if (!newScan && !unattended_ && renderer_ && renderedImage_) {
@@ -638,8 +644,12 @@ void Viewer::putOnScreen(Arrival arrival) {
             std::make_unique<Renderer>(context_, *scan, prepared.spacing, 0, PointMemory::Borrow);
     }
     // A whole scan's completion reads the scan on screen, which this replaces (where the
-    // renderer took the new one: else the old stays, and so does its completion).
+    // renderer took the new one: else the old stays, and so does its completion), and the old
+    // scan's nodes on their way to it go too.
     completing_.reset();
+    if (newScan) {
+        dropArrival();
+    }
     scan_ = std::move(scan);
     scanColors_ = std::move(arrival.fileColors);
     // A streamed scan's provisional nodes stay only until its view's come (refineStreamedView).
@@ -668,9 +678,6 @@ void Viewer::putOnScreen(Arrival arrival) {
     renderedCamera_.reset();
     renderedImage_ = false;
     if (!newScan) {
-        if (wanted != arrival.coloring) {
-            applyColoring(wanted);
-        }
         return;
     }
     refining_.reset();
@@ -828,6 +835,10 @@ void Viewer::applyColoring(Coloring coloring) {
     if (!renderer_) {
         return;
     }
+    // Nodes on their way are coloured the old way: they load again, coloured the new.
+    if (arriving_) {
+        dropArrival();
+    }
     // The renderer may read the shown colours in place: they stay alive and unchanged (moved
     // out, not overwritten) until it has a copy of the new ones.
     const std::vector<Rgba8> shown = std::exchange(scan_->colors, scanColors_);
@@ -895,14 +906,15 @@ bool Viewer::frameIsStale() const {
     const bool changed = !renderedCamera_ ||
                          !sameCamera(*renderedCamera_, camera_.camera(size.x, size.y)) ||
                          nlohmann::json(settings).dump() != renderedSettings_;
-    // While a view's nodes load, or a scan's local spacing and normals, the temporal filter
-    // does not refine the picture at rest: they replace it in a moment, and on llvmpipe its
+    // While a view's nodes load or upload, or a scan's local spacing and normals, the temporal
+    // filter does not refine the picture at rest: they replace it in a moment, and on llvmpipe its
     // frames took the cores their work needs. Nor during a cross-fade: on llvmpipe a filtered
     // frame took 0.25 s at 1280x720, which left two frames of a 0.3 s fade; the fade's own
     // frames are a blend and a copy.
     return redrawEveryFrame_ || changed ||
-           (filtersTemporally(settings) && renderedImage_ && !refining_ && !completing_ &&
-            !fading() && framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
+           (filtersTemporally(settings) && renderedImage_ && !refining_ && !arriving_ &&
+            !completing_ && !fading() &&
+            framesAtRest_ + 1 < kTemporalRestFrames);  // a failed frame is not retried
 }
 
 void Viewer::renderIfNeeded() {

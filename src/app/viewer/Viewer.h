@@ -132,6 +132,8 @@ class Viewer {
     /// Uploads streaming.upload_megabytes_per_frame more of the nodes on their way, and puts
     /// them on screen once all are on the GPU.
     void continueArrival();
+    /// Forgets the nodes on their way; their view loads again.
+    void dropArrival();
     void putOnScreen(Arrival arrival);
     /// An unattended run (script, frame limit) is waiting for a scan that opens again, for a
     /// streamed view's nodes or for a whole scan's local spacing and normals: its frames show
@@ -226,6 +228,7 @@ class Viewer {
     std::unique_ptr<StreamedViewJob> refining_;
     bool shownProvisional_ = false;      // the nodes on screen are PreparedScan::provisional
     std::unique_ptr<Arrival> arriving_;  // the next set of nodes, while it uploads
+    int uploadFrames_ = 0;               // frames that uploaded nodes (unattended runs print it)
     /// A scan loaded whole: its local spacing and normals, estimated after its provisional
     /// first picture (reads scan_: declared after it, so that it goes first).
     std::unique_ptr<BackgroundJob<std::optional<CompletedSpacing>>> completing_;
