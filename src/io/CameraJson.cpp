@@ -10,6 +10,7 @@
 
 #include "core/Error.h"
 #include "io/AtomicFile.h"
+#include "io/JsonText.h"
 
 namespace subscan {
 
@@ -129,9 +130,7 @@ Camera readCameraFile(const std::filesystem::path& path) {
         throw Error(fmt::format("{}: cannot open the camera file", path.string()));
     }
     try {
-        return cameraFromJson(nlohmann::json::parse(stream));
-    } catch (const nlohmann::json::parse_error& error) {
-        throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), error.byte));
+        return cameraFromJson(parseJsonText(stream));
     } catch (const Error& error) {
         throw Error(fmt::format("{}: {}", path.string(), error.what()));
     }

@@ -14,6 +14,7 @@
 #include "core/Error.h"
 #include "core/SensorView.h"
 #include "io/CameraJson.h"
+#include "io/JsonText.h"
 #include "python/Bindings.h"
 #include "python/JsonConversion.h"
 
@@ -163,9 +164,9 @@ Camera cameraFromPythonJson(const py::handle& object) {
     nlohmann::json json;
     if (py::isinstance<py::str>(object)) {
         try {
-            json = nlohmann::json::parse(object.cast<std::string>());
-        } catch (const nlohmann::json::parse_error& error) {
-            throw py::value_error(fmt::format("not valid JSON (byte {})", error.byte));
+            json = parseJsonText(object.cast<std::string>());
+        } catch (const Error& error) {
+            throw py::value_error(error.what());
         }
     } else {
         json = toJson(object, "the camera");

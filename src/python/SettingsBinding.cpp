@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "io/JsonText.h"
 #include "python/Bindings.h"
 #include "python/JsonConversion.h"
 
@@ -33,9 +34,9 @@ RenderSettings patched(const RenderSettings& settings, const nlohmann::json& pat
 nlohmann::json parseJson(const py::handle& object, std::string_view what) {
     if (py::isinstance<py::str>(object)) {
         try {
-            return nlohmann::json::parse(object.cast<std::string>());
-        } catch (const nlohmann::json::parse_error& error) {
-            throw py::value_error(fmt::format("not valid JSON (byte {})", error.byte));
+            return parseJsonText(object.cast<std::string>());
+        } catch (const Error& error) {
+            throw py::value_error(error.what());
         }
     }
     return toJson(object, what);

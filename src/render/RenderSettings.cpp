@@ -9,6 +9,7 @@
 
 #include "core/Error.h"
 #include "io/AtomicFile.h"
+#include "io/JsonText.h"
 #include "render/SettingsJson.h"
 #include "shared/bindings.h"
 
@@ -217,10 +218,8 @@ RenderSettings readSettingsFile(const std::filesystem::path& path, const RenderS
     }
     try {
         RenderSettings settings = defaults;
-        nlohmann::json::parse(stream).get_to(settings);
+        parseJsonText(stream).get_to(settings);
         return settings;
-    } catch (const nlohmann::json::parse_error& error) {
-        throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), error.byte));
     } catch (const Error& error) {
         throw Error(fmt::format("{}: {}", path.string(), error.what()));
     }

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include <fmt/format.h>
@@ -38,23 +40,29 @@ inline void rejectUnknownKeys(const nlohmann::json& json, std::string_view secti
 
 /// Reads `key` into `value` when present (absent keys keep their defaults, so a settings file
 /// holds only what it changes), checking min <= value <= max. Throws subscan::Error naming the
-/// key.
+/// key. The number is checked before it becomes a T: -1 would wrap around to 2^64 - 1 in an
+/// unsigned setting, and 2.5 lose its half in an integer one.
 template <class T>
 void readSetting(const nlohmann::json& json, std::string_view key, T& value, T min, T max) {
     const auto found = json.find(key);
     if (found == json.end()) {
         return;
     }
-    T read{};
-    try {
-        read = found->get<T>();
-    } catch (const nlohmann::json::exception&) {
+    if (!found->is_number()) {
         throw Error(fmt::format("the setting '{}' has the wrong type", key));
     }
-    if (!(read >= min && read <= max)) {
+    const double read = found->get<double>();
+    if (std::is_integral_v<T> && read != std::floor(read)) {
+        throw Error(fmt::format("the setting '{}' = {} is not a whole number", key, read));
+    }
+    // Floats compare as floats: 0.01 in the file is the bound 0.01f, not below it.
+    const bool inside = std::is_integral_v<T>
+                            ? read >= static_cast<double>(min) && read <= static_cast<double>(max)
+                            : static_cast<T>(read) >= min && static_cast<T>(read) <= max;
+    if (!inside) {
         throw Error(fmt::format("the setting '{}' = {} is outside {}..{}", key, read, min, max));
     }
-    value = read;
+    value = static_cast<T>(read);
 }
 
 inline void readSetting(const nlohmann::json& json, std::string_view key, bool& value) {

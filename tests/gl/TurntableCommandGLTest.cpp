@@ -185,6 +185,18 @@ TEST(TurntableCommandGLTest, RefusesWhatItCannotDoWithOneSentence) {
     EXPECT_THAT(overInput.err, HasSubstr("refusing to write"));
     EXPECT_EQ(test::fileBytes(scan), "0 0 0\n1 0 0\n0 1 0\n");
 
+    // Over an input in the frames' folder under a frame's name (a PLY, known by its content).
+    std::filesystem::create_directory(dir / "frames");
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    const std::filesystem::path frameNamed = dir.write("frames/0001.png", ply);
+    const auto overFrame = runSubscan(
+        {"turntable", frameNamed.string(), "-o", (dir / "frames").string(), "--frames", "3"});
+    EXPECT_EQ(overFrame.exitCode, 1);
+    EXPECT_THAT(overFrame.err, HasSubstr("refusing to write a frame over the input scan"));
+    EXPECT_EQ(test::fileBytes(frameNamed), ply);
+
     // --save-settings over the settings file it reads.
     const std::filesystem::path settings = dir.write("settings.json", "{}");
     const auto overSettings = runSubscan(

@@ -22,6 +22,26 @@ TEST(CliTest, UsageErrorsExitWithTwo) {
     EXPECT_EQ(runSubscan({"--help"}).exitCode, 0);
 }
 
+TEST(CliTest, NumbersThatAreNotFiniteAreRefused) {
+    // CLI11 reads them as numbers and its range checks let NaN through: the picture was empty,
+    // eval's PSNR 100 dB, and the exit 0.
+    const std::vector<std::vector<std::string>> cases{
+        {"render", "synthetic:sphere", "-o", "x.png", "--yaw", "nan"},
+        {"render", "synthetic:sphere", "-o", "x.png", "--pitch", "nan"},
+        {"render", "synthetic:sphere", "-o", "x.png", "--fovy", "inf"},
+        {"render", "synthetic:sphere", "-o", "x.png", "--distance", "1e999"},
+        {"render", "synthetic:sphere", "-o", "x.png", "--eta", "nan"},
+        {"eval", "synthetic:sphere", "--distance", "nan"},
+        {"eval", "synthetic:sphere", "--temporal", "--step", "nan"},
+        {"turntable", "synthetic:sphere", "-o", "frames", "--degrees", "-inf"},
+    };
+    for (const auto& arguments : cases) {
+        const test::CommandResult result = runSubscan(arguments);
+        EXPECT_EQ(result.exitCode, 2) << arguments.back();
+        EXPECT_THAT(result.err, HasSubstr("is not a finite number")) << arguments.back();
+    }
+}
+
 TEST(CliTest, InfoJsonHasExactlyTheDocumentedKeys) {
     const test::CommandResult result = runSubscan({"info", "synthetic:sphere", "--json"});
     ASSERT_EQ(result.exitCode, 0) << result.err;

@@ -151,6 +151,8 @@ TEST(ScanCommandTest, BadOptionsExitWithTwo) {
         {"scan", "synthetic:sphere", "-o", out, "--noise", "0.1q"},
         {"scan", "synthetic:sphere", "-o", out, "--color", "purple"},
         {"scan", "synthetic:sphere", "-o", out, "--seed", "-3"},
+        // Written as PLY whatever its name, which other tools then refused.
+        {"scan", "synthetic:sphere", "-o", (dir / "out.las").string()},
     };
     for (const auto& arguments : cases) {
         const test::CommandResult result = runSubscan(arguments);

@@ -1,5 +1,7 @@
 #include "app/cli/CommandSupport.h"
 
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <sstream>
@@ -16,6 +18,18 @@
 #include "sss/MaterialLibrary.h"
 
 namespace subscan::cli {
+
+CLI::Validator finiteNumber() {
+    return CLI::Validator(
+        [](std::string& text) {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            return end != text.c_str() && !std::isfinite(value)
+                       ? fmt::format("'{}' is not a finite number", text)
+                       : std::string();
+        },
+        "FINITE");
+}
 
 LoadedScan loadScanForCommand(std::string_view source) {
     constexpr std::uintmax_t kProgressBarBytes = 50u << 20;
@@ -113,6 +127,7 @@ void ScatteringOptions::add(CLI::App& command) {
     command
         .add_option("--sss-scale", scale,
                     "Multiplies every scattering radius and mean free path (> 0)")
+        ->check(finiteNumber())
         ->check(CLI::Range(0.0f, 1000.0f));
     command
         .add_option("--albedo", albedo,
@@ -126,10 +141,13 @@ void ScatteringOptions::add(CLI::App& command) {
     command.add_option("--mean-free-path", meanFreePath,
                        "R,G,B diffuse mean free path in mm for --coefficients color (default: "
                        "measured marble's 8.51,5.57,3.95)");
-    command.add_option("--eta", eta,
-                       "Relative index of refraction (default: the material's); overrides the "
-                       "material's for both coefficient sources");
-    command.add_option("--phase-g", phaseG, "Henyey-Greenstein asymmetry g, -1 < g < 1");
+    command
+        .add_option("--eta", eta,
+                    "Relative index of refraction (default: the material's); overrides the "
+                    "material's for both coefficient sources")
+        ->check(finiteNumber());
+    command.add_option("--phase-g", phaseG, "Henyey-Greenstein asymmetry g, -1 < g < 1")
+        ->check(finiteNumber());
     command.add_option("--single-samples", singleSamples,
                        "Samples along the refracted view ray (1..64)");
     command

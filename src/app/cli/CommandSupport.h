@@ -25,6 +25,11 @@ inline constexpr const char* kUpAxisHelp =
     "Up axis: auto (z for LAS, -y for a depth camera's organised grid in its own frame, else y) "
     "| y | z | -y";
 
+/// A check for every floating-point option: CLI11 reads "nan", "inf" and "1e999" as numbers,
+/// and its range checks let NaN through (every comparison with it is false), which gave an
+/// empty picture and exit 0.
+CLI::Validator finiteNumber();
+
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".
 LoadedScan loadScanForCommand(std::string_view source);

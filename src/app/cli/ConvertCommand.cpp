@@ -214,8 +214,10 @@ Command addConvertCommand(CLI::App& parent) {
             [](const std::string& path) -> std::string {
                 return outputFormat(path) != nullptr || lowercase(path).ends_with(".laz")
                            ? std::string()
-                           : fmt::format("'{}' has no extension of a format convert writes ({})",
-                                         path, supportedExtensions());
+                           : fmt::format(
+                                 "'{}' has no extension of a format convert writes ({}, "
+                                 ".laz, .copc.laz)",
+                                 path, supportedExtensions());
             },
             "FILE");
     convert->add_flag("--estimate-normals", options->estimateNormals,

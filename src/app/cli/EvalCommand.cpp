@@ -176,6 +176,7 @@ Command addEvalCommand(CLI::App& parent) {
     eval->add_option("--distance", options->evaluation.distance,
                      "Eye distance from the centre (scene units), for close-ups; default frames "
                      "the scene")
+        ->check(finiteNumber())
         ->check(CLI::PositiveNumber);
     eval->add_option("--points", options->points,
                      "Points of a mesh: vertices (its own), scan (a virtual scan of it), or a "
@@ -192,6 +193,7 @@ Command addEvalCommand(CLI::App& parent) {
         ->check(CLI::Range(2, 10000));
     eval->add_option("--step", options->temporalEvaluation.stepDegrees,
                      "Degrees of yaw between frames of --temporal")
+        ->check(finiteNumber())
         ->check(CLI::Range(0.0, 90.0));
     eval->add_option("--point-budget", options->evaluation.pointBudget,
                      "Reconstruct the surface as a streamed survey: the points indexed into a "

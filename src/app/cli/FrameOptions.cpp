@@ -51,13 +51,17 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
                                "normals", "shaded"}));
     scattering.add(command);
     command.add_option("--point-size", pointSize, "Splat size in pixels (splats mode)")
+        ->check(finiteNumber())
         ->check(CLI::Range(1.0f, 64.0f));
-    command.add_option("--yaw", yaw, "Orbit angle around the up axis, degrees");
+    command.add_option("--yaw", yaw, "Orbit angle around the up axis, degrees")
+        ->check(finiteNumber());
     command.add_option("--pitch", pitch, "Orbit elevation, degrees")
+        ->check(finiteNumber())
         ->check(CLI::Range(-90.0, 90.0));
     command
         .add_option("--distance", distance,
                     "Eye distance from the centre (scene units); default frames the bounds")
+        ->check(finiteNumber())
         ->check(CLI::PositiveNumber);
     command.add_option("--up", up, kUpAxisHelp)->check(CLI::IsMember(kUpAxisNames));
     sensorView.add(command);
@@ -68,6 +72,7 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
                     "class colours)")
         ->check(CLI::IsMember(coloringNames()));
     command.add_option("--fovy", fovy, "Vertical field of view, degrees")
+        ->check(finiteNumber())
         ->check(CLI::Range(1.0, 170.0));
     command.add_option("--camera", cameraFile, "camera.json to render from")
         ->check(CLI::ExistingFile);

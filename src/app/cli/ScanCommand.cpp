@@ -1,4 +1,7 @@
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -141,7 +144,21 @@ Command addScanCommand(CLI::App& parent) {
                      fmt::format("Mesh with faces (e.g. PLY), or synthetic:NAME ({})",
                                  fmt::join(builtInSceneNames(), ", ")))
         ->required();
-    scan->add_option("-o,--output", options->output, "Output PLY file")->required();
+    scan->add_option("-o,--output", options->output, "Output PLY file")
+        ->required()
+        ->check(
+            [](const std::string& path) -> std::string {
+                // Other extensions were written as PLY all the same, which other tools refuse.
+                std::string extension = std::filesystem::path(path).extension().string();
+                std::transform(extension.begin(), extension.end(), extension.begin(),
+                               [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+                return extension == ".ply" ? std::string()
+                                           : fmt::format(
+                                                 "'{}' is not a .ply file: scan writes "
+                                                 "PLY (convert writes other formats)",
+                                                 path);
+            },
+            "FILE.ply");
     scan->add_option("--views", options->settings.views,
                      "Scanner positions: a ring around the object, alternately 25 degrees above "
                      "and below it, plus one from the top when 5 or more")

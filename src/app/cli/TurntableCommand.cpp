@@ -125,6 +125,10 @@ int runTurntable(const TurntableOptions& options) {
     frame.refuseToOverwriteInputs(output, "the turntable");
     frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     const bool video = writesVideo(output);
+    // Nor over an input that lies in the frames' folder under a frame's name.
+    for (int index = 0; !video && index < options.frames; ++index) {
+        frame.refuseToOverwriteInputs(output / fmt::format("{:04}.png", index), "a frame");
+    }
     std::optional<std::filesystem::path> ffmpeg;
     if (video) {
         ffmpeg = findFfmpeg();
@@ -244,6 +248,7 @@ Command addTurntableCommand(CLI::App& parent) {
     turntable->add_option("--frames", options->frames, "Frames of the animation")
         ->check(CLI::Range(1, 100000));
     turntable->add_option("--degrees", options->degrees, "Degrees the scan turns in all")
+        ->check(finiteNumber())
         ->check(CLI::Range(-36000.0, 36000.0));
     turntable->add_option("--fps", options->fps, "Frames per second of the video")
         ->check(CLI::Range(1, 240));

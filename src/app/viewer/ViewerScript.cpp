@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
+#include "io/JsonText.h"
 
 namespace subscan::viewer {
 
@@ -226,9 +227,7 @@ std::vector<ScriptAction> readScriptFile(const std::filesystem::path& path) {
         throw Error(fmt::format("{}: cannot open the script", path.string()));
     }
     try {
-        return parseScript(nlohmann::json::parse(stream));
-    } catch (const nlohmann::json::parse_error& error) {
-        throw Error(fmt::format("{}: not valid JSON (byte {})", path.string(), error.byte));
+        return parseScript(parseJsonText(stream));
     } catch (const Error& error) {
         throw Error(fmt::format("{}: {}", path.string(), error.what()));
     }

@@ -101,5 +101,18 @@ TEST(CameraJsonTest, InvalidFieldsAreNamed) {
     EXPECT_THROW(cameraFromJson(missing), Error);
 }
 
+TEST(CameraJsonTest, ANumberBeyondADoubleIsNamedWithTheFile) {
+    // The parser reports 1e999 as an error of another kind than bad JSON: it ended the command
+    // as an "internal error" without the file's name.
+    const test::TempDir dir;
+    const auto file = dir.write("camera.json", R"({"fovy_deg": 1e999})");
+    try {
+        readCameraFile(file);
+        ADD_FAILURE() << "1e999 accepted";
+    } catch (const Error& error) {
+        EXPECT_THAT(error.what(), HasSubstr("camera.json: not valid JSON: a number beyond"));
+    }
+}
+
 }  // namespace
 }  // namespace subscan

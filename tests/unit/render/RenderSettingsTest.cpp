@@ -175,6 +175,27 @@ TEST(RenderSettingsTest, BadValuesAreNamed) {
     }
 }
 
+TEST(RenderSettingsTest, NumbersAreCheckedBeforeTheyBecomeTheSettingsType) {
+    const auto refusal = [](const nlohmann::json& json) {
+        return test::errorMessage([&] { (void)json.get<RenderSettings>(); });
+    };
+    // -1 wrapped around to 2^64 - 1 in an unsigned setting, and 2.5 lost its half.
+    EXPECT_THAT(refusal({{"streaming", {{"node_cache_megabytes", -1}}}}),
+                ::testing::HasSubstr("'node_cache_megabytes' = -1 is outside"));
+    EXPECT_THAT(refusal({{"temporal", {{"max_frames", 2.5}}}}),
+                ::testing::HasSubstr("'max_frames' = 2.5 is not a whole number"));
+    EXPECT_THAT(refusal({{"temporal", {{"max_frames", "8"}}}}),
+                ::testing::HasSubstr("'max_frames' has the wrong type"));
+    // A float setting at its bound as the file writes it (0.01, not 0.01f) is inside.
+    const nlohmann::json atBound = {{"temporal", {{"new_frame_weight", 0.01}}}};
+    EXPECT_FLOAT_EQ(atBound.get<RenderSettings>().temporal.newFrameWeight, 0.01f);
+    // A number beyond a double's range in a settings file: one sentence naming the file.
+    const test::TempDir dir;
+    const auto file = dir.write("huge.json", R"({"surface": {"fill_radius": 1e400}})");
+    EXPECT_THAT(test::errorMessage([&] { (void)readSettingsFile(file); }),
+                ::testing::HasSubstr("huge.json: not valid JSON: a number beyond"));
+}
+
 TEST(RenderSettingsTest, DisplayColorsUseColourThenIntensityThenGrey) {
     PointCloud cloud;
     cloud.positions.resize(3);
