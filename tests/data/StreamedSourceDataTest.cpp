@@ -207,16 +207,19 @@ TEST(StreamedSourceDataTest, TheSameDepthAsTheWholeFileAtAFullBudget) {
     }
     ASSERT_GT(covered, 30'000u);
     // The same file streamed and whole: the same points about other origins, whose rounding
-    // can tip a pixel's visibility where a point's spacing ratio decides how far the hidden
-    // point search goes (11 of about 35,000 pixels measured, 2026-12-06).
-    EXPECT_LT(static_cast<double>(streamedDiffers), 0.001 * static_cast<double>(all));
+    // can tip a point's visibility where its spacing ratio decides how far the hidden point
+    // search goes, and pull-push then carries the change of depth over the pixels around it
+    // (11 of about 35,000 pixels measured at the view before the exact framing; at its view,
+    // 2026-12-06: 6 pixels of the visibility stage, 116 of 35,237 of the depth).
+    EXPECT_LT(static_cast<double>(streamedDiffers), 0.005 * static_cast<double>(all));
     // All three cover nearly every pixel the whole file does (7 and 15 pixels of 35,454 differ
     // at the outline: points in another order tie differently in the rasterizer).
     EXPECT_GT(static_cast<double>(all), 0.999 * static_cast<double>(covered));
     // Equal depth where all three cover, but for the EPT copy's few ties and the rounding that
     // tips visibility where the hidden point search follows an occluder's spacing (16 pixels
-    // measured before that search, 79 of 35,474 with it, 2026-12-06).
-    EXPECT_GT(static_cast<double>(equal), 0.997 * static_cast<double>(all));
+    // measured before that search, 79 of 35,474 with it; 198 of 35,237 at the exact
+    // framing's view, 2026-12-06).
+    EXPECT_GT(static_cast<double>(equal), 0.993 * static_cast<double>(all));
 }
 
 TEST(StreamedSourceDataTest, ADamagedNodeIsLeftOutWithOneWarning) {

@@ -285,7 +285,7 @@ TEST_P(RasterPathGLTest, ColorAlphaIsTheWinnersLocalSpacingOnScreen) {
                                      : 7.0f * glm::vec3(unit(random), unit(random), unit(random));
         spacing[i] = glm::unpackHalf(glm::packHalf(glm::vec4(across, 2.0f + unit(random))));
     }
-    // What the GPU holds: the sparsest 0.1 % cut to the ratio the rest stay within
+    // What the GPU holds: the sparsest cut to 4 times the ratio the rest stay within
     // (PackedLocalSpacingKeepsItsValuesAndCutsTheSparsest).
     const PackedLocalSpacing packed = packLocalSpacing(spacing);
     std::vector<glm::vec4> held(spacing.size());
@@ -512,14 +512,18 @@ TEST(RasterizePointsGLTest, PackedLocalSpacingKeepsItsValuesAndCutsTheSparsest) 
     spacing[10].w = 0.5f;
     EXPECT_EQ(packLocalSpacing(spacing).sparseSpacingRatio, 1.0f);
     ASSERT_EQ(packed.halves.size(), spacing.size());
-    // Half floats hold these values exactly. The sparsest point's spacing is cut to the
-    // ratio: it reaches no further than the passes' region does.
+    // Half floats hold these values exactly. The sparsest point's spacing is cut to 4 times
+    // the ratio (a stray cluster far from the rest reaches no further).
     EXPECT_EQ(glm::unpackHalf(packed.halves[20]), glm::vec4(3.0f, 4.0f, 0.0f, 0.5f));
-    EXPECT_EQ(glm::unpackHalf(packed.halves[10]), glm::vec4(0.0f, 0.0f, 0.0f, 5.0f));
+    EXPECT_EQ(glm::unpackHalf(packed.halves[10]), glm::vec4(0.0f, 0.0f, 0.0f, 20.0f));
     // An across vector beyond it is shortened along its own direction, w kept below it.
     spacing[10] = glm::vec4(0.0f, 30.0f, 40.0f, 2.0f);
     EXPECT_EQ(glm::unpackHalf(packLocalSpacing(spacing).halves[10]),
-              glm::vec4(0.0f, 3.0f, 4.0f, 2.0f));
+              glm::vec4(0.0f, 12.0f, 16.0f, 2.0f));
+    // Up to 4 times it nothing is cut.
+    spacing[10] = glm::vec4(0.0f, 0.0f, 0.0f, 19.0f);
+    EXPECT_EQ(glm::unpackHalf(packLocalSpacing(spacing).halves[10]),
+              glm::vec4(0.0f, 0.0f, 0.0f, 19.0f));
     EXPECT_TRUE(packLocalSpacing({}).halves.empty());
 }
 

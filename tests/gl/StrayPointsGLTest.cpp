@@ -71,8 +71,10 @@ TEST(StrayPointsGLTest, AClusterFarFromTheScanFillsNoBlock) {
         }
     }
     std::printf("surface pixels within 20 pixels of the cluster: %d\n", near);
-    // Its own pixel and the few its spacing, cut to the scan's (the plane's 1.4 pixels), reaches.
-    EXPECT_LE(near, 9);
+    // Its own pixel and what its spacing, cut to 4 times the rest's (the plane's: about a
+    // pixel here), reaches: within a disc of 4 pixels' radius (measured: 16; without the cut
+    // 947).
+    EXPECT_LE(near, 50);
     EXPECT_GE(near, 1);  // the cluster itself still shows
 }
 
