@@ -43,6 +43,32 @@ bool isPlyInteger(PlyType type) {
 
 namespace {
 
+/// Whether an ascii body's `value` is one that a property of `type` holds: a binary file
+/// cannot say more, and a text one saying red 300 or 1.7 was clamped or rounded silently.
+bool plyTypeHolds(PlyType type, double value) {
+    const auto within = [&](double low, double high) {
+        return value >= low && value <= high && value == std::floor(value);
+    };
+    switch (type) {
+        case PlyType::Int8:
+            return within(-128.0, 127.0);
+        case PlyType::UInt8:
+            return within(0.0, 255.0);
+        case PlyType::Int16:
+            return within(-32768.0, 32767.0);
+        case PlyType::UInt16:
+            return within(0.0, 65535.0);
+        case PlyType::Int32:
+            return within(-2147483648.0, 2147483647.0);
+        case PlyType::UInt32:
+            return within(0.0, 4294967295.0);
+        case PlyType::Float32:
+        case PlyType::Float64:
+            return true;
+    }
+    return false;
+}
+
 std::optional<PlyType> parseType(std::string_view name) {
     static constexpr std::array<std::pair<std::string_view, PlyType>, 16> kNames{{
         {"char", PlyType::Int8},
@@ -354,7 +380,13 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
                 values.scalar[p] = loadBinary(property.type, file_.data() + position_);
                 position_ += size;
             } else {
-                values.scalar[p] = nextAsciiNumber(element, itemIndex);
+                const double value = nextAsciiNumber(element, itemIndex);
+                if (!plyTypeHolds(property.type, value)) {
+                    throw Error(fmt::format(
+                        "the PLY body's {} {} has {} = {}, which its integer type cannot hold",
+                        element.name, itemIndex + 1, property.name, value));
+                }
+                values.scalar[p] = value;
             }
             continue;
         }

@@ -211,6 +211,17 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
          "more than the"},
         {"non-numeric", "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz + "end_header\n1 two 3\n",
          "non-numeric value 'two'"},
+        // Clamped to 255 or rounded to 2 before: a text file can say what a binary one cannot.
+        {"colour beyond uchar",
+         "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
+             "property uchar red\nend_header\n"
+             "1 2 3 300\n",
+         "vertex 1 has red = 300, which its integer type cannot hold"},
+        {"fraction in an integer",
+         "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
+             "property uchar red\nend_header\n"
+             "1 2 3 1.7\n",
+         "red = 1.7"},
         {"face index out of range",
          "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
              "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
