@@ -100,6 +100,27 @@ Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& 
 
 }  // namespace
 
+void cutTheSparsest(std::vector<glm::vec4>& spacing) {
+    if (spacing.empty()) {
+        return;
+    }
+    const auto ratioOf = [](const glm::vec4& entry) {
+        return std::max(entry.w, glm::length(glm::vec3(entry)));
+    };
+    std::vector<float> ratios(spacing.size());
+    std::transform(spacing.begin(), spacing.end(), ratios.begin(), ratioOf);
+    const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
+                                               0.999 * static_cast<double>(ratios.size() - 1));
+    std::nth_element(ratios.begin(), quantile, ratios.end());
+    const float largest = kSparsestReach * std::max(1.0f, *quantile);
+    for (glm::vec4& entry : spacing) {
+        const glm::vec3 across(entry);
+        const float length = glm::length(across);
+        entry = glm::vec4(length > largest ? across * (largest / length) : across,
+                          std::min(entry.w, largest));
+    }
+}
+
 std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h,
                                             const std::function<bool()>& cancelled) {
     const std::vector<glm::vec3>& positions = cloud.positions;
@@ -171,6 +192,7 @@ std::vector<glm::vec4> estimateLocalSpacing(const PointCloud& cloud, double h,
         const bool acrossLines = acrossLength > kLineGapRatio * local && acrossLength < kLargest;
         entry = glm::vec4(acrossLines ? across : glm::vec3(0.0f), local);
     }
+    cutTheSparsest(spacing);
     return spacing;
 }
 

@@ -43,8 +43,8 @@ bool isPlyInteger(PlyType type) {
 
 namespace {
 
-/// Whether an ascii body's `value` is one that a property of `type` holds: a binary file
-/// cannot say more, and a text one saying red 300 or 1.7 was clamped or rounded silently.
+/// Whether an ascii body's `value` is one that a property of `type` holds, as a binary file's
+/// always is.
 bool plyTypeHolds(PlyType type, double value) {
     const auto within = [&](double low, double high) {
         return value >= low && value <= high && value == std::floor(value);
@@ -380,13 +380,7 @@ void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
                 values.scalar[p] = loadBinary(property.type, file_.data() + position_);
                 position_ += size;
             } else {
-                const double value = nextAsciiNumber(element, itemIndex);
-                if (!plyTypeHolds(property.type, value)) {
-                    throw Error(fmt::format(
-                        "the PLY body's {} {} has {} = {}, which its integer type cannot hold",
-                        element.name, itemIndex + 1, property.name, value));
-                }
-                values.scalar[p] = value;
+                values.scalar[p] = nextAsciiNumber(element, itemIndex);
             }
             continue;
         }
@@ -559,8 +553,27 @@ PointCloud PlyBodyReader::read() {
             } else {
                 ItemValues values;
                 values.scalar.resize(vertex->properties.size());
+                // Text can say what binary cannot: an integer colour channel's 300 or 1.7 was
+                // clamped or rounded silently. Properties that are not read are not judged.
+                std::vector<std::size_t> integerChannels;
+                if (layout.color) {
+                    integerChannels.assign(layout.color->begin(), layout.color->end());
+                }
+                if (layout.alpha) {
+                    integerChannels.push_back(*layout.alpha);
+                }
+                std::erase_if(integerChannels,
+                              [&](std::size_t p) { return !isPlyInteger(colorType(p)); });
                 for (std::uint64_t i = 0; i < vertex->count; ++i) {
                     readItem(*vertex, i, std::nullopt, values);
+                    for (const std::size_t p : integerChannels) {
+                        if (!plyTypeHolds(colorType(p), values.scalar[p])) {
+                            throw Error(fmt::format(
+                                "the PLY body's vertex {} has {} = {}, which its integer type "
+                                "cannot hold",
+                                i + 1, vertex->properties[p].name, values.scalar[p]));
+                        }
+                    }
                     builder.add(makeRecord([&](std::size_t p) { return values.scalar[p]; }));
                     if (i % kProgressEvery == 0) {
                         context_.reportProgress(position_, file_.size());

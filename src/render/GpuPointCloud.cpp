@@ -215,34 +215,20 @@ void GpuPointCloud::setColors(const std::vector<Rgba8>& colors) {
 }
 
 PackedLocalSpacing packLocalSpacing(const std::vector<glm::vec4>& spacing) {
-    constexpr float kSparsestReach = 4.0f;
     PackedLocalSpacing packed;
-    const auto ratioOf = [](const glm::vec4& entry) {
-        return std::max(entry.w, glm::length(glm::vec3(entry)));
-    };
+    packed.halves.resize(spacing.size());
+    std::transform(spacing.begin(), spacing.end(), packed.halves.begin(),
+                   [](const glm::vec4& entry) { return glm::u16vec4(glm::packHalf(entry)); });
     std::vector<float> ratios(spacing.size());
-    std::transform(spacing.begin(), spacing.end(), ratios.begin(), ratioOf);
+    std::transform(spacing.begin(), spacing.end(), ratios.begin(), [](const glm::vec4& entry) {
+        return std::max(entry.w, glm::length(glm::vec3(entry)));
+    });
     if (!ratios.empty()) {
         const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
                                                    0.999 * static_cast<double>(ratios.size() - 1));
         std::nth_element(ratios.begin(), quantile, ratios.end());
         packed.sparseSpacingRatio = std::max(1.0f, *quantile);
     }
-    // No point reaches further than 4 times that ratio. A cluster of stray points far from
-    // the rest (three 8 cm from the Stanford dragon, whose points lie 0.3 mm apart: 41 times
-    // it) filled a block hundreds of h wide; the sparsest ground of a LiDAR scan reaches up to
-    // 7 times it (lone_star.laz: 85 against 12.2; a cut at the ratio itself took 5 % of its
-    // surface, at 4 times 0.4 %, and left the dragon's cluster 28 pixels instead of 2,100).
-    const float largest = kSparsestReach * packed.sparseSpacingRatio;
-    packed.halves.resize(spacing.size());
-    std::transform(spacing.begin(), spacing.end(), packed.halves.begin(),
-                   [&](const glm::vec4& entry) {
-                       const glm::vec3 across(entry);
-                       const float length = glm::length(across);
-                       const glm::vec4 kept(length > largest ? across * (largest / length) : across,
-                                            std::min(entry.w, largest));
-                       return glm::u16vec4(glm::packHalf(kept));
-                   });
     return packed;
 }
 

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -55,10 +56,13 @@ void readSetting(const nlohmann::json& json, std::string_view key, T& value, T m
     if (std::is_integral_v<T> && read != std::floor(read)) {
         throw Error(fmt::format("the setting '{}' = {} is not a whole number", key, read));
     }
-    // Floats compare as floats: 0.01 in the file is the bound 0.01f, not below it.
-    const bool inside = std::is_integral_v<T>
-                            ? read >= static_cast<double>(min) && read <= static_cast<double>(max)
-                            : static_cast<T>(read) >= min && static_cast<T>(read) <= max;
+    // Floats compare as floats: 0.01 in the file is the bound 0.01f, not below it (and a
+    // double beyond a float's range is not cast to one at all).
+    const bool inside =
+        std::is_integral_v<T>
+            ? read >= static_cast<double>(min) && read <= static_cast<double>(max)
+            : std::abs(read) <= static_cast<double>(std::numeric_limits<T>::max()) &&
+                  static_cast<T>(read) >= min && static_cast<T>(read) <= max;
     if (!inside) {
         throw Error(fmt::format("the setting '{}' = {} is outside {}..{}", key, read, min, max));
     }

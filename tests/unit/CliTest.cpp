@@ -42,6 +42,19 @@ TEST(CliTest, NumbersThatAreNotFiniteAreRefused) {
     }
 }
 
+TEST(CliTest, ACameraFileExcludesTheOptionsItFixes) {
+    // The file's size and view won without a word: --width 640 rendered at the file's width.
+    const test::TempDir dir;
+    const std::string camera = dir.write("camera.json", "{}").string();
+    for (const std::string option :
+         {"--width", "--height", "--yaw", "--pitch", "--distance", "--fovy"}) {
+        const test::CommandResult result = runSubscan(
+            {"render", "synthetic:sphere", "-o", "x.png", "--camera", camera, option, "40"});
+        EXPECT_EQ(result.exitCode, 2) << option;
+        EXPECT_THAT(result.err, HasSubstr("excludes --camera")) << option;
+    }
+}
+
 TEST(CliTest, InfoJsonHasExactlyTheDocumentedKeys) {
     const test::CommandResult result = runSubscan({"info", "synthetic:sphere", "--json"});
     ASSERT_EQ(result.exitCode, 0) << result.err;

@@ -74,8 +74,13 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
     command.add_option("--fovy", fovy, "Vertical field of view, degrees")
         ->check(finiteNumber())
         ->check(CLI::Range(1.0, 170.0));
-    command.add_option("--camera", cameraFile, "camera.json to render from")
-        ->check(CLI::ExistingFile);
+    CLI::Option* camera = command.add_option("--camera", cameraFile, "camera.json to render from")
+                              ->check(CLI::ExistingFile);
+    // The file fixes the size and the view: these were ignored without a word.
+    for (const char* placed : {"--width", "--height", "--yaw", "--pitch", "--distance", "--fovy",
+                               "--view", "--sensor"}) {
+        camera->excludes(command.get_option(placed));
+    }
     command.add_option("--background", background, "R,G,B (sRGB 0..1) or #rrggbb");
     command.add_option("--raster", raster, "Compute rasterizer: auto | int64 | two-pass")
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));

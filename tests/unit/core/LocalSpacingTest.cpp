@@ -316,6 +316,55 @@ TEST(LocalSpacingTest, AStreamedLevelsPointsTakeAtLeastItsSpacing) {
                  std::invalid_argument);
 }
 
+TEST(LocalSpacingTest, TheSparsestAreCutToFourTimesWhatTheRestStayWithin) {
+    // 10,000 entries at 1.5: the ratio that all but the sparsest 0.1 % stay within, whose
+    // 4 times, 6, bounds every entry. An across vector is shortened along itself, w kept.
+    std::vector<glm::vec4> spacing(10'000, glm::vec4(0.0f, 0.0f, 0.0f, 1.5f));
+    spacing[10] = glm::vec4(0.0f, 0.0f, 0.0f, 40.0f);
+    spacing[20] = glm::vec4(0.0f, 30.0f, 40.0f, 2.0f);
+    spacing[30] = glm::vec4(0.0f, 0.0f, 0.0f, 5.9f);
+    cutTheSparsest(spacing);
+    EXPECT_EQ(spacing[10], glm::vec4(0.0f, 0.0f, 0.0f, 6.0f));
+    EXPECT_NEAR(glm::distance(spacing[20], glm::vec4(0.0f, 3.6f, 4.8f, 2.0f)), 0.0f, 1e-6f);
+    EXPECT_EQ(spacing[30], glm::vec4(0.0f, 0.0f, 0.0f, 5.9f));
+    EXPECT_EQ(spacing[0], glm::vec4(0.0f, 0.0f, 0.0f, 1.5f));
+
+    // Three points 150 spacings from a plane of grid points: their neighbours' distance would
+    // make them reach that far; estimated, they reach no further than 4 times the plane's.
+    PointCloudBuilder builder({}, 100 * 100 + 3);
+    std::vector<float> levelSpacing;
+    for (int i = 0; i < 100; ++i) {
+        for (int j = 0; j < 100; ++j) {
+            PointRecord record;
+            record.position = {i * 0.001, j * 0.001, 0.0};
+            builder.add(record);
+            levelSpacing.push_back(0.001f);
+        }
+    }
+    for (const double offset : {0.0, 0.0005, 0.0011}) {
+        PointRecord record;
+        record.position = {-0.15 + offset, 0.04, 0.0};
+        builder.add(record);
+        levelSpacing.push_back(0.001f);
+    }
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    const PointSpacing estimated = estimatePointSpacing(cloud);
+    ASSERT_EQ(estimated.local.size(), cloud.size());
+    for (std::size_t i = cloud.size() - 3; i < cloud.size(); ++i) {
+        EXPECT_LE(estimated.local[i].w, kSparsestReach) << i;  // the plane's ratio is 1
+    }
+    // A streamed view's coarse level raises its points' w after the cut: a level 100 times
+    // as sparse as the rest keeps its floor, or coarse levels would open up.
+    for (std::size_t i = cloud.size() - 3; i < cloud.size(); ++i) {
+        levelSpacing[i] = 0.1f;
+    }
+    const PointSpacing byLevel = estimatePointSpacing(cloud, levelSpacing);
+    for (std::size_t i = cloud.size() - 3; i < cloud.size(); ++i) {
+        EXPECT_GT(byLevel.local[i].w, 50.0f) << i;
+    }
+}
+
 TEST(LocalSpacingTest, ALargeEvenStreamedViewGetsItsLevelsSpacingWithoutEstimates) {
     // Above kAlwaysLocalSpacingPoints an even cloud gets no local estimate; a streamed view of
     // it still needs its levels' spacings: w = the level's spacing over the dominant level's,

@@ -214,14 +214,19 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
         // Clamped to 255 or rounded to 2 before: a text file can say what a binary one cannot.
         {"colour beyond uchar",
          "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
-             "property uchar red\nend_header\n"
-             "1 2 3 300\n",
+             "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
+             "1 2 3 300 0 0\n",
          "vertex 1 has red = 300, which its integer type cannot hold"},
         {"fraction in an integer",
          "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
-             "property uchar red\nend_header\n"
-             "1 2 3 1.7\n",
-         "red = 1.7"},
+             "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
+             "1 2 3 0 1.7 0\n",
+         "green = 1.7"},
+        {"alpha beyond uchar",
+         "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
+             "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+             "property uchar alpha\nend_header\n1 2 3 4 5 6 -1\n",
+         "alpha = -1"},
         {"face index out of range",
          "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
              "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
@@ -253,6 +258,21 @@ TEST(PlyReaderTest, BadInputsGiveOneClearSentence) {
         SCOPED_TRACE(c.name);
         EXPECT_THAT(decodeError(c.file, "bad.ply"), HasSubstr(c.expected));
     }
+}
+
+TEST(PlyReaderTest, ValuesThatAreNotReadAreNotJudged) {
+    // An integer property subscan does not read, and an element it skips, may hold anything
+    // a text file writes; only the colour channels read are checked against their type.
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement material 1\nproperty uchar id\n"
+        "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+        "property uchar quality\nproperty uchar red\nproperty uchar green\n"
+        "property uchar blue\nend_header\n256\n1 2 3 0.5 255.0 -0 7\n";
+    const PointCloud cloud = decode(file, "kept.ply").cloud;
+    ASSERT_EQ(cloud.size(), 1u);
+    EXPECT_EQ(cloud.colors[0].r, 255);
+    EXPECT_EQ(cloud.colors[0].g, 0);
+    EXPECT_EQ(cloud.colors[0].b, 7);
 }
 
 TEST(PlyReaderTest, HugeVertexCountInAsciiDoesNotAllocateOrHang) {

@@ -186,6 +186,11 @@ TEST(RenderSettingsTest, NumbersAreCheckedBeforeTheyBecomeTheSettingsType) {
                 ::testing::HasSubstr("'max_frames' = 2.5 is not a whole number"));
     EXPECT_THAT(refusal({{"temporal", {{"max_frames", "8"}}}}),
                 ::testing::HasSubstr("'max_frames' has the wrong type"));
+    EXPECT_THAT(refusal({{"temporal", {{"max_frames", true}}}}),
+                ::testing::HasSubstr("'max_frames' has the wrong type"));
+    // Beyond a float's range: refused before any cast to float.
+    EXPECT_THAT(refusal({{"raster", {{"point_size", 1e39}}}}),
+                ::testing::HasSubstr("'point_size' = 1e+39 is outside"));
     // A float setting at its bound as the file writes it (0.01, not 0.01f) is inside.
     const nlohmann::json atBound = {{"temporal", {{"new_frame_weight", 0.01}}}};
     EXPECT_FLOAT_EQ(atBound.get<RenderSettings>().temporal.newFrameWeight, 0.01f);
