@@ -65,6 +65,10 @@ class CloudRecordSource final : public PointRecordSource {
             throwNamed(source, error);
         }
         info_ = convertedSourceInfo(source, cloud_.size(), *writer_, bounds);
+        if (!cloud_.triangles.empty()) {
+            info_.warnings.push_back(facesNotKept(source, cloud_.triangles.size()));
+            cloud_.triangles = {};
+        }
     }
 
     PointCloud cloud_;

@@ -98,6 +98,11 @@ class PlyRecordSource final : public PointRecordSource {
         const Bounds bounds = findBounds(vertex);
         writer_.emplace(layout_.color.has_value(), layout_.normal.has_value(), bounds);
         info_ = convertedSourceInfo(std::move(name), vertexCount_, *writer_, bounds);
+        for (const PlyElement& element : header.elements) {
+            if (element.name == "face" && element.count > 0) {
+                info_.warnings.push_back(facesNotKept(info_.name, element.count));
+            }
+        }
     }
 
     const PointRecordSourceInfo& info() const override { return info_; }

@@ -241,6 +241,11 @@ void ConvertedRecordWriter::append(std::vector<std::byte>& records,
     }
 }
 
+std::string facesNotKept(const std::string& name, std::uint64_t faces) {
+    return fmt::format("{}: its faces ({}) are not kept: point records hold points only", name,
+                       faces);
+}
+
 PointRecordSourceInfo convertedSourceInfo(std::string name, std::uint64_t pointCount,
                                           const ConvertedRecordWriter& writer,
                                           const Bounds& bounds) {

@@ -108,6 +108,10 @@ PointRecordSourceInfo convertedSourceInfo(std::string name, std::uint64_t pointC
                                           const ConvertedRecordWriter& writer,
                                           const Bounds& bounds);
 
+/// The warning of a converted input whose faces point records cannot hold: they were dropped
+/// without a word where LAZ, COPC and the octree took a mesh.
+std::string facesNotKept(const std::string& name, std::uint64_t faces);
+
 /// Throws subscan::Error with `name` before the message: "name: message".
 [[noreturn]] void throwNamed(const std::string& name, const Error& error);
 

@@ -174,6 +174,33 @@ TEST(ConvertCommandTest, ClassificationSurvivesLasToLasAndIsNamedWhereItCannot) 
                                    ": PLY cannot hold classification codes; they are not written"));
 }
 
+TEST(ConvertCommandTest, AMeshsFacesDroppedByLazAreNamed) {
+    // LAZ and COPC are written from point records, which hold no faces: they were dropped
+    // without a word, while LAS output warned. A text PLY loads whole, a binary one streams.
+    const test::TempDir dir;
+    const std::string header =
+        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const auto text = dir.write(
+        "text.ply", "ply\nformat ascii 1.0\n" + header + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    std::string binary = "ply\nformat binary_little_endian 1.0\n" + header;
+    for (const float value : {0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}) {
+        binary.append(reinterpret_cast<const char*>(&value), sizeof value);
+    }
+    binary += '\x03';
+    for (const std::int32_t index : {0, 1, 2}) {
+        binary.append(reinterpret_cast<const char*>(&index), sizeof index);
+    }
+    const auto binaryPly = dir.write("binary.ply", binary);
+    for (const auto& [input, output] :
+         {std::pair{text, dir / "text.laz"}, std::pair{binaryPly, dir / "binary.copc.laz"}}) {
+        const test::CommandResult result =
+            runSubscan({"convert", input.string(), "-o", output.string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        EXPECT_THAT(result.err, HasSubstr(input.string() + ": its faces (1) are not kept"));
+    }
+}
+
 TEST(ConvertCommandTest, UnknownExtensionIsAUsageError) {
     const test::TempDir dir;
     const auto output = dir / "sphere.obj";
