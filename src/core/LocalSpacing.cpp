@@ -100,19 +100,25 @@ Neighbourhood neighbourhoodOf(const KdTree& tree, const std::vector<glm::vec3>& 
 
 }  // namespace
 
+float sparseSpacingRatio(const std::vector<glm::vec4>& spacing) {
+    if (spacing.empty()) {
+        return 1.0f;
+    }
+    std::vector<float> ratios(spacing.size());
+    std::transform(spacing.begin(), spacing.end(), ratios.begin(), [](const glm::vec4& entry) {
+        return std::max(entry.w, glm::length(glm::vec3(entry)));
+    });
+    const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
+                                               0.999 * static_cast<double>(ratios.size() - 1));
+    std::nth_element(ratios.begin(), quantile, ratios.end());
+    return std::max(1.0f, *quantile);
+}
+
 void cutTheSparsest(std::vector<glm::vec4>& spacing) {
     if (spacing.empty()) {
         return;
     }
-    const auto ratioOf = [](const glm::vec4& entry) {
-        return std::max(entry.w, glm::length(glm::vec3(entry)));
-    };
-    std::vector<float> ratios(spacing.size());
-    std::transform(spacing.begin(), spacing.end(), ratios.begin(), ratioOf);
-    const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
-                                               0.999 * static_cast<double>(ratios.size() - 1));
-    std::nth_element(ratios.begin(), quantile, ratios.end());
-    const float largest = kSparsestReach * std::max(1.0f, *quantile);
+    const float largest = kSparsestReach * sparseSpacingRatio(spacing);
     for (glm::vec4& entry : spacing) {
         const glm::vec3 across(entry);
         const float length = glm::length(across);

@@ -30,6 +30,11 @@ namespace subscan {
 /// (cutTheSparsest).
 /// `cancelled` (may be empty) is asked now and then, from any thread; once it says yes the
 /// work stops and the result is incomplete.
+/// The ratio (the larger of w and the across vector's length, in h) that all points of
+/// `spacing` (estimateLocalSpacing's form) but the sparsest 0.1 % stay within, at least 1; 1
+/// for none.
+float sparseSpacingRatio(const std::vector<glm::vec4>& spacing);
+
 /// No point's spacing reaches further than this many times the ratio (the larger of w and the
 /// across vector's length) that all but the sparsest 0.1 % stay within. A cluster of stray
 /// points far from the rest (three 8 cm from the Stanford dragon, whose points lie 0.3 mm

@@ -12,6 +12,7 @@
 
 #include "core/Coloring.h"
 #include "core/Error.h"
+#include "core/LocalSpacing.h"
 #include "shared/bindings.h"
 
 namespace subscan {
@@ -219,16 +220,7 @@ PackedLocalSpacing packLocalSpacing(const std::vector<glm::vec4>& spacing) {
     packed.halves.resize(spacing.size());
     std::transform(spacing.begin(), spacing.end(), packed.halves.begin(),
                    [](const glm::vec4& entry) { return glm::u16vec4(glm::packHalf(entry)); });
-    std::vector<float> ratios(spacing.size());
-    std::transform(spacing.begin(), spacing.end(), ratios.begin(), [](const glm::vec4& entry) {
-        return std::max(entry.w, glm::length(glm::vec3(entry)));
-    });
-    if (!ratios.empty()) {
-        const auto quantile = ratios.begin() + static_cast<std::ptrdiff_t>(
-                                                   0.999 * static_cast<double>(ratios.size() - 1));
-        std::nth_element(ratios.begin(), quantile, ratios.end());
-        packed.sparseSpacingRatio = std::max(1.0f, *quantile);
-    }
+    packed.sparseSpacingRatio = sparseSpacingRatio(spacing);
     return packed;
 }
 
