@@ -25,6 +25,7 @@
 #include "io/AtomicFile.h"
 #include "io/ByteOrder.h"
 #include "io/MappedFile.h"
+#include "io/TextParsing.h"
 #include "io/WriterSupport.h"
 
 namespace subscan {
@@ -60,9 +61,7 @@ constexpr std::array<PictureExtension, 5> kPictureExtensions{{
 }};
 
 std::optional<PictureFormat> formatOfExtension(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string extension = asciiLowercase(path.extension().string());
     for (const PictureExtension& candidate : kPictureExtensions) {
         if (candidate.extension == extension) {
             return candidate.format;

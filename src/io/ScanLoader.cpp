@@ -16,6 +16,7 @@
 #include "io/PcdReader.h"
 #include "io/PlyReader.h"
 #include "io/ReadContext.h"
+#include "io/TextParsing.h"
 #include "io/XyzReader.h"
 #include "lod/NodeSelection.h"
 #include "lod/NodeSource.h"
@@ -71,10 +72,7 @@ bool looksLikeOff(std::span<const std::byte> file) {
 }
 
 std::string lowerExtension(const std::filesystem::path& path) {
-    std::string extension = path.extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return extension;
+    return asciiLowercase(path.extension().string());
 }
 
 }  // namespace

@@ -9,6 +9,15 @@
 
 namespace subscan {
 
+/// `text` with its ASCII letters in lower case (file extensions, format names).
+inline std::string asciiLowercase(std::string_view text) {
+    std::string lower(text);
+    for (char& c : lower) {
+        c = c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
+    }
+    return lower;
+}
+
 inline bool isBlank(char c) {
     return c == ' ' || c == '\t' || c == '\r';
 }

@@ -308,13 +308,6 @@ bool isCount(double value) {
     return value >= 0.0 && value <= 9007199254740992.0 && value == std::floor(value);
 }
 
-std::string toLower(std::string_view text) {
-    std::string lowercase(text);
-    std::transform(lowercase.begin(), lowercase.end(), lowercase.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return lowercase;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Column layout
 
@@ -427,7 +420,7 @@ std::optional<HeaderLine> parseHeaderNames(std::string_view content, std::size_t
             name.back() == name.front()) {
             name = name.substr(1, name.size() - 2);
         }
-        const std::string lowercase = toLower(name);
+        const std::string lowercase = asciiLowercase(name);
         hasX = hasX || lowercase == "x";
         hasY = hasY || lowercase == "y";
         hasZ = hasZ || lowercase == "z";
@@ -443,7 +436,7 @@ std::optional<HeaderLine> parseHeaderNames(std::string_view content, std::size_t
 Layout layoutFromNames(const HeaderLine& header, std::vector<std::string>& warnings) {
     std::array<std::optional<std::size_t>, static_cast<std::size_t>(Role::Count)> columnOf;
     for (std::size_t column = 0; column < header.names.size(); ++column) {
-        if (const auto role = roleFromName(toLower(header.names[column]))) {
+        if (const auto role = roleFromName(asciiLowercase(header.names[column]))) {
             auto& slot = columnOf[static_cast<std::size_t>(*role)];
             if (!slot) {
                 slot = column;
@@ -653,7 +646,7 @@ void rejectLoneCarriageReturns(std::string_view content, std::size_t lineNumber)
 void considerHeaderLine(std::string_view content, std::size_t lineNumber, Prelude& prelude) {
     // ESRI ASCII grids share the .asc extension with point lists, but hold a raster.
     constexpr std::string_view kGridKeyword = "ncols";
-    if (toLower(content.substr(0, kGridKeyword.size())) == kGridKeyword &&
+    if (asciiLowercase(content.substr(0, kGridKeyword.size())) == kGridKeyword &&
         (content.size() == kGridKeyword.size() || isBlank(content[kGridKeyword.size()]))) {
         throw Error(
             "it is an ESRI ASCII grid (a raster with an 'ncols' header), not a list of "

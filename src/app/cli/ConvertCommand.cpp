@@ -17,6 +17,7 @@
 #include "io/LasWriter.h"
 #include "io/PcdWriter.h"
 #include "io/PlyWriter.h"
+#include "io/TextParsing.h"
 #include "io/WriterSupport.h"
 #include "io/XyzWriter.h"
 #include "lod/CopcWriter.h"
@@ -51,12 +52,6 @@ constexpr std::array<OutputFormat, 4> kOutputFormats{{
     {".xyz", "XYZ text", writeXyz, true, false, false},
 }};
 
-std::string lowercase(std::string text) {
-    std::transform(text.begin(), text.end(), text.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return text;
-}
-
 /// Outputs written from LAS 1.4 point records (io/PointRecordSource.h) rather than from a
 /// loaded cloud: LAZ and COPC always, LAS when the input is LAS, LAZ or COPC, so that its
 /// integer coordinates and every attribute pass unchanged.
@@ -69,7 +64,7 @@ bool isLasFamily(const std::string& source) {
 }
 
 RecordOutput recordOutput(const std::filesystem::path& output, const std::string& source) {
-    const std::string name = lowercase(output.filename().string());
+    const std::string name = asciiLowercase(output.filename().string());
     if (name.ends_with(".copc.laz")) {
         return RecordOutput::Copc;
     }
@@ -108,7 +103,7 @@ std::uint64_t convertRecords(const std::string& source, const std::filesystem::p
 
 /// The format named by the output's extension (any case), or nullptr.
 const OutputFormat* outputFormat(const std::filesystem::path& output) {
-    const std::string extension = lowercase(output.extension().string());
+    const std::string extension = asciiLowercase(output.extension().string());
     const auto* format = std::find_if(
         kOutputFormats.begin(), kOutputFormats.end(),
         [&](const OutputFormat& candidate) { return candidate.extension == extension; });
@@ -212,7 +207,7 @@ Command addConvertCommand(CLI::App& parent) {
         ->required()
         ->check(
             [](const std::string& path) -> std::string {
-                return outputFormat(path) != nullptr || lowercase(path).ends_with(".laz")
+                return outputFormat(path) != nullptr || asciiLowercase(path).ends_with(".laz")
                            ? std::string()
                            : fmt::format(
                                  "'{}' has no extension of a format convert writes ({}, "

@@ -1,5 +1,3 @@
-#include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -13,6 +11,7 @@
 #include "app/cli/Commands.h"
 #include "core/Error.h"
 #include "io/PlyWriter.h"
+#include "io/TextParsing.h"
 #include "scan/Scene.h"
 #include "scan/VirtualScanner.h"
 
@@ -149,14 +148,12 @@ Command addScanCommand(CLI::App& parent) {
         ->check(
             [](const std::string& path) -> std::string {
                 // Other extensions were written as PLY all the same, which other tools refuse.
-                std::string extension = std::filesystem::path(path).extension().string();
-                std::transform(extension.begin(), extension.end(), extension.begin(),
-                               [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-                return extension == ".ply" ? std::string()
-                                           : fmt::format(
-                                                 "'{}' is not a .ply file: scan writes "
-                                                 "PLY (convert writes other formats)",
-                                                 path);
+                return asciiLowercase(std::filesystem::path(path).extension().string()) == ".ply"
+                           ? std::string()
+                           : fmt::format(
+                                 "'{}' is not a .ply file: scan writes "
+                                 "PLY (convert writes other formats)",
+                                 path);
             },
             "FILE.ply");
     scan->add_option("--views", options->settings.views,
