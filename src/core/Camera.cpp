@@ -193,9 +193,12 @@ Camera orbitCamera(const Bounds& bounds, const OrbitView& orbit, int width, int 
                                  std::sin(pitch) * frame.up +
                                  std::cos(yaw) * std::cos(pitch) * frame.front;
     glm::dvec3 up = frame.up;
-    // Looking straight down the up axis leaves lookAt without a horizon: tilt the up vector.
+    // Looking straight along the up axis leaves lookAt without a horizon: the picture's up is
+    // then the limit it takes as the pitch nears ±90°, the yaw's horizontal direction away from
+    // the eye looking down, towards it looking up, so the view still turns with the yaw.
     if (std::abs(glm::dot(direction, up)) > 0.9999) {
-        up = -frame.front;
+        up =
+            (pitch > 0.0 ? -1.0 : 1.0) * (std::sin(yaw) * frame.side + std::cos(yaw) * frame.front);
     }
     constexpr double kMargin = 1.05;
     double distance = kMargin * radius / std::sin(std::min(halfFovy, halfFovx));

@@ -170,6 +170,34 @@ TEST(CameraTest, OrbitsAboutYAndZKeepTheirDirections) {
     }
 }
 
+TEST(CameraTest, ViewsAlongTheUpAxisStillTurnWithTheYaw) {
+    // Straight down (or up) the picture's up has no horizon to follow; it must be the limit the
+    // view takes as the pitch nears ±90°, so the picture turns with the yaw and does not jump
+    // where the up vector is replaced (an outside test found yaw ignored from pitch 89.2° on).
+    const Bounds bounds = box({-1, -1, -1}, {1, 1, 1});
+    for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
+        for (const double pitch : {90.0, -90.0}) {
+            for (const double yaw : {0.0, 30.0, 90.0, -135.0}) {
+                const Camera pole = orbitCamera(bounds, {yaw, pitch, 5.0, up}, 100, 100, 40);
+                const Camera near = orbitCamera(
+                    bounds, {yaw, pitch - std::copysign(0.5, pitch), 5.0, up}, 100, 100, 40);
+                // The picture's right axis (the view's first row) in world space: half a degree
+                // of pitch moves it by about sin(0.5°) = 0.009, a jump of 90° by 1.4.
+                const glm::dvec3 right(pole.view[0][0], pole.view[1][0], pole.view[2][0]);
+                const glm::dvec3 nearRight(near.view[0][0], near.view[1][0], near.view[2][0]);
+                EXPECT_LT(glm::length(right - nearRight), 0.02)
+                    << int(up) << " pitch " << pitch << " yaw " << yaw;
+            }
+            // Turning the yaw by 90° at the pole turns the picture's right axis by 90°.
+            const Camera a = orbitCamera(bounds, {0, pitch, 5.0, up}, 100, 100, 40);
+            const Camera b = orbitCamera(bounds, {90, pitch, 5.0, up}, 100, 100, 40);
+            const double cosine = a.view[0][0] * b.view[0][0] + a.view[1][0] * b.view[1][0] +
+                                  a.view[2][0] * b.view[2][0];
+            EXPECT_NEAR(cosine, 0.0, 1e-9) << int(up);  // double-precision lookAt
+        }
+    }
+}
+
 TEST(CameraTest, OrbitAnglesInvertTheOrbitForEveryUpAxis) {
     const Bounds bounds = box({-1, -1, -1}, {1, 1, 1});
     for (const UpAxis up : {UpAxis::Y, UpAxis::Z, UpAxis::NegativeY}) {
