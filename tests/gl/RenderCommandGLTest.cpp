@@ -346,15 +346,16 @@ TEST(RenderCommandGLTest, RasterResolutionAndTimingsOptionsDoWhatTheySay) {
     EXPECT_NEAR(total, sum, 0.0005 * static_cast<double>(passes.size() + 1))  // 3 decimals each
         << timed.out;
 
-    // --resolution half: the reconstruction runs at half the size (its camera, exported, says
-    // so) and the picture, scaled up, still shows the sphere where it is, within one reduced
-    // pixel (2 output pixels) of its silhouette.
+    // --resolution half: the reconstruction runs at half the size (the buffers' camera, exported
+    // beside the picture's, says so) and the picture, scaled up, still shows the sphere where it
+    // is, within one reduced pixel (2 output pixels) of its silhouette.
     const auto half =
         render("half.png", {"--resolution", "half", "--export-buffers", (dir / "half").string()});
     ASSERT_EQ(half.exitCode, 0) << half.err;
-    const Camera pipeline = readCameraFile(dir / "half" / "camera.json");
+    const Camera pipeline = readCameraFile(dir / "half" / "buffers_camera.json");
     EXPECT_EQ(pipeline.width, (kWidth + 1) / 2);
     EXPECT_EQ(pipeline.height, (kHeight + 1) / 2);
+    EXPECT_EQ(readCameraFile(dir / "half" / "camera.json").width, kWidth);
     truth.expectDrawnOnTheSphere(readPng(dir / "half.png"), 1.0, 2);
     EXPECT_NE(test::fileBytes(dir / "half.png"), test::fileBytes(dir / "auto.png"));
 }
@@ -739,6 +740,49 @@ TEST(RenderCommandGLTest, OutputsAreWrittenOnlyAfterTheWorkAndNeverOverAnInput) 
     EXPECT_TRUE(std::filesystem::exists(dir / "x.png"));
     EXPECT_TRUE(std::filesystem::exists(dir / "buffers" / "camera.json"));
     EXPECT_TRUE(std::filesystem::exists(settings));
+}
+
+TEST(RenderCommandGLTest, AnExportedCameraRendersItsPictureAgain) {
+    // With --samples the buffers come from the last, jittered frame; camera.json is the
+    // picture's camera all the same, so --camera renders the same picture (it used to carry
+    // that frame's jitter, which --camera then added to every frame's own: found from outside).
+    const test::TempDir dir;
+    const std::vector<std::string> common{"--mode",  "surface", "--samples", "4",
+                                          "--width", "48",      "--height",  "40"};
+    auto render = [&](const std::string& name, std::vector<std::string> extra) {
+        std::vector<std::string> arguments{"render",
+                                           "synthetic:sphere?points=20000",
+                                           "-o",
+                                           (dir / (name + ".png")).string(),
+                                           "--export-buffers",
+                                           (dir / name).string(),
+                                           "--mode",
+                                           "surface",
+                                           "--samples",
+                                           "4"};
+        arguments.insert(arguments.end(), extra.begin(), extra.end());
+        return runSubscan(arguments);
+    };
+    const auto first = render("first", {"--width", "48", "--height", "40", "--yaw", "20"});
+    ASSERT_EQ(first.exitCode, 0) << first.err;
+    const auto again = render("again", {"--camera", (dir / "first" / "camera.json").string()});
+    ASSERT_EQ(again.exitCode, 0) << again.err;
+    EXPECT_EQ(test::fileBytes(dir / "again.png"), test::fileBytes(dir / "first.png"));
+    EXPECT_EQ(test::fileBytes(dir / "again" / "camera.json"),
+              test::fileBytes(dir / "first" / "camera.json"));
+    EXPECT_EQ(readCameraFile(dir / "first" / "camera.json").jitterPixels, glm::dvec2(0.0));
+    // The buffers' own camera, jittered, beside it: what their pixels were rendered through.
+    const Camera buffers = readCameraFile(dir / "first" / "buffers_camera.json");
+    EXPECT_NE(buffers.jitterPixels, glm::dvec2(0.0));
+    EXPECT_EQ(buffers.width, 48);
+
+    // Without jitter or reduction the two are one: no buffers_camera.json, not even an earlier
+    // export's left in the folder.
+    const auto plain = runSubscan({"render", "synthetic:sphere?points=20000", "-o",
+                                   (dir / "plain.png").string(), "--export-buffers",
+                                   (dir / "first").string(), "--width", "48", "--height", "40"});
+    ASSERT_EQ(plain.exitCode, 0) << plain.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "first" / "buffers_camera.json"));
 }
 
 /// The RGB of pixel i of a 3-channel PFM.

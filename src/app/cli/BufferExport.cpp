@@ -14,14 +14,27 @@
 namespace subscan::cli {
 
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
-                   const RenderSettings& settings) {
+                   const RenderSettings& settings, const Camera& picture) {
     std::error_code error;
     std::filesystem::create_directories(directory, error);
     if (error) {
         throw Error(fmt::format("{}: cannot create the directory: {}", directory.string(),
                                 error.message()));
     }
-    writeCameraFile(directory / "camera.json", renderer.pipelineCamera());
+    writeCameraFile(directory / "camera.json", picture);
+    const Camera& buffersCamera = renderer.pipelineCamera();
+    const std::filesystem::path buffersCameraFile = directory / "buffers_camera.json";
+    if (buffersCamera.width != picture.width || buffersCamera.height != picture.height ||
+        buffersCamera.jitterPixels != picture.jitterPixels) {
+        writeCameraFile(buffersCameraFile, buffersCamera);
+    } else {
+        // An earlier export's into the same folder would describe other buffers.
+        std::filesystem::remove(buffersCameraFile, error);
+        if (error) {
+            throw Error(fmt::format("{}: cannot remove it: {}", buffersCameraFile.string(),
+                                    error.message()));
+        }
+    }
     const std::vector<FrameBuffer> buffers = readFrameBuffers(renderer, settings);
     // "depth" comes first: color.png's alpha and mask.png are where it is finite.
     const ImageF& depth = buffers.front().image;

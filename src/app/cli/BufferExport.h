@@ -11,11 +11,12 @@ namespace subscan::cli {
 /// mask.png and radiance.pfm (after scattering in sss mode), with depth.pfm holding the
 /// reconstructed depth (+inf outside the mask); with single scattering also single.pfm (that
 /// term alone, linear RGB like radiance.pfm), sigma_s.pfm and sigma_a.pfm (σs′ and σa in mm⁻¹).
-/// The camera and the buffers are the pipeline's last frame's: at reduced resolution smaller
-/// than the picture; with the temporal filter at rest, that frame's jittered camera (its
-/// `jitter_pixels` in camera.json), the picture being the mean over many. Needs a frame
-/// rendered with FrameOutputs::Everything.
+/// camera.json is `picture`, the camera the picture was rendered through, so `--camera` renders
+/// it again. The buffers are the pipeline's last frame's: at reduced resolution smaller than the
+/// picture, with the temporal filter at rest that frame's jittered camera (the picture being
+/// the mean over many); where their camera is not the picture's it is written beside it as
+/// buffers_camera.json. Needs a frame rendered with FrameOutputs::Everything.
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
-                   const RenderSettings& settings);
+                   const RenderSettings& settings, const Camera& picture);
 
 }  // namespace subscan::cli

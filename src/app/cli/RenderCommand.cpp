@@ -177,7 +177,7 @@ int runRender(const RenderOptions& options) {
     context->throwOnErrors("while rendering");
     // Outputs only once the picture exists, so a failed render leaves none behind.
     if (!options.exportDirectory.empty()) {
-        exportBuffers(options.exportDirectory, renderer, settings);
+        exportBuffers(options.exportDirectory, renderer, settings, camera);
         context->throwOnErrors("while reading the buffers back");
     }
     if (linearPicture) {

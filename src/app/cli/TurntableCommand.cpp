@@ -207,7 +207,7 @@ int runTurntable(const TurntableOptions& options) {
                 std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index);
             frame.refuseToOverwriteInputs(buffers / "camera.json", "the camera");
             createFolder(buffers, "buffers");
-            exportBuffers(buffers, renderer, settings);
+            exportBuffers(buffers, renderer, settings, camera);
         }
         bar.update((index + 1.0) / options.frames);
     }
