@@ -2,10 +2,13 @@
 
 #include <array>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
 #include <fmt/format.h>
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 #include <nlohmann/json.hpp>
 
 #include "core/Error.h"
@@ -81,6 +84,11 @@ Camera cameraFromJson(const nlohmann::json& json) {
         throw Error("the camera is not a JSON object");
     }
     Camera camera;
+    for (const char* key : {"width", "height"}) {
+        if (json.contains(key) && json.at(key).is_number_float()) {
+            throw Error(fmt::format("the camera's '{}' is not a whole number", key));
+        }
+    }
     camera.width = required<int>(json, "width");
     camera.height = required<int>(json, "height");
     camera.fovyDegrees = required<double>(json, "fovy_deg");
@@ -115,8 +123,48 @@ Camera cameraFromJson(const nlohmann::json& json) {
             camera.view[column][row] = value;
         }
     }
+    // A rigid motion: a rotation and a translation. Anything else (a scale, a shear, a
+    // projective last row) would be drawn as a distorted picture, not refused. The bounds
+    // allow a view printed with 6 digits or more.
+    constexpr double kRigid = 1e-5;
+    const glm::dmat3 rotation(camera.view);
+    const glm::dmat3 product = glm::transpose(rotation) * rotation;
+    bool rigid = glm::determinant(rotation) > 0.0;
+    for (int column = 0; column < 3; ++column) {
+        for (int row = 0; row < 3; ++row) {
+            rigid = rigid && std::abs(product[column][row] - (row == column ? 1.0 : 0.0)) <= kRigid;
+        }
+    }
+    if (!rigid || glm::dvec4(camera.view[0][3], camera.view[1][3], camera.view[2][3],
+                             camera.view[3][3]) != glm::dvec4(0.0, 0.0, 0.0, 1.0)) {
+        throw Error(
+            "the camera's 'view' is not a rigid motion (a rotation, then a translation, with the "
+            "last row 0 0 0 1)");
+    }
     camera.jitterPixels = optionalPixels(json, "jitter_pixels");
     camera.principalOffsetPixels = optionalPixels(json, "principal_offset_pixels");
+    // The projection follows from the size, fovy_deg, near, far and the offsets; one that says
+    // otherwise (another tool's, an orthographic one, an edited one) would be ignored unseen.
+    if (json.contains("projection")) {
+        const auto given = required<std::vector<std::vector<double>>>(json, "projection");
+        const glm::dmat4 derived = camera.projection();
+        bool agrees = given.size() == 4;
+        for (std::size_t row = 0; agrees && row < 4; ++row) {
+            agrees = given[row].size() == 4;
+            for (std::size_t column = 0; agrees && column < 4; ++column) {
+                const double expected = derived[static_cast<int>(column)][static_cast<int>(row)];
+                // Relative to the entry's size: a file printed with 6 significant digits
+                // agrees, any other projection does not.
+                agrees = std::abs(given[row][column] - expected) <=
+                         kRigid * std::max(1.0, std::abs(expected));
+            }
+        }
+        if (!agrees) {
+            throw Error(
+                "the camera's 'projection' is not the one its width, height, fovy_deg, near and "
+                "far give (subscan derives it from them): remove it or make it match");
+        }
+    }
     return camera;
 }
 

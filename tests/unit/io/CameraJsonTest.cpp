@@ -1,3 +1,6 @@
+#include <string>
+
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <glm/ext/matrix_transform.hpp>
@@ -99,6 +102,60 @@ TEST(CameraJsonTest, InvalidFieldsAreNamed) {
     nlohmann::json missing = valid;
     missing.erase("view");
     EXPECT_THROW(cameraFromJson(missing), Error);
+}
+
+TEST(CameraJsonTest, AViewThatIsNoRigidMotionOrAnotherProjectionIsRefused) {
+    // Both used to be drawn: a scaled view as a stretched picture, a projection that disagrees
+    // with fovy_deg (another tool's, an orthographic one) as if it were not there.
+    Camera camera;
+    camera.view = glm::lookAt(glm::dvec3(1, 2, 5), glm::dvec3(0), glm::dvec3(0, 1, 0));
+    const nlohmann::json valid = cameraToJson(camera);
+    EXPECT_NO_THROW(cameraFromJson(valid));
+    nlohmann::json withoutProjection = valid;
+    withoutProjection.erase("projection");
+    EXPECT_NO_THROW(cameraFromJson(withoutProjection));
+    // Printed with 6 significant digits, as a person or another tool might write it: accepted.
+    nlohmann::json rounded = valid;
+    for (const char* key : {"view", "projection"}) {
+        for (auto& row : rounded[key]) {
+            for (auto& value : row) {
+                value = std::stod(fmt::format("{:.6g}", value.get<double>()));
+            }
+        }
+    }
+    EXPECT_NO_THROW(cameraFromJson(rounded));
+
+    auto expectRefused = [](const nlohmann::json& json, const char* message, const char* what) {
+        try {
+            cameraFromJson(json);
+            ADD_FAILURE() << what << " accepted";
+        } catch (const Error& error) {
+            EXPECT_THAT(error.what(), HasSubstr(message)) << what;
+        }
+    };
+    nlohmann::json scaled = valid;
+    scaled["view"][0][0] = 2.0 * scaled["view"][0][0].get<double>();
+    expectRefused(scaled, "not a rigid motion", "a scaled view");
+    nlohmann::json zeroRow = valid;
+    zeroRow["view"][0] = {0, 0, 0, 0};
+    expectRefused(zeroRow, "not a rigid motion", "a zero row");
+    nlohmann::json projective = valid;
+    projective["view"][3] = {0, 0, 1, 0};
+    expectRefused(projective, "not a rigid motion", "a projective last row");
+    nlohmann::json mirrored = valid;
+    for (int column = 0; column < 4; ++column) {
+        mirrored["view"][2][column] = -mirrored["view"][2][column].get<double>();
+    }
+    expectRefused(mirrored, "not a rigid motion", "a mirrored view");
+    nlohmann::json wider = valid;
+    wider["projection"][0][0] = 5.0;
+    expectRefused(wider, "'projection' is not the one", "another projection");
+    nlohmann::json edited = valid;
+    edited["fovy_deg"] = 60.0;  // the projection left as it was
+    expectRefused(edited, "'projection' is not the one", "fovy_deg edited alone");
+    nlohmann::json fractional = valid;
+    fractional["width"] = 33.5;
+    expectRefused(fractional, "'width' is not a whole number", "a fractional width");
 }
 
 TEST(CameraJsonTest, ANumberBeyondADoubleIsNamedWithTheFile) {
