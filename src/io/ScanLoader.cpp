@@ -7,6 +7,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
 
 #include "core/Error.h"
 #include "io/E57Reader.h"
@@ -157,6 +158,15 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
             throw Error(
                 "its format is unknown: it is not PLY, LAS, LAZ, PCD, E57, OFF or a text list "
                 "of coordinates");
+    }
+    // Some exporters fill the normal fields with zeros: no direction at all, which would shade
+    // the whole surface flat. Such normals count as absent, so they are estimated as for a file
+    // without them.
+    if (!scan.cloud.normals.empty() &&
+        std::none_of(scan.cloud.normals.begin(), scan.cloud.normals.end(),
+                     [](const glm::vec3& normal) { return glm::dot(normal, normal) > 0.0f; })) {
+        scan.cloud.normals.clear();
+        context.warnings.push_back("its normals are all zero: they are ignored");
     }
     scan.formatDetail = std::move(context.formatDetail);
     scan.warnings = std::move(context.warnings);

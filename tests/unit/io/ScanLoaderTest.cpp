@@ -111,6 +111,21 @@ TEST(ScanLoaderTest, AFileThatShrinksWhileItIsReadIsOneSentenceNotASignal) {
     EXPECT_THAT(loadError(path.string()), HasSubstr("truncated"));
 }
 
+TEST(ScanLoaderTest, NormalsThatAreAllZeroCountAsAbsent) {
+    // Exporters that write zeros into the normal fields: the surface was shaded flat with them.
+    auto xyz = [](const std::string& lines) { return "x y z nx ny nz\n" + lines; };
+    const std::string zero = xyz("0 0 0 0 0 0\n1 0 0 0 0 0\n0 1 0 0 0 0\n");
+    const LoadedScan zeros = decodeScan(asBytes(zero), ScanFormat::Xyz);
+    EXPECT_FALSE(zeros.cloud.hasNormals());
+    EXPECT_THAT(zeros.warnings, ::testing::Contains(HasSubstr("normals are all zero")));
+    // One real normal among zeros: the file's are kept (the others are points without one).
+    const std::string some = xyz("0 0 0 0 0 0\n1 0 0 0 0 1\n0 1 0 0 0 0\n");
+    const LoadedScan kept = decodeScan(asBytes(some), ScanFormat::Xyz);
+    ASSERT_TRUE(kept.cloud.hasNormals());
+    EXPECT_EQ(kept.cloud.normals[1], glm::vec3(0, 0, 1));
+    EXPECT_TRUE(kept.warnings.empty());
+}
+
 TEST(ScanLoaderTest, SyntheticScenes) {
     const LoadedScan sphere = loadScan("synthetic:sphere?points=500");
     EXPECT_EQ(sphere.format, "synthetic");
