@@ -117,6 +117,56 @@ TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
         ++entries;
     }
     EXPECT_EQ(entries, 1);
+
+    // The extension in capitals is an MP4 too, not a folder of that name.
+    const auto capitals = runSubscan(
+        with(with({"turntable"}, kScene), {"-o", (dir / "SPIN.MP4").string(), "--frames", "2"}));
+    ASSERT_EQ(capitals.exitCode, 0) << capitals.err;
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "SPIN.MP4"));
+}
+
+TEST(TurntableCommandGLTest, CtrlCLeavesNoFramesBehind) {
+    if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
+        GTEST_SKIP() << "ffmpeg is not installed (scripts/setup-deps.sh installs it)";
+    }
+    // A terminal's Ctrl-C while the frames are rendered: they lay in a hidden folder beside the
+    // video, which used to stay, with every frame so far. Sent once that folder exists.
+    const test::TempDir dir;
+    const std::string command = fmt::format(
+        "SUBSCAN_GL_DEBUG=1 '{}' turntable synthetic:sphere?points=4000 --mode surface "
+        "--width 64 --height 48 --frames 100000 -o '{}' 2> '{}' & pid=$!; "
+        "for i in $(seq 600); do ls -a '{}' | grep -q frames && break; sleep 0.1; done; "
+        "kill -INT $pid; wait $pid; echo $?",
+        test::subscanExecutable(), (dir / "spin.mp4").string(), (dir / "err").string(),
+        dir.path().string());
+    const auto run = test::runProgram("/bin/sh", {"-c", command});
+    EXPECT_EQ(run.out, "1\n") << run.err;
+    std::ifstream errors(dir / "err");
+    const std::string said((std::istreambuf_iterator<char>(errors)), {});
+    EXPECT_THAT(said, HasSubstr("interrupted; no video written"));
+    std::vector<std::string> left;
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+        left.push_back(entry.path().filename().string());
+    }
+    EXPECT_EQ(left, std::vector<std::string>{"err"});
+}
+
+TEST(TurntableCommandGLTest, AFolderHoldsThisSequenceAlone) {
+    // A shorter turntable into the folder of a longer one: its frames beyond went unnoticed
+    // into whatever read the folder next (ffmpeg -i %04d.png mixed the two runs).
+    const test::TempDir dir;
+    const auto longer = runSubscan(
+        with(with({"turntable"}, kScene), {"-o", (dir / "frames").string(), "--frames", "4"}));
+    ASSERT_EQ(longer.exitCode, 0) << longer.err;
+    const std::filesystem::path other = dir.write("frames/notes.txt", "mine");
+    const auto shorter = runSubscan(
+        with(with({"turntable"}, kScene), {"-o", (dir / "frames").string(), "--frames", "2"}));
+    ASSERT_EQ(shorter.exitCode, 0) << shorter.err;
+    EXPECT_THAT(shorter.err, HasSubstr("removed 2 frames of an earlier turntable"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "frames" / "0001.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "frames" / "0002.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "frames" / "0003.png"));
+    EXPECT_EQ(test::fileBytes(other), "mine");  // nothing else is touched
 }
 
 TEST(TurntableCommandGLTest, TurnsAStreamedSurveyWithinItsBudget) {
@@ -177,6 +227,15 @@ TEST(TurntableCommandGLTest, RefusesWhatItCannotDoWithOneSentence) {
     EXPECT_EQ(noFfmpeg.exitCode, 1);
     EXPECT_THAT(noFfmpeg.err, HasSubstr("ffmpeg is not installed"));
     EXPECT_FALSE(std::filesystem::exists(dir / "spin.mp4"));
+
+    // A picture's or another video format's name: refused, not made a folder of that name.
+    for (const char* name : {"spin.gif", "spin.mov", "still.PNG"}) {
+        const auto media = runSubscan(
+            with(with({"turntable"}, kScene), {"-o", (dir / name).string(), "--frames", "2"}));
+        EXPECT_EQ(media.exitCode, 1) << name;
+        EXPECT_THAT(media.err, HasSubstr("turntable writes an MP4 video")) << name;
+        EXPECT_FALSE(std::filesystem::exists(dir / name)) << name;
+    }
 
     // Over its own input.
     const std::filesystem::path scan = dir.write("scan.xyz", "0 0 0\n1 0 0\n0 1 0\n");

@@ -1,10 +1,7 @@
-#include <signal.h>
-#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -12,6 +9,7 @@
 #include "app/ProgressBar.h"
 #include "app/cli/CommandSupport.h"
 #include "app/cli/Commands.h"
+#include "app/cli/InterruptWatcher.h"
 #include "core/Error.h"
 #include "io/PointRecordSource.h"
 #include "lod/CopcWriter.h"
@@ -32,42 +30,6 @@ struct IndexOptions {
     unsigned threads = 0;
     std::size_t memoryMegabytes = kDefaultMemoryMegabytes;
     std::string temporaryDirectory;
-};
-
-/// Ctrl-C and SIGTERM become a flag the indexer checks between its steps (it then removes its
-/// files and the partial output): the signals are blocked in every thread and a watcher thread
-/// waits for them, so no handler runs in the middle of a write.
-class InterruptWatcher {
-  public:
-    InterruptWatcher() {
-        sigemptyset(&signals_);
-        sigaddset(&signals_, SIGINT);
-        sigaddset(&signals_, SIGTERM);
-        ::pthread_sigmask(SIG_BLOCK, &signals_, &previous_);
-        watcher_ = std::jthread([this](const std::stop_token& stop) {
-            const timespec wait{0, 100'000'000};
-            while (!stop.stop_requested()) {
-                if (::sigtimedwait(&signals_, nullptr, &wait) > 0) {
-                    interrupted_ = true;
-                }
-            }
-        });
-    }
-    ~InterruptWatcher() {
-        watcher_.request_stop();
-        watcher_.join();
-        ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
-    }
-    InterruptWatcher(const InterruptWatcher&) = delete;
-    InterruptWatcher& operator=(const InterruptWatcher&) = delete;
-
-    const std::atomic<bool>& interrupted() const { return interrupted_; }
-
-  private:
-    sigset_t signals_{};
-    sigset_t previous_{};
-    std::atomic<bool> interrupted_{false};
-    std::jthread watcher_;
 };
 
 void checkOutput(const IndexOptions& options) {

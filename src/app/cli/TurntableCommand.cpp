@@ -1,3 +1,4 @@
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,8 +19,10 @@
 #include "app/cli/CommandSupport.h"
 #include "app/cli/Commands.h"
 #include "app/cli/FrameOptions.h"
+#include "app/cli/InterruptWatcher.h"
 #include "core/Error.h"
 #include "io/Image.h"
+#include "io/TextParsing.h"
 #include "lod/NodeSelection.h"
 #include "render/Renderer.h"
 
@@ -40,7 +43,40 @@ struct TurntableOptions {
 };
 
 bool writesVideo(const std::filesystem::path& output) {
-    return output.extension() == ".mp4";
+    return asciiLowercase(output.extension().string()) == ".mp4";
+}
+
+/// Refuses an output named as a picture or a video turntable cannot write: it would have become
+/// a folder of that name.
+void checkOutputName(const std::filesystem::path& output) {
+    const std::string extension = asciiLowercase(output.extension().string());
+    for (const char* media :
+         {".mov", ".gif", ".webm", ".mkv", ".avi", ".m4v", ".png", ".jpg", ".jpeg", ".apng"}) {
+        if (extension == media) {
+            throw Error(fmt::format(
+                "{}: turntable writes an MP4 video (-o NAME.mp4) or a folder of numbered PNGs, "
+                "not {} files",
+                output.string(), extension));
+        }
+    }
+}
+
+/// Removes the numbered frames (NNNN.png) beyond the first `frames` that an earlier, longer
+/// turntable left in `folder`, so the folder holds this sequence alone; returns how many.
+int removeFramesBeyond(const std::filesystem::path& folder, int frames) {
+    int removed = 0;
+    for (int index = frames;; ++index) {
+        const std::filesystem::path stale = folder / fmt::format("{:04}.png", index);
+        std::error_code error;
+        if (!std::filesystem::remove(stale, error)) {
+            if (error) {
+                throw Error(fmt::format("{}: cannot remove this frame of an earlier turntable: {}",
+                                        stale.string(), error.message()));
+            }
+            return removed;
+        }
+        ++removed;
+    }
 }
 
 /// The ffmpeg on PATH, or nullopt.
@@ -75,8 +111,18 @@ void encodeVideo(const std::filesystem::path& ffmpeg, const std::filesystem::pat
         argv.push_back(const_cast<char*>(argument.c_str()));
     }
     argv.push_back(nullptr);
+    // ffmpeg takes Ctrl-C as a terminal sends it to both, though this process blocks it
+    // (InterruptWatcher): the child starts with no signal blocked.
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    sigset_t none;
+    sigemptyset(&none);
+    posix_spawnattr_setsigmask(&attributes, &none);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK);
     pid_t child = 0;
-    if (posix_spawn(&child, argv[0], nullptr, nullptr, argv.data(), environ) != 0) {
+    const int spawned = posix_spawn(&child, argv[0], nullptr, &attributes, argv.data(), environ);
+    posix_spawnattr_destroy(&attributes);
+    if (spawned != 0) {
         throw Error(fmt::format("{}: cannot run {}", video.string(), ffmpeg.string()));
     }
     int status = 0;
@@ -120,8 +166,11 @@ class FrameFolder {
 };
 
 int runTurntable(const TurntableOptions& options) {
+    // Before any thread starts (the GL driver's), so that every thread blocks the signals.
+    const InterruptWatcher interrupts;
     const FrameOptions& frame = options.frame;
     const std::filesystem::path output = options.output;
+    checkOutputName(output);
     frame.refuseToOverwriteInputs(output, "the turntable");
     frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     const bool video = writesVideo(output);
@@ -196,7 +245,14 @@ int runTurntable(const TurntableOptions& options) {
         renderer.render(first, settings, outputs);
     }
     ProgressBar bar("turntable", options.frames > 1);
+    auto stopIfInterrupted = [&] {
+        if (interrupts.interrupted()) {
+            throw Error(fmt::format("{}: interrupted{}", output.string(),
+                                    video ? "; no video written" : ""));
+        }
+    };
     for (int index = 0; index < options.frames; ++index) {
+        stopIfInterrupted();
         const Camera camera = cameraAt(index);
         renderer.render(camera, settings, outputs);
         const Image8 picture{camera.width, camera.height, 4, renderer.readImage()};
@@ -218,15 +274,23 @@ int runTurntable(const TurntableOptions& options) {
         std::error_code error;
         try {
             encodeVideo(*ffmpeg, folder, partial, options.fps);
+            stopIfInterrupted();
             std::filesystem::rename(partial, output, error);
         } catch (const Error&) {
             std::filesystem::remove(partial, error);
+            stopIfInterrupted();
             throw;
         }
         if (error) {
             std::filesystem::remove(partial, error);
             throw Error(
                 fmt::format("{}: cannot write the video: {}", output.string(), error.message()));
+        }
+    }
+    if (!video) {
+        if (const int removed = removeFramesBeyond(folder, options.frames); removed > 0) {
+            fmt::print(stderr, "subscan: removed {} frames of an earlier turntable from {}\n",
+                       removed, folder.string());
         }
     }
     frame.saveSettings(settings);
