@@ -55,6 +55,42 @@ TEST(CliTest, ACameraFileExcludesTheOptionsItFixes) {
     }
 }
 
+TEST(CliTest, OptionsThePictureWouldIgnoreAreRefusedOrNamed) {
+    // All were accepted and ignored without a word (found by an outside test).
+    const test::TempDir dir;
+    const std::string out = (dir / "x.png").string();
+    auto render = [&](std::vector<std::string> options) {
+        std::vector<std::string> arguments{"render", "synthetic:sphere", "-o", out, "--width",
+                                           "32",     "--height",         "24"};
+        arguments.insert(arguments.end(), options.begin(), options.end());
+        return runSubscan(arguments);
+    };
+    // The sensor's view has no orbit.
+    for (const std::string option : {"--yaw", "--pitch", "--distance"}) {
+        const test::CommandResult result =
+            render({"--view", "sensor", "--sensor", "0,0,5", option, "10"});
+        EXPECT_EQ(result.exitCode, 1) << option;
+        EXPECT_THAT(result.err, HasSubstr(option + " has no effect with --view sensor")) << option;
+    }
+    const test::CommandResult sensorAlone = render({"--sensor", "0,0,5"});
+    EXPECT_EQ(sensorAlone.exitCode, 1);
+    EXPECT_THAT(sensorAlone.err, HasSubstr("add --view sensor"));
+    EXPECT_FALSE(std::filesystem::exists(out));
+    // A mode's own options in another mode: drawn, with a warning (--save-settings keeps them).
+    const test::CommandResult material = render({"--mode", "surface", "--material", "skin1"});
+    EXPECT_EQ(material.exitCode, 0) << material.err;
+    EXPECT_THAT(material.err,
+                HasSubstr("--material sets the subsurface scattering of the sss mode: it has no "
+                          "effect on the surface mode's picture"));
+    const test::CommandResult size = render({"--mode", "points", "--point-size", "4"});
+    EXPECT_EQ(size.exitCode, 0) << size.err;
+    EXPECT_THAT(size.err, HasSubstr("--point-size is the splats' size"));
+    const test::CommandResult used =
+        render({"--mode", "sss", "--material", "skin1", "--point-size", "4"});
+    EXPECT_EQ(used.exitCode, 0) << used.err;
+    EXPECT_THAT(used.err, ::testing::Not(HasSubstr("--material")));
+}
+
 TEST(CliTest, InfoJsonHasExactlyTheDocumentedKeys) {
     const test::CommandResult result = runSubscan({"info", "synthetic:sphere", "--json"});
     ASSERT_EQ(result.exitCode, 0) << result.err;

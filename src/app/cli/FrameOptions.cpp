@@ -95,7 +95,18 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
     command.add_flag("--software", software,
                      "Use Mesa's software rasterizer even when a GPU exists");
     streaming.add(command);
+    this->command = &command;
 }
+
+namespace {
+
+/// The options that only the sss mode's scattering reads.
+constexpr const char* kScatteringOptions[] = {"--scattering",     "--material",  "--unit",
+                                              "--sss-scale",      "--albedo",    "--coefficients",
+                                              "--mean-free-path", "--eta",       "--phase-g",
+                                              "--single-samples", "--light-path"};
+
+}  // namespace
 
 RenderSettings FrameOptions::settings() const {
     RenderSettings defaults;
@@ -125,7 +136,42 @@ RenderSettings FrameOptions::settings() const {
     }
     scattering.apply(settings.scattering);
     streaming.apply(settings.streaming);
+    checkIgnoredOptions(rasterSettings.mode);
     return settings;
+}
+
+void FrameOptions::checkIgnoredOptions(RenderMode effectiveMode) const {
+    auto given = [this](const char* name) {
+        return command != nullptr && command->get_option(name)->count() > 0;
+    };
+    // Each of these was accepted and then ignored without a word. The view's are refused; the
+    // mode's are only warned of, since --save-settings keeps them for the other modes.
+    if (sensorView.wanted()) {
+        for (const char* orbit : {"--yaw", "--pitch", "--distance"}) {
+            if (given(orbit)) {
+                throw Error(fmt::format(
+                    "{} has no effect with --view sensor: the view is the sensor's", orbit));
+            }
+        }
+    } else if (given("--sensor")) {
+        throw Error("--sensor places the sensor of --view sensor: add --view sensor");
+    }
+    if (given("--point-size") && effectiveMode != RenderMode::Splats) {
+        fmt::print(stderr,
+                   "subscan: warning: --point-size is the splats' size: it has no effect on the "
+                   "{} mode's picture\n",
+                   toString(effectiveMode));
+    }
+    if (effectiveMode != RenderMode::Sss) {
+        for (const char* option : kScatteringOptions) {
+            if (given(option)) {
+                fmt::print(stderr,
+                           "subscan: warning: {} sets the subsurface scattering of the sss mode: "
+                           "it has no effect on the {} mode's picture\n",
+                           option, toString(effectiveMode));
+            }
+        }
+    }
 }
 
 void FrameOptions::applyColoring(LoadedScan& scan) const {

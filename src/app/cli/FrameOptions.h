@@ -44,12 +44,15 @@ struct FrameOptions {
     bool software = false;
     StreamingOptions streaming;
     RenderMode defaultMode = RenderMode::Points;  // set by add()
+    const CLI::App* command = nullptr;            // set by add(): which options were given
 
     /// The options on `command`; `modeByDefault` is the mode where neither --mode nor the
     /// settings file names one.
     void add(CLI::App& command, RenderMode modeByDefault = RenderMode::Points);
     /// The settings file's settings (over the defaults, where the file leaves a key out) with
-    /// the given options written over them; throws subscan::Error naming a bad value.
+    /// the given options written over them; throws subscan::Error naming a bad value or an
+    /// option the view would ignore (--yaw with --view sensor, --sensor without it), and warns
+    /// of those the mode ignores (--point-size outside splats, scattering outside sss).
     RenderSettings settings() const;
     /// The camera of --camera; or with --view sensor the sensor's (SensorViewOptions); or the
     /// orbit of --yaw, --pitch, --distance, --up and --fovy around the scan's bounds, framed by
@@ -67,6 +70,9 @@ struct FrameOptions {
     void refuseToOverwriteInputs(const std::filesystem::path& output, std::string_view what) const;
     /// Writes --save-settings, if given (after the inputs are read).
     void saveSettings(const RenderSettings& settings) const;
+
+  private:
+    void checkIgnoredOptions(RenderMode effectiveMode) const;
 };
 
 }  // namespace subscan::cli
