@@ -356,12 +356,14 @@ TEST(StreamedSourceDataTest, WhatCannotBeStreamedIsOneSentence) {
     SUBSCAN_REQUIRE_TEST_DATA(data);
     EXPECT_EQ(openStreamed((data / "lone_star.laz").string(), LodMode::Auto), nullptr);
     EXPECT_EQ(openStreamed((data / "lone_star.copc.laz").string(), LodMode::Off), nullptr);
+    const test::TempDir dir;
     const test::CommandResult result =
         test::runSubscan({"render", (data / "bun_zipper_res4.ply").string(), "--lod", "on", "-o",
-                          "/nonexistent/out.png"});
+                          (dir / "out.png").string()});
     EXPECT_EQ(result.exitCode, 1);
     EXPECT_THAT(result.err, HasSubstr("is neither a COPC file nor an EPT dataset"));
     EXPECT_EQ(test::lineCount(result.err), 1u) << result.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out.png"));
     EXPECT_THROW(parseLodMode("sometimes"), Error);
     EXPECT_EQ(test::errorMessage(
                   [&] { openStreamed((data / "no-such-survey.copc.laz").string(), LodMode::On); }),

@@ -727,6 +727,19 @@ TEST(RenderCommandGLTest, OutputsAreWrittenOnlyAfterTheWorkAndNeverOverAnInput) 
     EXPECT_EQ(test::fileBytes(camera), cameraText);
     EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
 
+    // A picture or settings file into a folder that does not exist: said before any output is
+    // written (the buffers were written, then the picture failed).
+    for (const auto& [picture, saved] : {std::pair{dir / "missing" / "x.png", dir / "s.json"},
+                                         std::pair{dir / "x.png", dir / "missing" / "s.json"}}) {
+        const auto missing =
+            runSubscan({"render", scan.string(), "-o", picture.string(), "--export-buffers",
+                        (dir / "early").string(), "--save-settings", saved.string()});
+        EXPECT_EQ(missing.exitCode, 1);
+        EXPECT_THAT(missing.err, HasSubstr("missing does not exist"));
+        EXPECT_FALSE(std::filesystem::exists(dir / "early"));
+        EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+    }
+
     // A .jpg output is a JPEG.
     const auto jpeg = runSubscan({"render", scan.string(), "-o", (dir / "view.jpg").string()});
     ASSERT_EQ(jpeg.exitCode, 0) << jpeg.err;

@@ -31,6 +31,15 @@ CLI::Validator finiteNumber() {
         "FINITE");
 }
 
+void requireOutputFolder(const std::filesystem::path& output) {
+    const std::filesystem::path folder = output.parent_path();
+    std::error_code error;
+    if (!output.empty() && !folder.empty() && !std::filesystem::is_directory(folder, error)) {
+        throw Error(
+            fmt::format("{}: its folder {} does not exist", output.string(), folder.string()));
+    }
+}
+
 LoadedScan loadScanForCommand(std::string_view source) {
     constexpr std::uintmax_t kProgressBarBytes = 50u << 20;
     std::error_code ignored;

@@ -30,6 +30,10 @@ inline constexpr const char* kUpAxisHelp =
 /// empty picture and exit 0.
 CLI::Validator finiteNumber();
 
+/// Throws subscan::Error when the folder `output` (a file to write) would go into does not
+/// exist: said before the work, not after it, with other outputs already written.
+void requireOutputFolder(const std::filesystem::path& output);
+
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".
 LoadedScan loadScanForCommand(std::string_view source);

@@ -104,6 +104,8 @@ int runRender(const RenderOptions& options) {
     frame.refuseToOverwriteInputs(output, "the image");
     const bool linearPicture = holdsLinearRadiance(pictureFormat(output));
     frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
+    requireOutputFolder(output);
+    requireOutputFolder(frame.saveSettingsFile);
     if (!options.exportDirectory.empty()) {
         frame.refuseToOverwriteInputs(
             std::filesystem::path(options.exportDirectory) / "camera.json", "the camera");

@@ -174,6 +174,10 @@ int runTurntable(const TurntableOptions& options) {
     frame.refuseToOverwriteInputs(output, "the turntable");
     frame.refuseToOverwriteInputs(frame.saveSettingsFile, "the settings");
     const bool video = writesVideo(output);
+    if (video) {
+        requireOutputFolder(output);
+    }
+    requireOutputFolder(frame.saveSettingsFile);
     // Nor over an input that lies in the frames' folder under a frame's name.
     for (int index = 0; !video && index < options.frames; ++index) {
         frame.refuseToOverwriteInputs(output / fmt::format("{:04}.png", index), "a frame");
