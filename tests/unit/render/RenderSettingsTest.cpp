@@ -291,6 +291,16 @@ TEST(RenderSettingsTest, AnUnknownKeyInAnySectionIsNamed) {
         ::testing::HasSubstr("unknown setting 'color' in 'lights'"));
     EXPECT_THAT(settingsError(R"({"scattering": []})"),
                 ::testing::HasSubstr("the settings section 'scattering' must be a JSON object"));
+    // A key given twice: the last used to win without a word.
+    EXPECT_THAT(settingsError(R"({"raster": {"mode": "surface", "mode": "points"}})"),
+                ::testing::HasSubstr("the key 'mode' appears twice in one object"));
+    EXPECT_THAT(settingsError(R"({"raster": {}, "raster": {"mode": "points"}})"),
+                ::testing::HasSubstr("the key 'raster' appears twice"));
+    // The same key in two objects is no repetition.
+    const test::TempDir dir;
+    EXPECT_NO_THROW(readSettingsFile(dir.write(
+        "two.json",
+        R"({"shading": {"lights": [{"direction": [0, 1, 0]}, {"direction": [1, 0, 0]}]}})")));
 }
 
 TEST(RenderSettingsTest, ImpossibleScatteringValuesAreNamed) {
