@@ -88,10 +88,33 @@ struct PlyVertexLayout {
     std::optional<std::size_t> alpha;
     std::optional<std::array<std::size_t, 3>> normal;
     std::optional<std::size_t> intensity;
+
+    /// The colour properties read: red, green and blue, then alpha if there is one.
+    std::vector<std::size_t> colorChannels() const {
+        std::vector<std::size_t> channels;
+        if (color) {
+            channels.assign(color->begin(), color->end());
+            if (alpha) {
+                channels.push_back(*alpha);
+            }
+        }
+        return channels;
+    }
 };
 
 /// x, y and z (required, else subscan::Error), red/green/blue[/alpha] or diffuse_*, nx/ny/nz,
 /// intensity or scalar_intensity; a list where a value belongs is an error.
 PlyVertexLayout findPlyVertexLayout(const PlyElement& vertex);
+
+/// How a colour property's values map to 0..255: as they are, from 0..65535 or from 0..1.
+enum class PlyColorScale { Byte, Word, Unit };
+
+/// Writers store colour in wider types than its values need: PDAL writes LAS colour (often
+/// 8-bit values) as ushort, and some write float colour as 0..255. So, as the LAS, PCD and text
+/// readers judge, 16-bit channels are 0..255 and float ones 0..1 unless some colour value of the
+/// whole file is larger: above 255 in a 16-bit channel, above 1 in a float one.
+bool isLargePlyColorValue(PlyType type, double value);
+/// `largeValues`: whether isLargePlyColorValue held for any colour value of the file.
+PlyColorScale plyColorScale(PlyType type, bool largeValues);
 
 }  // namespace subscan

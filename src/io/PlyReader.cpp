@@ -273,14 +273,30 @@ PlyVertexLayout findPlyVertexLayout(const PlyElement& vertex) {
     return layout;
 }
 
+bool isLargePlyColorValue(PlyType type, double value) {
+    if (type == PlyType::UInt16 || type == PlyType::Int16) {
+        return value > 255.0;
+    }
+    return !isPlyInteger(type) && value > 1.0;
+}
+
+PlyColorScale plyColorScale(PlyType type, bool largeValues) {
+    if (type == PlyType::UInt16 || type == PlyType::Int16) {
+        return largeValues ? PlyColorScale::Word : PlyColorScale::Byte;
+    }
+    if (!isPlyInteger(type)) {
+        return largeValues ? PlyColorScale::Byte : PlyColorScale::Unit;
+    }
+    return PlyColorScale::Byte;
+}
+
 namespace {
 
-/// Colour channels: 8-bit as is, 16-bit scaled down, floats taken as 0..1.
-std::uint8_t toColorChannel(double value, PlyType type) {
+std::uint8_t toColorChannel(double value, PlyColorScale scale) {
     double scaled = value;
-    if (type == PlyType::UInt16 || type == PlyType::Int16) {
-        scaled = value / 257.0;
-    } else if (!isPlyInteger(type)) {
+    if (scale == PlyColorScale::Word) {
+        scaled = value / 257.0;  // 65535 -> 255
+    } else if (scale == PlyColorScale::Unit) {
         scaled = value * 255.0;
     }
     if (!(scaled > 0.0)) {
@@ -501,18 +517,29 @@ PointCloud PlyBodyReader::read() {
     PointCloudBuilder builder(attributes, expected, face != nullptr);
 
     const auto colorType = [&](std::size_t index) { return vertex->properties[index].type; };
+    const std::vector<std::size_t> colorChannels = layout.colorChannels();
+    // Until the last vertex says whether 16-bit and float channels hold large values, each
+    // vertex's colour is kept read both ways: 4 bytes a point, and only for such channels.
+    const bool colorScaleOpen =
+        std::any_of(colorChannels.begin(), colorChannels.end(), [&](std::size_t p) {
+            return plyColorScale(colorType(p), false) != plyColorScale(colorType(p), true);
+        });
+    bool largeColorValues = false;
+    std::vector<Rgba8> largeValueColors;
+    const auto colorOf = [&](auto&& value, bool largeValues) {
+        const auto channel = [&](std::size_t p) {
+            return toColorChannel(value(p), plyColorScale(colorType(p), largeValues));
+        };
+        const auto& c = *layout.color;
+        return Rgba8{channel(c[0]), channel(c[1]), channel(c[2]),
+                     layout.alpha ? channel(*layout.alpha) : std::uint8_t{255}};
+    };
     auto makeRecord = [&](auto&& value) {
         PointRecord record;
         record.position = {value(layout.position[0]), value(layout.position[1]),
                            value(layout.position[2])};
         if (layout.color) {
-            const auto& c = *layout.color;
-            record.color = {toColorChannel(value(c[0]), colorType(c[0])),
-                            toColorChannel(value(c[1]), colorType(c[1])),
-                            toColorChannel(value(c[2]), colorType(c[2])),
-                            layout.alpha
-                                ? toColorChannel(value(*layout.alpha), colorType(*layout.alpha))
-                                : std::uint8_t{255}};
+            record.color = colorOf(value, false);
         }
         if (layout.normal) {
             const auto& n = *layout.normal;
@@ -523,6 +550,19 @@ PointCloud PlyBodyReader::read() {
             record.intensity = saturateToFloat(value(*layout.intensity));
         }
         return record;
+    };
+    const auto addVertex = [&](auto&& value) {
+        const std::size_t kept = builder.validPoints();
+        builder.add(makeRecord(value));
+        if (!colorScaleOpen) {
+            return;
+        }
+        for (const std::size_t p : colorChannels) {
+            largeColorValues = largeColorValues || isLargePlyColorValue(colorType(p), value(p));
+        }
+        if (builder.validPoints() > kept) {
+            largeValueColors.push_back(colorOf(value, true));
+        }
     };
     constexpr std::uint64_t kProgressEvery = 1 << 16;
 
@@ -542,9 +582,9 @@ PointCloud PlyBodyReader::read() {
                 }
                 for (std::uint64_t i = 0; i < vertex->count; ++i) {
                     const std::byte* record = file_.data() + position_;
-                    builder.add(makeRecord([&](std::size_t p) {
+                    addVertex([&](std::size_t p) {
                         return loadBinary(vertex->properties[p].type, record + offsets[p]);
-                    }));
+                    });
                     position_ += *stride;
                     if (i % kProgressEvery == 0) {
                         context_.reportProgress(position_, file_.size());
@@ -555,13 +595,7 @@ PointCloud PlyBodyReader::read() {
                 values.scalar.resize(vertex->properties.size());
                 // Text can say what binary cannot: an integer colour channel's 300 or 1.7 was
                 // clamped or rounded silently. Properties that are not read are not judged.
-                std::vector<std::size_t> integerChannels;
-                if (layout.color) {
-                    integerChannels.assign(layout.color->begin(), layout.color->end());
-                }
-                if (layout.alpha) {
-                    integerChannels.push_back(*layout.alpha);
-                }
+                std::vector<std::size_t> integerChannels = colorChannels;
                 std::erase_if(integerChannels,
                               [&](std::size_t p) { return !isPlyInteger(colorType(p)); });
                 for (std::uint64_t i = 0; i < vertex->count; ++i) {
@@ -574,7 +608,7 @@ PointCloud PlyBodyReader::read() {
                                 i + 1, vertex->properties[p].name, values.scalar[p]));
                         }
                     }
-                    builder.add(makeRecord([&](std::size_t p) { return values.scalar[p]; }));
+                    addVertex([&](std::size_t p) { return values.scalar[p]; });
                     if (i % kProgressEvery == 0) {
                         context_.reportProgress(position_, file_.size());
                     }
@@ -615,7 +649,11 @@ PointCloud PlyBodyReader::read() {
         }
     }
     context_.reportProgress(file_.size(), file_.size());
-    return builder.finish(context_.warnings);
+    PointCloud cloud = builder.finish(context_.warnings);
+    if (largeColorValues) {
+        cloud.colors = std::move(largeValueColors);
+    }
+    return cloud;
 }
 
 }  // namespace

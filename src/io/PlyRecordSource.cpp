@@ -15,7 +15,8 @@
 #include "io/RecordSourceSupport.h"
 
 // Binary PLY vertices as records, read in pieces: a first pass finds the bounds (a PLY header
-// has none), which choose the quantization; each read then converts the next vertices.
+// has none), which choose the quantization, and the colour's scale; each read then converts
+// the next vertices.
 namespace subscan {
 
 namespace {
@@ -27,24 +28,13 @@ constexpr std::size_t kLargestHeaderBytes = 16u << 20;
 /// Vertices read from the file at once (a few MiB for wide vertices).
 constexpr std::size_t kVerticesPerBlock = 1 << 16;
 
-enum class ColorScale { Byte, Word, Unit };
-
-/// How the whole-file PLY reader reads colour: 16-bit types as 16-bit, floats as 0..1, any
-/// other type as 8-bit values.
-ColorScale colorScale(PlyType type) {
-    if (type == PlyType::UInt16 || type == PlyType::Int16) {
-        return ColorScale::Word;
-    }
-    return isPlyInteger(type) ? ColorScale::Byte : ColorScale::Unit;
-}
-
-std::uint16_t colorWord(double value, ColorScale scale) {
+std::uint16_t colorWord(double value, PlyColorScale scale) {
     switch (scale) {
-        case ColorScale::Byte:
+        case PlyColorScale::Byte:
             return colorWordFromByte(value);
-        case ColorScale::Word:
+        case PlyColorScale::Word:
             return colorWordFromWord(value);
-        case ColorScale::Unit:
+        case PlyColorScale::Unit:
             return colorWordFromUnit(value);
     }
     return 0;
@@ -90,12 +80,16 @@ class PlyRecordSource final : public PointRecordSource {
             access_.types.push_back(property.type);
             offset += plySizeOf(property.type);
         }
+        // The first pass, over every vertex, also tells how to read the colour, as the
+        // whole-file reader decides it.
+        bool largeColorValues = false;
+        const Bounds bounds = findBounds(vertex, largeColorValues);
         if (layout_.color) {
             for (int k = 0; k < 3; ++k) {
-                colorScales_[k] = colorScale(vertex.properties[(*layout_.color)[k]].type);
+                colorScales_[k] =
+                    plyColorScale(access_.types[(*layout_.color)[k]], largeColorValues);
             }
         }
-        const Bounds bounds = findBounds(vertex);
         writer_.emplace(layout_.color.has_value(), layout_.normal.has_value(), bounds);
         info_ = convertedSourceInfo(std::move(name), vertexCount_, *writer_, bounds);
         for (const PlyElement& element : header.elements) {
@@ -144,7 +138,9 @@ class PlyRecordSource final : public PointRecordSource {
                 access_.value(vertex, layout_.position[2])};
     }
 
-    Bounds findBounds(const PlyElement& vertex) {
+    /// Also sets `largeColorValues` when a colour value is large (isLargePlyColorValue).
+    Bounds findBounds(const PlyElement& vertex, bool& largeColorValues) {
+        const std::vector<std::size_t> colorChannels = layout_.colorChannels();
         Bounds bounds;
         forEachVertex(0, static_cast<std::size_t>(vertexCount_),
                       [&](const std::byte* data, std::uint64_t index) {
@@ -159,6 +155,11 @@ class PlyRecordSource final : public PointRecordSource {
                               }
                           }
                           bounds.add(p);
+                          for (const std::size_t c : colorChannels) {
+                              largeColorValues =
+                                  largeColorValues ||
+                                  isLargePlyColorValue(access_.types[c], access_.value(data, c));
+                          }
                       });
         return bounds;
     }
@@ -190,7 +191,7 @@ class PlyRecordSource final : public PointRecordSource {
     std::size_t stride_;
     PlyVertexLayout layout_;
     VertexAccess access_;
-    std::array<ColorScale, 3> colorScales_{};
+    std::array<PlyColorScale, 3> colorScales_{};
     std::optional<ConvertedRecordWriter> writer_;
     PointRecordSourceInfo info_;
     std::uint64_t nextVertex_ = 0;

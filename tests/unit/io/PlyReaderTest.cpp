@@ -1,5 +1,10 @@
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -95,6 +100,69 @@ TEST(PlyReaderTest, FloatAndDiffuseColours) {
         "property float diffuse_blue\nend_header\n0 0 0 1.0 0.5 0\n";
     const PointCloud cloud = decode(file, "f.ply").cloud;
     EXPECT_EQ(cloud.colors[0], (Rgba8{255, 128, 0, 255}));
+}
+
+/// A binary PLY of one vertex per colour, with colour channels of `type`.
+template <class Channel>
+std::string colorPly(const char* type, const std::vector<std::array<Channel, 3>>& colors) {
+    std::string file = binaryHeader(
+        "binary_little_endian",
+        fmt::format("element vertex {}\nproperty float x\nproperty float y\nproperty float z\n"
+                    "property {} red\nproperty {} green\nproperty {} blue\n",
+                    colors.size(), type, type, type));
+    for (std::size_t i = 0; i < colors.size(); ++i) {
+        // The second vertex is dropped (NaN), so the colours kept must skip its colour.
+        appendBytes(file, i == 1 ? NAN : static_cast<float>(i));
+        appendBytes(file, 0.0f);
+        appendBytes(file, 0.0f);
+        for (const Channel c : colors[i]) {
+            appendBytes(file, c);
+        }
+    }
+    return file;
+}
+
+TEST(PlyReaderTest, SixteenBitColourIsEightBitUnlessAValueOfTheFileIsLarger) {
+    // PDAL writes LAS colour as ushort: 8-bit values there were divided by 257 (black).
+    using Word = std::array<std::uint16_t, 3>;
+    const PointCloud bytes =
+        decode(colorPly<std::uint16_t>("ushort",
+                                       {Word{248, 149, 136}, Word{1, 2, 3}, Word{0, 255, 100}}),
+               "bytes.ply")
+            .cloud;
+    ASSERT_EQ(bytes.size(), 2u);
+    EXPECT_EQ(bytes.colors[0], (Rgba8{248, 149, 136, 255}));
+    EXPECT_EQ(bytes.colors[1], (Rgba8{0, 255, 100, 255}));
+    // One value above 255, in the last vertex, makes every vertex 16-bit.
+    const PointCloud words =
+        decode(colorPly<std::uint16_t>("uint16",
+                                       {Word{514, 257, 0}, Word{1, 2, 3}, Word{0, 255, 65535}}),
+               "words.ply")
+            .cloud;
+    ASSERT_EQ(words.size(), 2u);
+    EXPECT_EQ(words.colors[0], (Rgba8{2, 1, 0, 255}));
+    EXPECT_EQ(words.colors[1], (Rgba8{0, 1, 255, 255}));
+}
+
+TEST(PlyReaderTest, FloatColourIsZeroToOneUnlessAValueOfTheFileIsLarger) {
+    using Floats = std::array<float, 3>;
+    // (255, 128, 0) was clamped to (255, 255, 0).
+    const PointCloud bytes =
+        decode(colorPly<float>("float", {Floats{1.0f, 0.5f, 0.0f}, Floats{9.0f, 9.0f, 9.0f},
+                                         Floats{255.0f, 128.0f, 0.0f}}),
+               "bytes.ply")
+            .cloud;
+    ASSERT_EQ(bytes.size(), 2u);
+    EXPECT_EQ(bytes.colors[0], (Rgba8{1, 1, 0, 255}));  // 0.5 rounds half up
+    EXPECT_EQ(bytes.colors[1], (Rgba8{255, 128, 0, 255}));
+    const PointCloud units =
+        decode(colorPly<float>("float32", {Floats{1.0f, 0.5f, 0.0f}, Floats{0.0f, 0.0f, 0.0f},
+                                           Floats{0.25f, 1.0f, 0.0f}}),
+               "units.ply")
+            .cloud;
+    ASSERT_EQ(units.size(), 2u);
+    EXPECT_EQ(units.colors[0], (Rgba8{255, 128, 0, 255}));
+    EXPECT_EQ(units.colors[1], (Rgba8{64, 255, 0, 255}));
 }
 
 TEST(PlyReaderTest, FacesAreFannedIntoTriangles) {

@@ -596,6 +596,60 @@ TEST(PointRecordSourceTest, AsciiPlyIsLoadedWholeWithTheSameRecords) {
     }
 }
 
+/// A binary PLY of float x y z and colour channels of `type`, one vertex per colour.
+template <class Channel>
+std::string binaryColorPly(const char* type, const std::vector<std::array<Channel, 3>>& colors) {
+    std::string out = fmt::format(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\n"
+        "property float y\nproperty float z\nproperty {} red\nproperty {} green\n"
+        "property {} blue\nend_header\n",
+        colors.size(), type, type, type);
+    for (std::size_t i = 0; i < colors.size(); ++i) {
+        for (const float coordinate : {static_cast<float>(i), 0.0f, 0.0f}) {
+            appendBytes(out, coordinate);
+        }
+        for (const Channel c : colors[i]) {
+            appendBytes(out, c);
+        }
+    }
+    return out;
+}
+
+/// The LAS colour words of every record of `source`.
+std::vector<std::array<std::uint16_t, 3>> recordColors(PointRecordSource& source) {
+    const std::vector<std::byte> records = readAllRecords(source, 2);
+    std::vector<std::array<std::uint16_t, 3>> colors;
+    for (std::size_t i = 0; i < source.info().pointCount; ++i) {
+        colors.push_back(recordFields(records, source.info().format, i).rgb);
+    }
+    return colors;
+}
+
+TEST(PointRecordSourceTest, PlyColourScaleIsJudgedFromEveryVertexAsTheReaderDoes) {
+    using Words = std::vector<std::array<std::uint16_t, 3>>;
+    using Floats = std::vector<std::array<float, 3>>;
+    const test::TempDir dir;
+    // 8-bit values in ushort (PDAL's LAS colour) were divided by 257: near black.
+    EXPECT_EQ(recordColors(*open(dir.write(
+                  "bytes.ply",
+                  binaryColorPly<std::uint16_t>("ushort", Words{{248, 149, 136}, {0, 255, 100}})))),
+              (Words{{248 * 257, 149 * 257, 136 * 257}, {0, 255 * 257, 100 * 257}}));
+    // A value above 255 in the last vertex makes the file's colour 16-bit, from the first on.
+    EXPECT_EQ(recordColors(*open(
+                  dir.write("words.ply", binaryColorPly<std::uint16_t>(
+                                             "ushort", Words{{248, 149, 136}, {0, 255, 1000}})))),
+              (Words{{248, 149, 136}, {0, 255, 1000}}));
+    // Float colour 0..255 was taken as 0..1 and clamped.
+    EXPECT_EQ(recordColors(*open(dir.write(
+                  "floats.ply",
+                  binaryColorPly<float>("float", Floats{{255.0f, 128.0f, 0.0f}, {1, 1, 1}})))),
+              (Words{{255 * 257, 128 * 257, 0}, {257, 257, 257}}));
+    EXPECT_EQ(
+        recordColors(*open(dir.write(
+            "units.ply", binaryColorPly<float>("float", Floats{{1.0f, 0.5f, 0.0f}, {0, 0, 1}})))),
+        (Words{{65535, 32768, 0}, {0, 0, 65535}}));
+}
+
 TEST(PointRecordSourceTest, BadPlyFilesAreOneSentenceNamingTheFileAndField) {
     const test::TempDir dir;
     auto vertices = plyVertices(5);
