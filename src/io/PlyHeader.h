@@ -46,6 +46,7 @@ struct PlyHeader {
     std::string version;
     std::vector<PlyElement> elements;
     std::size_t bodyOffset = 0;
+    std::size_t headerLines = 0;  // up to and including end_header, to number the body's lines
 };
 
 std::size_t plySizeOf(PlyType type);

@@ -227,6 +227,7 @@ PlyHeader parsePlyHeader(std::string_view file) {
         throw Error("the PLY header has no 'format' line");
     }
     header.bodyOffset = position;
+    header.headerLines = static_cast<std::size_t>(lineNumber);
     return header;
 }
 
@@ -317,10 +318,12 @@ std::optional<std::size_t> findFaceList(const PlyElement& face) {
 }
 
 /// Decodes the body: binary (either byte order) and ascii share everything but value access.
+/// An ascii item is one line (blank lines aside), so a line with the wrong number of values is
+/// an error rather than a shift of every value after it.
 class PlyBodyReader {
   public:
     PlyBodyReader(const PlyHeader& header, std::span<const std::byte> file, ReadContext& context)
-        : header_(header), file_(file), context_(context) {}
+        : header_(header), file_(file), context_(context), lineNumber_(header.headerLines) {}
 
     PointCloud read();
 
@@ -335,14 +338,30 @@ class PlyBodyReader {
     double loadBinary(PlyType type, const std::byte* p) const;
     void readItem(const PlyElement& element, std::uint64_t itemIndex,
                   std::optional<std::size_t> faceList, ItemValues& values);
+    void readBinaryItem(const PlyElement& element, std::uint64_t itemIndex,
+                        std::optional<std::size_t> faceList, ItemValues& values);
+    void readAsciiItem(const PlyElement& element, std::uint64_t itemIndex,
+                       std::optional<std::size_t> faceList, ItemValues& values);
     void skipElement(const PlyElement& element);
     [[noreturn]] void failTruncated(const PlyElement& element, std::uint64_t itemIndex) const;
-    double nextAsciiNumber(const PlyElement& element, std::uint64_t itemIndex);
+    std::uint64_t listLength(double countValue, const PlyElement& element,
+                             std::uint64_t itemIndex) const;
+    bool nextAsciiLine();
+    std::optional<double> nextAsciiValue(const PlyElement& element, std::uint64_t itemIndex);
+    [[noreturn]] void failAsciiLine(const PlyElement& element, std::uint64_t itemIndex) const;
+    void warnAboutAsciiLinesLeft();
 
     const PlyHeader& header_;
     std::span<const std::byte> file_;
     ReadContext& context_;
     std::size_t position_ = 0;
+    // Ascii only: the line read last (its bytes, number, and whether a line end ends it), and
+    // the next value's place on it.
+    std::size_t lineStart_ = 0;
+    std::size_t lineEnd_ = 0;
+    std::size_t lineNumber_;
+    bool lineEnded_ = false;
+    std::size_t cursor_ = 0;
 };
 
 double PlyBodyReader::loadBinary(PlyType type, const std::byte* p) const {
@@ -356,28 +375,92 @@ void PlyBodyReader::failTruncated(const PlyElement& element, std::uint64_t itemI
                     element.name, itemIndex + 1, element.count));
 }
 
-double PlyBodyReader::nextAsciiNumber(const PlyElement& element, std::uint64_t itemIndex) {
+std::uint64_t PlyBodyReader::listLength(double countValue, const PlyElement& element,
+                                        std::uint64_t itemIndex) const {
+    // Lists longer than 2^32 entries cannot be real, and the bound keeps the cast defined.
+    if (!(countValue >= 0.0 && countValue <= 4294967295.0 &&
+          countValue == std::floor(countValue))) {
+        throw Error(fmt::format("the PLY body has the invalid list length {} in {} {}{}",
+                                countValue, element.name, itemIndex + 1,
+                                binary() ? "" : fmt::format(" (line {})", lineNumber_)));
+    }
+    return static_cast<std::uint64_t>(countValue);
+}
+
+/// Moves to the next line that holds a value; false at the body's end.
+bool PlyBodyReader::nextAsciiLine() {
+    const std::string_view text(reinterpret_cast<const char*>(file_.data()), file_.size());
+    while (position_ < text.size()) {
+        lineStart_ = position_;
+        lineEnd_ = std::min(text.find('\n', position_), text.size());
+        lineEnded_ = lineEnd_ < text.size();
+        position_ = std::min(lineEnd_ + 1, text.size());
+        ++lineNumber_;
+        cursor_ = lineStart_;
+        while (cursor_ < lineEnd_ && isWhitespace(text[cursor_])) {
+            ++cursor_;
+        }
+        if (cursor_ < lineEnd_) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/// The current line's next value, or nullopt at its end.
+std::optional<double> PlyBodyReader::nextAsciiValue(const PlyElement& element,
+                                                    std::uint64_t itemIndex) {
+    if (cursor_ == lineEnd_) {
+        return std::nullopt;
+    }
     const char* text = reinterpret_cast<const char*>(file_.data());
-    const std::size_t size = file_.size();
-    while (position_ < size && isWhitespace(text[position_])) {
-        ++position_;
-    }
-    if (position_ >= size) {
-        failTruncated(element, itemIndex);
-    }
     double value = 0.0;
-    const char* end = parseNumber(text + position_, text + size, value);
-    if (end == nullptr || (end < text + size && !isWhitespace(*end))) {
-        std::size_t tokenEnd = position_;
-        while (tokenEnd < size && !isWhitespace(text[tokenEnd])) {
+    const char* end = parseNumber(text + cursor_, text + lineEnd_, value);
+    if (end == nullptr || (end < text + lineEnd_ && !isWhitespace(*end))) {
+        std::size_t tokenEnd = cursor_;
+        while (tokenEnd < lineEnd_ && !isWhitespace(text[tokenEnd])) {
             ++tokenEnd;
         }
-        throw Error(fmt::format("the PLY body has the non-numeric value {} in {} {}",
-                                quoteForMessage({text + position_, tokenEnd - position_}),
-                                element.name, itemIndex + 1));
+        throw Error(fmt::format("the PLY body has the non-numeric value {} in {} {} (line {})",
+                                quoteForMessage({text + cursor_, tokenEnd - cursor_}), element.name,
+                                itemIndex + 1, lineNumber_));
     }
-    position_ = static_cast<std::size_t>(end - text);
+    cursor_ = static_cast<std::size_t>(end - text);
+    while (cursor_ < lineEnd_ && isWhitespace(text[cursor_])) {
+        ++cursor_;
+    }
     return value;
+}
+
+/// The current line holds more or fewer values than its item needs: says how many it needs.
+void PlyBodyReader::failAsciiLine(const PlyElement& element, std::uint64_t itemIndex) const {
+    const std::string_view text(reinterpret_cast<const char*>(file_.data()), file_.size());
+    const std::vector<std::string_view> words =
+        splitWords(text.substr(lineStart_, lineEnd_ - lineStart_));
+    // One value per scalar; a list's count, then that many. The line was read up to where it
+    // fell short or went on, so the counts on it are valid list lengths.
+    std::size_t needed = 0;
+    bool countsKnown = true;
+    for (const PlyProperty& property : element.properties) {
+        ++needed;
+        if (!property.isList) {
+            continue;
+        }
+        if (needed > words.size()) {
+            countsKnown = false;  // a list has its count at least
+            continue;
+        }
+        const std::string_view countWord = words[needed - 1];
+        double count = 0.0;
+        parseNumber(countWord.data(), countWord.data() + countWord.size(), count);
+        needed += static_cast<std::size_t>(count);
+    }
+    if (needed > words.size() && !lineEnded_) {
+        failTruncated(element, itemIndex);  // the file ends inside this line
+    }
+    throw Error(fmt::format(
+        "PLY line {} has {} values, but the header's properties of {} {} need {}{}", lineNumber_,
+        words.size(), element.name, itemIndex + 1, countsKnown ? "" : "at least ", needed));
 }
 
 /// Reads one item: scalars into values.scalar, the face list (if asked) into values.faceIndices;
@@ -385,67 +468,95 @@ double PlyBodyReader::nextAsciiNumber(const PlyElement& element, std::uint64_t i
 void PlyBodyReader::readItem(const PlyElement& element, std::uint64_t itemIndex,
                              std::optional<std::size_t> faceList, ItemValues& values) {
     values.faceIndices.clear();
+    if (binary()) {
+        readBinaryItem(element, itemIndex, faceList, values);
+    } else {
+        readAsciiItem(element, itemIndex, faceList, values);
+    }
+}
+
+void PlyBodyReader::readBinaryItem(const PlyElement& element, std::uint64_t itemIndex,
+                                   std::optional<std::size_t> faceList, ItemValues& values) {
+    const auto load = [&](PlyType type) {
+        const std::size_t size = plySizeOf(type);
+        if (file_.size() - position_ < size) {
+            failTruncated(element, itemIndex);
+        }
+        const double value = loadBinary(type, file_.data() + position_);
+        position_ += size;
+        return value;
+    };
     for (std::size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& property = element.properties[p];
         if (!property.isList) {
-            if (binary()) {
-                const std::size_t size = plySizeOf(property.type);
-                if (file_.size() - position_ < size) {
-                    failTruncated(element, itemIndex);
-                }
-                values.scalar[p] = loadBinary(property.type, file_.data() + position_);
-                position_ += size;
-            } else {
-                values.scalar[p] = nextAsciiNumber(element, itemIndex);
-            }
+            values.scalar[p] = load(property.type);
             continue;
         }
-        double countValue = 0.0;
-        if (binary()) {
-            const std::size_t size = plySizeOf(property.countType);
-            if (file_.size() - position_ < size) {
-                failTruncated(element, itemIndex);
-            }
-            countValue = loadBinary(property.countType, file_.data() + position_);
-            position_ += size;
-        } else {
-            countValue = nextAsciiNumber(element, itemIndex);
+        const std::uint64_t count = listLength(load(property.countType), element, itemIndex);
+        const std::size_t itemSize = plySizeOf(property.type);
+        if (count > (file_.size() - position_) / itemSize) {
+            failTruncated(element, itemIndex);
         }
-        // Lists longer than 2^32 entries cannot be real, and the bound keeps the cast defined.
-        if (!(countValue >= 0.0 && countValue <= 4294967295.0 &&
-              countValue == std::floor(countValue))) {
-            throw Error(fmt::format("the PLY body has the invalid list length {} in {} {}",
-                                    countValue, element.name, itemIndex + 1));
-        }
-        const auto count = static_cast<std::uint64_t>(countValue);
-        const bool keep = faceList && *faceList == p;
-        if (binary()) {
-            const std::size_t itemSize = plySizeOf(property.type);
-            if (count > (file_.size() - position_) / itemSize) {
-                failTruncated(element, itemIndex);
-            }
-            if (keep) {
-                for (std::uint64_t i = 0; i < count; ++i) {
-                    const double index = loadBinary(property.type, file_.data() + position_);
-                    values.faceIndices.push_back(index >= 0.0 && index < 4294967295.0
-                                                     ? static_cast<std::uint32_t>(index)
-                                                     : kInvalidIndex);
-                    position_ += itemSize;
-                }
-            } else {
-                position_ += static_cast<std::size_t>(count) * itemSize;
-            }
-        } else {
+        if (faceList && *faceList == p) {
             for (std::uint64_t i = 0; i < count; ++i) {
-                const double index = nextAsciiNumber(element, itemIndex);
-                if (keep) {
-                    values.faceIndices.push_back(index >= 0.0 && index < 4294967295.0 &&
-                                                         index == std::floor(index)
-                                                     ? static_cast<std::uint32_t>(index)
-                                                     : kInvalidIndex);
-                }
+                const double index = load(property.type);
+                values.faceIndices.push_back(index >= 0.0 && index < 4294967295.0
+                                                 ? static_cast<std::uint32_t>(index)
+                                                 : kInvalidIndex);
+            }
+        } else {
+            position_ += static_cast<std::size_t>(count) * itemSize;
+        }
+    }
+}
+
+void PlyBodyReader::readAsciiItem(const PlyElement& element, std::uint64_t itemIndex,
+                                  std::optional<std::size_t> faceList, ItemValues& values) {
+    if (!nextAsciiLine()) {
+        failTruncated(element, itemIndex);
+    }
+    const auto next = [&] {
+        const std::optional<double> value = nextAsciiValue(element, itemIndex);
+        if (!value) {
+            failAsciiLine(element, itemIndex);
+        }
+        return *value;
+    };
+    for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& property = element.properties[p];
+        if (!property.isList) {
+            values.scalar[p] = next();
+            continue;
+        }
+        const std::uint64_t count = listLength(next(), element, itemIndex);
+        const bool keep = faceList && *faceList == p;
+        for (std::uint64_t i = 0; i < count; ++i) {
+            const double index = next();
+            if (keep) {
+                values.faceIndices.push_back(index >= 0.0 && index < 4294967295.0 &&
+                                                     index == std::floor(index)
+                                                 ? static_cast<std::uint32_t>(index)
+                                                 : kInvalidIndex);
             }
         }
+    }
+    if (cursor_ != lineEnd_) {
+        failAsciiLine(element, itemIndex);
+    }
+}
+
+/// Like the PCD reader: lines after the last element are ignored, but not silently.
+void PlyBodyReader::warnAboutAsciiLinesLeft() {
+    std::size_t linesLeft = 0;
+    while (nextAsciiLine()) {
+        ++linesLeft;
+    }
+    if (linesLeft > 0) {
+        const PlyElement& last = header_.elements.back();
+        context_.warnings.push_back(
+            fmt::format("ignored the {} PLY ascii line{} after the last element, the {} {} "
+                        "items declared in the header",
+                        linesLeft, linesLeft == 1 ? "" : "s", last.count, last.name));
     }
 }
 
@@ -566,7 +677,9 @@ PointCloud PlyBodyReader::read() {
     };
     constexpr std::uint64_t kProgressEvery = 1 << 16;
 
-    for (std::size_t e = 0; e <= lastNeeded; ++e) {
+    // Ascii bodies are read to their end, to tell of lines that no element declares.
+    const std::size_t lastRead = binary() ? lastNeeded : header_.elements.size() - 1;
+    for (std::size_t e = 0; e <= lastRead; ++e) {
         const PlyElement& element = header_.elements[e];
         if (&element == vertex) {
             const auto stride = vertex->fixedStride();
@@ -647,6 +760,9 @@ PointCloud PlyBodyReader::read() {
         } else {
             skipElement(element);
         }
+    }
+    if (!binary()) {
+        warnAboutAsciiLinesLeft();
     }
     context_.reportProgress(file_.size(), file_.size());
     PointCloud cloud = builder.finish(context_.warnings);

@@ -40,9 +40,9 @@ inline const char* parseNumber(const char* first, const char* last, double& valu
     return result.ptr;
 }
 
-/// Splits on runs of whitespace.
-inline std::vector<std::string_view> splitWords(std::string_view line) {
-    std::vector<std::string_view> words;
+/// Splits on runs of whitespace into `words`, which keeps its capacity for the next line.
+inline void splitWords(std::string_view line, std::vector<std::string_view>& words) {
+    words.clear();
     std::size_t i = 0;
     while (i < line.size()) {
         while (i < line.size() && isWhitespace(line[i])) {
@@ -57,6 +57,12 @@ inline std::vector<std::string_view> splitWords(std::string_view line) {
         }
         i = j;
     }
+}
+
+/// Splits on runs of whitespace.
+inline std::vector<std::string_view> splitWords(std::string_view line) {
+    std::vector<std::string_view> words;
+    splitWords(line, words);
     return words;
 }
 

@@ -19,6 +19,7 @@ using test::decode;
 using test::decodeError;
 using test::expectPosition;
 using ::testing::HasSubstr;
+using ::testing::IsEmpty;
 
 std::string binaryHeader(const char* encoding, const std::string& body) {
     return std::string("ply\nformat ") + encoding + " 1.0\n" + body + "end_header\n";
@@ -227,6 +228,71 @@ TEST(PlyReaderTest, StrayByeLinesAndCrLfHeaderAreTolerated) {
     const PointCloud cloud = decode(file, "bye.ply").cloud;
     ASSERT_EQ(cloud.size(), 1u);
     expectPosition(cloud, 0, 1, 2, 3);
+}
+
+TEST(PlyReaderTest, AsciiItemsAreLinesWhateverTheirBlanksAndLineEnds) {
+    // Blank lines, tabs, trailing blanks and CRLF; lists in an element before the vertices and
+    // in one after the faces, which is read (and checked) to the end of the body.
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement camera 1\nproperty list uchar float k\n"
+        "property float f\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+        "element edge 1\nproperty int a\nproperty list uchar int b\nend_header\n"
+        "2 0.5 0.5 35\r\n\r\n0 0 0  \r\n\t1 0 0\t\n\n  0 1 0\n3 0 1 2\r\n7 0\n\n  \n";
+    const LoadedScan scan = decode(file, "blanks.ply");
+    ASSERT_EQ(scan.cloud.size(), 3u);
+    expectPosition(scan.cloud, 1, 1, 0, 0);
+    expectPosition(scan.cloud, 2, 0, 1, 0);
+    ASSERT_EQ(scan.cloud.triangles.size(), 1u);
+    EXPECT_THAT(scan.warnings, IsEmpty());
+}
+
+TEST(PlyReaderTest, AsciiLineWithTheWrongNumberOfValuesNamesTheLine) {
+    const std::string xyz =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\n";
+    const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+    struct Case {
+        const char* name;
+        std::string file;
+        const char* expected;
+    };
+    const Case cases[] = {
+        // An undeclared column shifted every value after it: (0,0,0) (7,1,1) (1,7,2)...
+        {"extra column", xyz + "end_header\n0 0 0 7\n1 1 1 7\n2 2 2 7\n3 3 3 7\n",
+         "PLY line 8 has 4 values, but the header's properties of vertex 1 need 3"},
+        {"missing value", xyz + "end_header\n0 0 0\n1 1\n2 2 2\n3 3 3\n0 0 0\n",
+         "PLY line 9 has 2 values, but the header's properties of vertex 2 need 3"},
+        {"short face", xyz + faces + "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1\n",
+         "PLY line 14 has 3 values, but the header's properties of face 1 need 4"},
+        // Vertex lines read as faces gave "skipped 1 PLY faces with fewer than 3 vertices".
+        {"vertex count too small",
+         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\n" +
+             faces + "end_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n",
+         "PLY line 13 has 3 values, but the header's properties of face 1 need 2"},
+        {"list count missing",
+         "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+         "property float z\nproperty list uchar float extra\nproperty float w\nend_header\n"
+         "0 0 0\n",
+         "PLY line 10 has 3 values, but the header's properties of vertex 1 need at least 5"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.name);
+        EXPECT_THAT(decodeError(c.file, "lines.ply"), HasSubstr(c.expected));
+    }
+}
+
+TEST(PlyReaderTest, AsciiLinesAfterTheLastElementAreIgnoredWithAWarning) {
+    // The header says 2 vertices, the body holds 4: the last 2 were ignored silently.
+    const std::string file =
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n0 0 0\n1 1 1\n2 2 2\n\n3 3 3\n";
+    const LoadedScan scan = decode(file, "more.ply");
+    EXPECT_EQ(scan.cloud.size(), 2u);
+    EXPECT_THAT(scan.warnings, ::testing::Contains(HasSubstr(
+                                   "ignored the 2 PLY ascii lines after the last "
+                                   "element, the 2 vertex items declared in the header")));
 }
 
 TEST(PlyReaderTest, NanVerticesAreDroppedAndFacesRemapped) {
