@@ -15,8 +15,8 @@
 #include "io/XyzReader.h"
 
 // Text lists of points (XYZ, PTS, CSV...) as records, read in pieces of whole lines: a first
-// pass counts the points and finds their bounds, which choose the quantization; each read then
-// parses lines until it has the points asked for.
+// pass counts the points and finds their bounds, which choose the quantization, and the colour
+// encoding; each read then parses lines until it has the points asked for.
 namespace subscan {
 
 namespace {
@@ -108,7 +108,13 @@ class TextRecordSource final : public PointRecordSource {
         const PointTextLayout& layout = reader_->layout();
         Bounds bounds;
         std::uint64_t count = 0;
+        TextColorRange colors;
         parseAll([&](std::span<const double> values, std::size_t line) {
+            if (layout.color) {
+                for (const std::size_t column : *layout.color) {
+                    colors.add(values[column]);
+                }
+            }
             const glm::dvec3 p = position(values);
             for (int axis = 0; axis < 3; ++axis) {
                 if (!std::isfinite(p[axis])) {
@@ -123,6 +129,7 @@ class TextRecordSource final : public PointRecordSource {
         if (count == 0) {
             throw Error("it holds no points, only PTS count lines");
         }
+        colorEncoding_ = layout.colorEncodingFromName ? layout.colorEncoding : colors.encoding();
         writer_.emplace(layout.color.has_value(), layout.normal.has_value(), bounds);
         const std::vector<std::string> warnings = std::move(info_.warnings);
         info_ = convertedSourceInfo(info_.name, count, *writer_, bounds);
@@ -200,9 +207,9 @@ class TextRecordSource final : public PointRecordSource {
             for (int k = 0; k < 3; ++k) {
                 const double value = values[(*layout.color)[k]];
                 point.rgb[k] =
-                    layout.colorEncoding == TextColorEncoding::UnitFloat ? colorWordFromUnit(value)
-                    : layout.colorEncoding == TextColorEncoding::Word16  ? colorWordFromWord(value)
-                                                                         : colorWordFromByte(value);
+                    colorEncoding_ == TextColorEncoding::UnitFloat ? colorWordFromUnit(value)
+                    : colorEncoding_ == TextColorEncoding::Word16  ? colorWordFromWord(value)
+                                                                   : colorWordFromByte(value);
             }
         }
         if (layout.normal) {
@@ -221,6 +228,8 @@ class TextRecordSource final : public PointRecordSource {
     std::optional<PointTextReader> reader_;
     std::optional<LinePieces> pieces_;
     std::optional<ConvertedRecordWriter> writer_;
+    // From every colour value of the first pass; the reader's layout has the first lines' guess.
+    TextColorEncoding colorEncoding_ = TextColorEncoding::Byte;
     std::vector<std::byte> pending_;  // the records of the piece parsed last
     std::size_t pendingPoint_ = 0;    // the next of them to give out
 };

@@ -581,24 +581,14 @@ Layout guessLayout(std::size_t columnCount, const Sample& sample,
     return layout;
 }
 
-/// Colour columns hold bytes unless the values say otherwise: fractions no larger than 1 are
-/// 0..1 floats, values above 255 are 16-bit (as PDAL writes LAS colours).
 ColorEncoding guessColorEncoding(const Layout& layout, const Sample& sample) {
-    double largest = 0.0;
-    bool anyFraction = false;
+    TextColorRange range;
     for (const std::size_t column : *layout.color) {
         for (const double v : sample.column(column)) {
-            largest = std::max(largest, v);
-            anyFraction = anyFraction || v != std::floor(v);
+            range.add(v);
         }
     }
-    if (anyFraction && largest <= 1.0) {
-        return ColorEncoding::UnitFloat;
-    }
-    if (largest > 255.0 && largest <= 65535.0) {
-        return ColorEncoding::Word16;
-    }
-    return ColorEncoding::Byte;
+    return range.encoding();
 }
 
 std::uint8_t toColorChannel(double value, ColorEncoding encoding) {
@@ -950,7 +940,28 @@ std::string_view withoutByteOrderMark(std::string_view text) {
     return text;
 }
 
+std::string describeText(const Prelude& prelude, const Layout& layout) {
+    std::string text = prelude.pts ? "PTS text" : "text";
+    if (prelude.columnCount > 0) {
+        text += ": " + describeLayout(layout);
+    }
+    if (prelude.sample.separators.decimalComma) {
+        text += " (decimal commas)";
+    }
+    return text;
+}
+
 }  // namespace
+
+TextColorEncoding TextColorRange::encoding() const {
+    if (anyFraction_ && largest_ <= 1.0) {
+        return ColorEncoding::UnitFloat;
+    }
+    if (largest_ > 255.0 && largest_ <= 65535.0) {
+        return ColorEncoding::Word16;
+    }
+    return ColorEncoding::Byte;
+}
 
 struct PointTextReader::State {
     Prelude prelude;
@@ -970,13 +981,7 @@ PointTextReader::PointTextReader(std::string_view head, ReadContext& context)
     State& state = *state_;
     state.prelude = readPrelude(head, start);
     state.layout = chooseLayout(state.prelude, context.warnings);
-    context.formatDetail = state.prelude.pts ? "PTS text" : "text";
-    if (state.prelude.columnCount > 0) {
-        context.formatDetail += ": " + describeLayout(state.layout);
-    }
-    if (state.prelude.sample.separators.decimalComma) {
-        context.formatDetail += " (decimal commas)";
-    }
+    context.formatDetail = describeText(state.prelude, state.layout);
     state.parser.emplace(state.prelude, state.layout);
     // The sampled lines point into `head`, which the caller may now drop; only their number and
     // length (for expectedPoints) are kept.
@@ -1021,9 +1026,18 @@ void PointTextReader::finish() const {
     state_->parser->finish();
 }
 
-PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
-    const std::string_view text(reinterpret_cast<const char*>(file.data()), file.size());
-    PointTextReader reader(text, context);
+void PointTextReader::restart(TextColorEncoding encoding, ReadContext& context) {
+    State& state = *state_;
+    state.layout.colorEncoding = encoding;
+    context.formatDetail = describeText(state.prelude, state.layout);
+    state.parser.emplace(state.prelude, state.layout);
+}
+
+namespace {
+
+/// Parses the point lines of `text` into a cloud; `colors` sees every colour value.
+PointCloud readPoints(std::string_view text, PointTextReader& reader, ReadContext& context,
+                      TextColorRange& colors) {
     const Layout& layout = reader.layout();
     PointAttributes attributes;
     attributes.color = layout.color.has_value();
@@ -1032,6 +1046,11 @@ PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
     PointCloudBuilder builder(attributes, reader.expectedPoints(text.size() - reader.dataOffset()));
     std::uint64_t pointLines = 0;
     const auto addPoint = [&](std::span<const double> values, std::size_t) {
+        if (layout.color) {
+            for (const std::size_t column : *layout.color) {
+                colors.add(values[column]);
+            }
+        }
         builder.add(makeRecord(layout, values));
         if (++pointLines > kMaxPoints) {
             throw Error(fmt::format("it has more than the {} points subscan can hold", kMaxPoints));
@@ -1048,6 +1067,27 @@ PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
     }
     reader.finish();
     return builder.finish(context.warnings);
+}
+
+}  // namespace
+
+PointCloud readXyz(std::span<const std::byte> file, ReadContext& context) {
+    const std::string_view text(reinterpret_cast<const char*>(file.data()), file.size());
+    PointTextReader reader(text, context);
+    const std::size_t layoutWarnings = context.warnings.size();
+    TextColorRange colors;
+    PointCloud cloud = readPoints(text, reader, context, colors);
+    const Layout& layout = reader.layout();
+    if (layout.color && !layout.colorEncodingFromName &&
+        colors.encoding() != layout.colorEncoding) {
+        // The first lines misled the guess. Reading the file again costs no memory, which
+        // keeping every point's colour values until the end would; such files are rare.
+        cloud = PointCloud{};
+        context.warnings.resize(layoutWarnings);
+        reader.restart(colors.encoding(), context);
+        cloud = readPoints(text, reader, context, colors);
+    }
+    return cloud;
 }
 
 bool looksLikePointText(std::span<const std::byte> file) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -25,6 +26,25 @@ bool looksLikePointText(std::span<const std::byte> file);
 
 /// How the colour columns of a point text are written: bytes, 0..1 floats or 16-bit values.
 enum class TextColorEncoding { Byte, UnitFloat, Word16 };
+
+/// The encoding that fits colour values: fractions no larger than 1 are 0..1 floats, values
+/// above 255 (up to 65535) are 16-bit, as PDAL writes LAS colour; anything else is bytes. Only
+/// every value of a file tells: a scan that starts in the dark has 16-bit colours below 256 on
+/// its first lines.
+class TextColorRange {
+  public:
+    void add(double value) {
+        if (!std::isnan(value)) {
+            largest_ = std::max(largest_, value);
+            anyFraction_ = anyFraction_ || value != std::floor(value);
+        }
+    }
+    TextColorEncoding encoding() const;
+
+  private:
+    double largest_ = 0.0;
+    bool anyFraction_ = false;
+};
 
 /// Which column of a point line holds what.
 struct PointTextLayout {
@@ -54,8 +74,9 @@ struct PointTextLayout {
 
 /// A text list of points read in pieces: the layout is decided from the file's first lines (the
 /// header lines and a sample of point lines), then the point lines are parsed piece by piece,
-/// so a file of any size goes through a buffer of bounded size. readXyz is this reader given
-/// the whole file.
+/// so a file of any size goes through a buffer of bounded size. The sample's colour encoding is
+/// a first guess; callers judge it from every value with TextColorRange. readXyz is this reader
+/// given the whole file.
 class PointTextReader {
   public:
     /// `head` is the start of the file: all of it, or whole lines enough to hold the lines
@@ -80,6 +101,10 @@ class PointTextReader {
                const std::function<void(std::span<const double>, std::size_t)>& point);
     /// At the end of the file: checks the point count of the last PTS block.
     void finish() const;
+    /// Starts again at dataOffset(), with the colour columns read as `encoding`: for a file
+    /// whose later lines showed that the first ones misled the guess. The format detail in
+    /// `context` says so.
+    void restart(TextColorEncoding encoding, ReadContext& context);
 
   private:
     struct State;

@@ -712,6 +712,22 @@ TEST(PointRecordSourceTest, TextListsStreamThroughPiecesOfLines) {
     expectPiecesAgree(*source);
 }
 
+TEST(PointRecordSourceTest, TextColourEncodingIsJudgedFromEveryLine) {
+    // 150 dark points, then 16-bit colour: the first 100 lines decided, and later values were
+    // clamped to 255 (white).
+    std::string text = "x y z r g b\n";
+    for (int i = 0; i < 1000; ++i) {
+        const int value = i < 150 ? i : 20000 + 45 * i;
+        text += fmt::format("{} 0 0 {} 0 {}\n", i, value, value);
+    }
+    const test::TempDir dir;
+    const auto source = open(dir.write("dark.xyz", text));
+    const std::vector<std::array<std::uint16_t, 3>> colors = recordColors(*source);
+    ASSERT_EQ(colors.size(), 1000u);
+    EXPECT_EQ(colors[149], (std::array<std::uint16_t, 3>{149, 0, 149}));
+    EXPECT_EQ(colors[999], (std::array<std::uint16_t, 3>{64955, 0, 64955}));
+}
+
 TEST(PointRecordSourceTest, BadTextListsAreOneSentenceNamingTheFileAndLine) {
     const test::TempDir dir;
     EXPECT_THAT(openError(dir.write("nan.xyz", "1 2 3\n4 nan 6\n")),

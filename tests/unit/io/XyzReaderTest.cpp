@@ -230,6 +230,42 @@ TEST(XyzReaderTest, ColourValuesClampAndOtherEncodingsAreRecognised) {
     EXPECT_EQ(fractions.cloud.colors[0], (Rgba8{255, 128, 0, 255}));
 }
 
+/// 150 dark points ("x y z r g b", values 0..149), then 850 in 16-bit colour (up to 64955), and
+/// one to drop.
+std::string darkStartThenSixteenBit(bool header) {
+    std::string text = header ? "x y z red green blue\n" : "";
+    for (int i = 0; i < 1000; ++i) {
+        const int value = i < 150 ? i : 20000 + 45 * i;
+        text += fmt::format("{} 0 0 {} {} {}\n", i, value, value, value);
+    }
+    return text + "nan 0 0 0 0 0\n";
+}
+
+TEST(XyzReaderTest, ColourEncodingIsJudgedFromEveryLineNotTheFirstOnes) {
+    // The first 100 lines decided: later 16-bit values were clamped to 255 (white), silently.
+    for (const bool header : {false, true}) {
+        SCOPED_TRACE(header ? "header" : "no header");
+        const LoadedScan scan = decode(darkStartThenSixteenBit(header), "dark.xyz");
+        EXPECT_EQ(scan.formatDetail, "text: x y z r g b (16-bit colour)");
+        ASSERT_EQ(scan.cloud.size(), 1000u);
+        EXPECT_EQ(scan.cloud.colors[149].r, 1);    // 149 / 257, rounded
+        EXPECT_EQ(scan.cloud.colors[150].r, 104);  // 26750 / 257
+        EXPECT_EQ(scan.cloud.colors[999].r, 253);  // 64955 / 257
+        // Read twice, warned once.
+        EXPECT_THAT(scan.warnings, ElementsAre(HasSubstr("dropped 1 of 1001 points")));
+    }
+    // Fractions no larger than 1 after integer lines: 0..1 floats, the first lines too.
+    std::string unit = "x y z r g b\n";
+    for (int i = 0; i < 120; ++i) {
+        unit += "0 0 0 1 0 1\n";
+    }
+    unit += "0 0 0 0.5 0.25 1\n";
+    const LoadedScan units = decode(unit, "unit.xyz");
+    EXPECT_EQ(units.formatDetail, "text: x y z rf gf bf");
+    EXPECT_EQ(units.cloud.colors[0], (Rgba8{255, 0, 255, 255}));
+    EXPECT_EQ(units.cloud.colors[120], (Rgba8{128, 64, 255, 255}));
+}
+
 TEST(XyzReaderTest, HeaderColumnsItDoesNotKnowAreNamedInOneWarning) {
     const LoadedScan scan = decode(
         "Scan of the yard\nX,Y,Z,Classification,Red,Green,Blue,GpsTime\n"
