@@ -1,6 +1,7 @@
 #include "io/OffReader.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -110,22 +111,49 @@ std::uint32_t countAt(const std::vector<std::string_view>& words, std::size_t in
     return static_cast<std::uint32_t>(value);
 }
 
-/// A vertex colour's channels: 0..1 when any of them is written with a decimal point or an
-/// exponent, else 0..255 integers.
-Rgba8 parseColor(const std::vector<std::string_view>& words, std::size_t first, std::size_t count,
-                 std::size_t lineNumber) {
-    bool fractions = false;
-    for (std::size_t c = 0; c < count; ++c) {
-        fractions = fractions || words[first + c].find_first_of(".eE") != std::string_view::npos;
+/// A vertex colour as written: 3 or 4 channels (RGB or RGBA).
+struct WrittenColor {
+    // Floats hold 0..255 exactly and 0..1 to 1e-7, far finer than a step of 1/255.
+    std::array<float, 4> channels{};
+    std::size_t count = 0;
+};
+
+/// Whether a file's colours are 0..1 floats or 0..255 integers is decided once for all of
+/// them: white "1 1 1" in a file of "0.5 0.25 1" is 0..1 like its neighbours.
+class ColorScale {
+  public:
+    /// Reads a vertex's colour words, noting whether they look like 0..1 floats.
+    WrittenColor read(const std::vector<std::string_view>& words, std::size_t first,
+                      std::size_t count, std::size_t lineNumber) {
+        WrittenColor color;
+        color.count = count;
+        for (std::size_t c = 0; c < count; ++c) {
+            const double value = numberAt(words, first + c, lineNumber, "colour");
+            color.channels[c] = saturateToFloat(value);
+            floatWords_ =
+                floatWords_ || words[first + c].find_first_of(".eE") != std::string_view::npos;
+            aboveOne_ = aboveOne_ || value > 1.0;
+        }
+        return color;
     }
-    std::uint8_t channels[4] = {0, 0, 0, 255};
-    for (std::size_t c = 0; c < count; ++c) {
-        const double value = numberAt(words, first + c, lineNumber, "colour");
-        const double scaled = std::clamp(fractions ? value * 255.0 : value, 0.0, 255.0);
-        channels[c] = static_cast<std::uint8_t>(std::lround(std::isnan(scaled) ? 0.0 : scaled));
+
+    /// 0..1 when some colour is written with a decimal point or an exponent and none exceeds 1
+    /// (a writer of 0..255 may print "255.0"), else 0..255.
+    Rgba8 toRgba(const WrittenColor& color) const {
+        const bool unit = floatWords_ && !aboveOne_;
+        std::uint8_t channels[4] = {0, 0, 0, 255};
+        for (std::size_t c = 0; c < color.count; ++c) {
+            const float value = color.channels[c];
+            const double scaled = std::clamp(unit ? value * 255.0 : value, 0.0, 255.0);
+            channels[c] = static_cast<std::uint8_t>(std::lround(std::isnan(scaled) ? 0.0 : scaled));
+        }
+        return {channels[0], channels[1], channels[2], channels[3]};
     }
-    return {channels[0], channels[1], channels[2], channels[3]};
-}
+
+  private:
+    bool floatWords_ = false;
+    bool aboveOne_ = false;
+};
 
 class OffParser {
   public:
@@ -168,7 +196,11 @@ class OffParser {
             context_.warnings.push_back(
                 fmt::format("skipped {} faces with fewer than 3 vertices", skipped));
         }
-        return builder.finish(context_.warnings);
+        PointCloud cloud = builder.finish(context_.warnings);
+        for (std::size_t i = 0; i < cloud.colors.size(); ++i) {
+            cloud.colors[i] = colorScale_.toRgba(writtenColors_[i]);
+        }
+        return cloud;
     }
 
   private:
@@ -222,10 +254,15 @@ class OffParser {
                         numberAt(words, normalAt + static_cast<std::size_t>(axis), line, "normal"));
                 }
             }
-            if (layout.color) {
-                record.color = parseColor(words, colorAt, colorWords, line);
-            }
+            const std::size_t kept = builder.validPoints();
             builder.add(record);
+            // Read for every vertex, so that a dropped one's colour is judged too.
+            if (layout.color) {
+                const WrittenColor color = colorScale_.read(words, colorAt, colorWords, line);
+                if (builder.validPoints() > kept) {
+                    writtenColors_.push_back(color);
+                }
+            }
             if (i % (1u << 16) == 0) {
                 context_.reportProgress(lines_.position(), size_);
             }
@@ -269,6 +306,8 @@ class OffParser {
     MeaningfulLines lines_;
     ReadContext& context_;
     std::size_t size_;
+    ColorScale colorScale_;
+    std::vector<WrittenColor> writtenColors_;  // of the vertices kept, until the scale is known
 };
 
 }  // namespace

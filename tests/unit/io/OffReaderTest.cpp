@@ -47,10 +47,27 @@ TEST(OffReaderTest, VertexColoursAsBytesOrFractions) {
     EXPECT_EQ(bytes.cloud.colors[1], (Rgba8{10, 20, 30, 255}));
     EXPECT_EQ(bytes.cloud.colors[2], (Rgba8{0, 0, 0, 0}));
     const LoadedScan fractions =
-        test::decode("COFF 2 0 0\n0 0 0 1.0 0.5 0.0 1.0\n1 0 0 0.2 1e-1 2.0\n");
-    // 0.5 * 255 = 127.5 rounds to 128; 2.0 is clamped to 255.
+        test::decode("COFF 2 0 0\n0 0 0 1.0 0.5 0.0 1.0\n1 0 0 0.2 1e-1 -0.5\n");
+    // 0.5 * 255 = 127.5 rounds to 128; -0.5 is clamped to 0.
     EXPECT_EQ(fractions.cloud.colors[0], (Rgba8{255, 128, 0, 255}));
-    EXPECT_EQ(fractions.cloud.colors[1], (Rgba8{51, 26, 255, 255}));
+    EXPECT_EQ(fractions.cloud.colors[1], (Rgba8{51, 26, 0, 255}));
+}
+
+TEST(OffReaderTest, ColourScaleIsDecidedOnceForTheWholeFile) {
+    // Writers that print with %g write 1.0 as "1": white, red and alpha 1 were read as 0..255
+    // (black, transparent) next to vertices with a decimal point.
+    const LoadedScan units = test::decode(
+        "COFF\n5 0 0\n0 0 0 1 1 1 1\n1 0 0 0.5 0.5 0.5 1\n0 1 0 1 0 0 1\nnan 0 0 0 0 0 0.5\n"
+        "0 0 1 0.25 1 0 1\n");
+    ASSERT_EQ(units.cloud.size(), 4u);  // the NaN vertex is dropped, its colour with it
+    EXPECT_EQ(units.cloud.colors[0], (Rgba8{255, 255, 255, 255}));
+    EXPECT_EQ(units.cloud.colors[1], (Rgba8{128, 128, 128, 255}));
+    EXPECT_EQ(units.cloud.colors[2], (Rgba8{255, 0, 0, 255}));
+    EXPECT_EQ(units.cloud.colors[3], (Rgba8{64, 255, 0, 255}));
+    // A value above 1 makes decimals 0..255, as in PLY and text files: "255.0" is not clamped.
+    const LoadedScan bytes = test::decode("COFF\n2 0 0\n0 0 0 255.0 128.0 0.0\n1 0 0 0.5 1 1\n");
+    EXPECT_EQ(bytes.cloud.colors[0], (Rgba8{255, 128, 0, 255}));
+    EXPECT_EQ(bytes.cloud.colors[1], (Rgba8{1, 1, 1, 255}));  // 0.5 rounds half up
 }
 
 TEST(OffReaderTest, NormalsHomogeneousCoordinatesAndTextureCoordinates) {
