@@ -224,8 +224,14 @@ Camera sensorCamera(const PointCloud& cloud, const SensorPose& sensor, UpAxis up
         direction = -frame.front;
     }
     direction = glm::normalize(direction);
-    if (std::abs(glm::dot(direction, upVector)) > 0.9999) {
-        upVector = -frame.front;
+    if (const double along = glm::dot(direction, upVector); std::abs(along) > 0.9999) {
+        // Looking (nearly) straight down or up: the picture's up is the limit the view's takes
+        // there, the horizontal direction it looks in (away from it looking up), not a fixed
+        // one that turned the picture where this began.
+        const glm::dvec3 horizontal = direction - along * upVector;
+        upVector = glm::length(horizontal) > 1e-12
+                       ? (along < 0.0 ? 1.0 : -1.0) * glm::normalize(horizontal)
+                       : -frame.front;
     }
     camera.view = glm::lookAt(sensor.position, sensor.position + direction, upVector);
     double nearest = std::numeric_limits<double>::infinity();

@@ -210,6 +210,32 @@ TEST(SensorViewTest, SensorCameraLooksFromTheSensorAtThePoints) {
     }
 }
 
+TEST(SensorViewTest, ASensorNearlyStraightAboveItsPointsTurnsNoPicture) {
+    // Within 0.81° of straight above the picture's up used to be replaced by a fixed axis: a
+    // sensor moved by a hair across that angle turned the picture (an airborne pass overhead).
+    PointCloudBuilder builder({}, 400);
+    for (int i = 0; i < 400; ++i) {
+        PointRecord record;
+        record.position = glm::dvec3(i % 20, i / 20, 0.05 * (i % 7));
+        builder.add(record);
+    }
+    std::vector<std::string> warnings;
+    const PointCloud cloud = builder.finish(warnings);
+    const glm::dvec3 middle = framingBounds(cloud).center();
+    for (const double bearing : {0.0, 1.0, 2.5, -2.0}) {
+        const glm::dvec3 away(std::cos(bearing), std::sin(bearing), 0.0);
+        // 100 m up, 1.2 m and 1.6 m aside: 0.69° and 0.92° from the vertical, either side.
+        const Camera inside = sensorCamera(
+            cloud, {middle + glm::dvec3(0, 0, 100) + 1.2 * away, "inside"}, UpAxis::Z, 64, 48, 40);
+        const Camera outside = sensorCamera(
+            cloud, {middle + glm::dvec3(0, 0, 100) + 1.6 * away, "outside"}, UpAxis::Z, 64, 48, 40);
+        // The picture's up axis in world space; 0.23° of tilt apart moves it by about 0.004.
+        const glm::dvec3 upInside(inside.view[0][1], inside.view[1][1], inside.view[2][1]);
+        const glm::dvec3 upOutside(outside.view[0][1], outside.view[1][1], outside.view[2][1]);
+        EXPECT_LT(glm::length(upInside - upOutside), 0.01) << bearing;
+    }
+}
+
 TEST(SensorViewTest, AStationAmidItsPointsLooksLevelTowardsTheirMiddle) {
     // Ground 60 x 60 m around the station (1.5 m above it, Y up), a 30 m tower straight above
     // the station's feet raising the framing box's middle to 15 m, and a building 45 m east.
