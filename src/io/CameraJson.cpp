@@ -85,8 +85,12 @@ Camera cameraFromJson(const nlohmann::json& json) {
     }
     Camera camera;
     for (const char* key : {"width", "height"}) {
+        // 640.0 is 640 (a script that divided wrote it so); 33.5 is no size.
         if (json.contains(key) && json.at(key).is_number_float()) {
-            throw Error(fmt::format("the camera's '{}' is not a whole number", key));
+            const double value = json.at(key).get<double>();
+            if (value != std::floor(value)) {
+                throw Error(fmt::format("the camera's '{}' {} is not a whole number", key, value));
+            }
         }
     }
     camera.width = required<int>(json, "width");
@@ -124,9 +128,10 @@ Camera cameraFromJson(const nlohmann::json& json) {
         }
     }
     // A rigid motion: a rotation and a translation. Anything else (a scale, a shear, a
-    // projective last row) would be drawn as a distorted picture, not refused. The bounds
-    // allow a view printed with 6 digits or more.
-    constexpr double kRigid = 1e-5;
+    // projective last row) would be drawn as a distorted picture, not refused. The bound allows
+    // a view printed with 4 decimals (numpy's and MATLAB's short formats), whose picture is
+    // off by about 1e-4 of its size, and refuses any scale or shear of a thousandth or more.
+    constexpr double kRigid = 1e-3;
     const glm::dmat3 rotation(camera.view);
     const glm::dmat3 product = glm::transpose(rotation) * rotation;
     bool rigid = glm::determinant(rotation) > 0.0;
@@ -153,16 +158,17 @@ Camera cameraFromJson(const nlohmann::json& json) {
             agrees = given[row].size() == 4;
             for (std::size_t column = 0; agrees && column < 4; ++column) {
                 const double expected = derived[static_cast<int>(column)][static_cast<int>(row)];
-                // Relative to the entry's size: a file printed with 6 significant digits
-                // agrees, any other projection does not.
+                // Relative to the entry's size: a file printed with 4 decimals agrees, another
+                // field of view, size, near plane or kind of projection does not.
                 agrees = std::abs(given[row][column] - expected) <=
                          kRigid * std::max(1.0, std::abs(expected));
             }
         }
         if (!agrees) {
             throw Error(
-                "the camera's 'projection' is not the one its width, height, fovy_deg, near and "
-                "far give (subscan derives it from them): remove it or make it match");
+                "the camera's 'projection' is not the one its width, height, fovy_deg, near, far "
+                "and pixel offsets give (subscan derives it from them): remove it or make it "
+                "match");
         }
     }
     return camera;

@@ -14,8 +14,9 @@ namespace subscan {
 /// in `projection` too), and a sensor's camera `principal_offset_pixels` [x, y]
 /// (Camera::principalOffsetPixels), each absent when zero.
 nlohmann::json cameraToJson(const Camera& camera);
-/// Validates every field; `projection` is not read back (it follows from fovy, near, far, the
-/// image size and the jitter). Throws subscan::Error naming the field.
+/// Validates every field. `projection` follows from fovy, near, far, the image size and the
+/// pixel offsets: where given it must agree with them. `view` must be a rigid motion. Throws
+/// subscan::Error naming the field.
 Camera cameraFromJson(const nlohmann::json& json);
 
 void writeCameraFile(const std::filesystem::path& path, const Camera& camera);

@@ -726,6 +726,16 @@ TEST(RenderCommandGLTest, OutputsAreWrittenOnlyAfterTheWorkAndNeverOverAnInput) 
     EXPECT_THAT(overCamera.err, HasSubstr("refusing to write the camera over the input camera"));
     EXPECT_EQ(test::fileBytes(camera), cameraText);
     EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+    // Nor over (or removing) a buffers' camera given as --camera.
+    std::filesystem::create_directory(dir / "own");
+    const auto buffersCamera = dir.write("own/buffers_camera.json", cameraText);
+    const auto overBuffersCamera =
+        runSubscan({"render", scan.string(), "-o", (dir / "x.png").string(), "--camera",
+                    buffersCamera.string(), "--export-buffers", (dir / "own").string()});
+    EXPECT_EQ(overBuffersCamera.exitCode, 1);
+    EXPECT_THAT(overBuffersCamera.err,
+                HasSubstr("refusing to write the buffers' camera over the input camera"));
+    EXPECT_EQ(test::fileBytes(buffersCamera), cameraText);
 
     // A picture or settings file into a folder that does not exist: said before any output is
     // written (the buffers were written, then the picture failed).
@@ -760,8 +770,6 @@ TEST(RenderCommandGLTest, AnExportedCameraRendersItsPictureAgain) {
     // picture's camera all the same, so --camera renders the same picture (it used to carry
     // that frame's jitter, which --camera then added to every frame's own: found from outside).
     const test::TempDir dir;
-    const std::vector<std::string> common{"--mode",  "surface", "--samples", "4",
-                                          "--width", "48",      "--height",  "40"};
     auto render = [&](const std::string& name, std::vector<std::string> extra) {
         std::vector<std::string> arguments{"render",
                                            "synthetic:sphere?points=20000",

@@ -13,6 +13,12 @@
 
 namespace subscan::cli {
 
+void refuseToOverwriteCameraInputs(const FrameOptions& frame,
+                                   const std::filesystem::path& directory) {
+    frame.refuseToOverwriteInputs(directory / "camera.json", "the camera");
+    frame.refuseToOverwriteInputs(directory / "buffers_camera.json", "the buffers' camera");
+}
+
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
                    const RenderSettings& settings, const Camera& picture) {
     std::error_code error;

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "app/cli/FrameOptions.h"
 #include "render/RenderSettings.h"
 #include "render/Renderer.h"
 
@@ -16,6 +17,11 @@ namespace subscan::cli {
 /// picture, with the temporal filter at rest that frame's jittered camera (the picture being
 /// the mean over many); where their camera is not the picture's it is written beside it as
 /// buffers_camera.json. Needs a frame rendered with FrameOutputs::Everything.
+/// Throws subscan::Error where exportBuffers into `directory` would write over (or remove) an
+/// input: its camera.json or buffers_camera.json being the --camera file.
+void refuseToOverwriteCameraInputs(const FrameOptions& frame,
+                                   const std::filesystem::path& directory);
+
 void exportBuffers(const std::filesystem::path& directory, const Renderer& renderer,
                    const RenderSettings& settings, const Camera& picture);
 

@@ -107,8 +107,7 @@ int runRender(const RenderOptions& options) {
     requireOutputFolder(output);
     requireOutputFolder(frame.saveSettingsFile);
     if (!options.exportDirectory.empty()) {
-        frame.refuseToOverwriteInputs(
-            std::filesystem::path(options.exportDirectory) / "camera.json", "the camera");
+        refuseToOverwriteCameraInputs(frame, options.exportDirectory);
     }
     RenderSettings settings = frame.settings();
     const RasterSettings& raster = settings.raster;

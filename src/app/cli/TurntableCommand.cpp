@@ -182,6 +182,10 @@ int runTurntable(const TurntableOptions& options) {
     for (int index = 0; !video && index < options.frames; ++index) {
         frame.refuseToOverwriteInputs(output / fmt::format("{:04}.png", index), "a frame");
     }
+    for (int index = 0; !options.exportDirectory.empty() && index < options.frames; ++index) {
+        refuseToOverwriteCameraInputs(
+            frame, std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index));
+    }
     std::optional<std::filesystem::path> ffmpeg;
     if (video) {
         ffmpeg = findFfmpeg();
@@ -265,7 +269,6 @@ int runTurntable(const TurntableOptions& options) {
         if (!options.exportDirectory.empty()) {
             const std::filesystem::path buffers =
                 std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index);
-            frame.refuseToOverwriteInputs(buffers / "camera.json", "the camera");
             createFolder(buffers, "buffers");
             exportBuffers(buffers, renderer, settings, camera);
         }

@@ -114,16 +114,20 @@ TEST(CameraJsonTest, AViewThatIsNoRigidMotionOrAnotherProjectionIsRefused) {
     nlohmann::json withoutProjection = valid;
     withoutProjection.erase("projection");
     EXPECT_NO_THROW(cameraFromJson(withoutProjection));
-    // Printed with 6 significant digits, as a person or another tool might write it: accepted.
+    // Printed with 4 decimals, as numpy's or MATLAB's short formats write it: accepted. So is a
+    // size written as a float (1280.0).
     nlohmann::json rounded = valid;
     for (const char* key : {"view", "projection"}) {
         for (auto& row : rounded[key]) {
             for (auto& value : row) {
-                value = std::stod(fmt::format("{:.6g}", value.get<double>()));
+                value = std::stod(fmt::format("{:.4f}", value.get<double>()));
             }
         }
     }
+    rounded["width"] = valid["width"].get<double>();
+    ASSERT_TRUE(rounded["width"].is_number_float());
     EXPECT_NO_THROW(cameraFromJson(rounded));
+    EXPECT_EQ(cameraFromJson(rounded).width, camera.width);
 
     auto expectRefused = [](const nlohmann::json& json, const char* message, const char* what) {
         try {
@@ -134,7 +138,9 @@ TEST(CameraJsonTest, AViewThatIsNoRigidMotionOrAnotherProjectionIsRefused) {
         }
     };
     nlohmann::json scaled = valid;
-    scaled["view"][0][0] = 2.0 * scaled["view"][0][0].get<double>();
+    for (int column = 0; column < 3; ++column) {  // 1 % wider, a picture visibly stretched
+        scaled["view"][0][column] = 1.01 * scaled["view"][0][column].get<double>();
+    }
     expectRefused(scaled, "not a rigid motion", "a scaled view");
     nlohmann::json zeroRow = valid;
     zeroRow["view"][0] = {0, 0, 0, 0};
@@ -155,7 +161,7 @@ TEST(CameraJsonTest, AViewThatIsNoRigidMotionOrAnotherProjectionIsRefused) {
     expectRefused(edited, "'projection' is not the one", "fovy_deg edited alone");
     nlohmann::json fractional = valid;
     fractional["width"] = 33.5;
-    expectRefused(fractional, "'width' is not a whole number", "a fractional width");
+    expectRefused(fractional, "'width' 33.5 is not a whole number", "a fractional width");
 }
 
 TEST(CameraJsonTest, ANumberBeyondADoubleIsNamedWithTheFile) {
