@@ -50,7 +50,9 @@ void checkOutput(const IndexOptions& options) {
 int runIndex(const IndexOptions& options) {
     checkOutput(options);
     const auto start = std::chrono::steady_clock::now();
-    const InterruptWatcher interrupts;
+    InterruptWatcher interrupts;
+    // The indexer checks the flag from its first step and removes what it wrote.
+    interrupts.defer();
 
     std::vector<std::unique_ptr<PointRecordSource>> sources;
     for (const std::string& path : options.sources) {

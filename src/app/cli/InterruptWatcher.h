@@ -3,15 +3,18 @@
 #include <signal.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <ctime>
 #include <stop_token>
 #include <thread>
 
 namespace subscan::cli {
 
-/// Ctrl-C and SIGTERM become a flag a long command checks between its steps (it then removes
-/// its temporary files and the partial output: index, turntable): the signals are blocked in every
-/// thread and a watcher thread waits for them, so no handler runs in the middle of a write.
+/// Ctrl-C and SIGTERM end the command at once while it has written nothing; once it has
+/// (defer()), they become a flag it checks between its steps, then removes its temporary files
+/// and the partial output (index, turntable), and a second one ends it at once. The signals are
+/// blocked in every thread (make this before any thread starts) and a watcher thread waits for
+/// them, so no handler runs in the middle of a write.
 class InterruptWatcher {
   public:
     InterruptWatcher() {
@@ -22,9 +25,14 @@ class InterruptWatcher {
         watcher_ = std::jthread([this](const std::stop_token& stop) {
             const timespec wait{0, 100'000'000};
             while (!stop.stop_requested()) {
-                if (::sigtimedwait(&signals_, nullptr, &wait) > 0) {
-                    interrupted_ = true;
+                const int signal = ::sigtimedwait(&signals_, nullptr, &wait);
+                if (signal <= 0) {
+                    continue;
                 }
+                if (!deferred_ || interrupted_) {
+                    std::_Exit(128 + signal);  // as the signal's default action would end it
+                }
+                interrupted_ = true;
             }
         });
     }
@@ -36,11 +44,14 @@ class InterruptWatcher {
     InterruptWatcher(const InterruptWatcher&) = delete;
     InterruptWatcher& operator=(const InterruptWatcher&) = delete;
 
+    /// From now on an interrupt is the flag interrupted(): there is something to clean up.
+    void defer() { deferred_ = true; }
     const std::atomic<bool>& interrupted() const { return interrupted_; }
 
   private:
     sigset_t signals_{};
     sigset_t previous_{};
+    std::atomic<bool> deferred_{false};
     std::atomic<bool> interrupted_{false};
     std::jthread watcher_;
 };

@@ -3,12 +3,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -98,7 +101,8 @@ std::optional<std::filesystem::path> findFfmpeg() {
 /// Runs ffmpeg on the numbered PNGs in `frames` into `video` (H.264, yuv420p, even sizes);
 /// throws subscan::Error with its exit status.
 void encodeVideo(const std::filesystem::path& ffmpeg, const std::filesystem::path& frames,
-                 const std::filesystem::path& video, int fps) {
+                 const std::filesystem::path& video, int fps,
+                 const std::atomic<bool>& interrupted) {
     // -nostdin: ffmpeg would otherwise read (and, in the background, stop on) the terminal.
     const std::vector<std::string> arguments = {
         ffmpeg.string(), "-nostdin", "-y", "-loglevel", "error", "-framerate", std::to_string(fps),
@@ -125,11 +129,22 @@ void encodeVideo(const std::filesystem::path& ffmpeg, const std::filesystem::pat
     if (spawned != 0) {
         throw Error(fmt::format("{}: cannot run {}", video.string(), ffmpeg.string()));
     }
+    // Waited for in steps, so that an interrupt meant for this process alone stops ffmpeg too
+    // instead of waiting for the whole video.
     int status = 0;
     pid_t waited = 0;
-    do {
-        waited = waitpid(child, &status, 0);
-    } while (waited == -1 && errno == EINTR);
+    bool stopped = false;
+    for (;;) {
+        waited = waitpid(child, &status, WNOHANG);
+        if (waited == child || (waited == -1 && errno != EINTR)) {
+            break;
+        }
+        if (interrupted && !stopped) {
+            ::kill(child, SIGTERM);
+            stopped = true;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
     if (waited != child || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         throw Error(fmt::format("{}: ffmpeg failed to encode the frames (exit status {})",
                                 video.string(), WIFEXITED(status) ? WEXITSTATUS(status) : -1));
@@ -167,7 +182,7 @@ class FrameFolder {
 
 int runTurntable(const TurntableOptions& options) {
     // Before any thread starts (the GL driver's), so that every thread blocks the signals.
-    const InterruptWatcher interrupts;
+    InterruptWatcher interrupts;
     const FrameOptions& frame = options.frame;
     const std::filesystem::path output = options.output;
     checkOutputName(output);
@@ -237,6 +252,8 @@ int runTurntable(const TurntableOptions& options) {
                       PointMemory::Borrow);
     renderer.prepareNormals(scan.cloud, streamed ? streamedNormals(settings.surface.normals)
                                                  : settings.surface.normals);
+    // From the frames' folder on an interrupt stops at the next frame, which cleans up.
+    interrupts.defer();
     std::optional<FrameFolder> temporary;
     std::filesystem::path folder = output;
     if (video) {
@@ -280,7 +297,7 @@ int runTurntable(const TurntableOptions& options) {
             output.parent_path() / fmt::format(".{}.partial", output.filename().string());
         std::error_code error;
         try {
-            encodeVideo(*ffmpeg, folder, partial, options.fps);
+            encodeVideo(*ffmpeg, folder, partial, options.fps, interrupts.interrupted());
             stopIfInterrupted();
             std::filesystem::rename(partial, output, error);
         } catch (const Error&) {
