@@ -121,6 +121,15 @@ ScanFormat detectFormat(std::span<const std::byte> file, const std::filesystem::
     return ScanFormat::Unknown;
 }
 
+void ignoreZeroNormals(PointCloud& cloud, std::vector<std::string>& warnings) {
+    if (!cloud.normals.empty() &&
+        std::none_of(cloud.normals.begin(), cloud.normals.end(),
+                     [](const glm::vec3& normal) { return glm::dot(normal, normal) > 0.0f; })) {
+        cloud.normals.clear();
+        warnings.push_back("its normals are all zero: they are ignored");
+    }
+}
+
 LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
                       const std::function<void(double)>& progress) {
     if (file.empty()) {
@@ -159,15 +168,7 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
                 "its format is unknown: it is not PLY, LAS, LAZ, PCD, E57, OFF or a text list "
                 "of coordinates");
     }
-    // Some exporters fill the normal fields with zeros: no direction at all, which would shade
-    // the whole surface flat. Such normals count as absent, so they are estimated as for a file
-    // without them.
-    if (!scan.cloud.normals.empty() &&
-        std::none_of(scan.cloud.normals.begin(), scan.cloud.normals.end(),
-                     [](const glm::vec3& normal) { return glm::dot(normal, normal) > 0.0f; })) {
-        scan.cloud.normals.clear();
-        context.warnings.push_back("its normals are all zero: they are ignored");
-    }
+    ignoreZeroNormals(scan.cloud, context.warnings);
     scan.formatDetail = std::move(context.formatDetail);
     scan.warnings = std::move(context.warnings);
     scan.sensor = std::move(context.sensor);

@@ -40,6 +40,11 @@ struct LoadedScan {
 /// `progress` (may be empty) receives the fraction done while a file is decoded.
 LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress = {});
 
+/// Some exporters fill the normal fields with zeros: no direction at all, which would shade the
+/// whole surface flat. Such normals count as absent (they are estimated as for a file without
+/// them), with a warning.
+void ignoreZeroNormals(PointCloud& cloud, std::vector<std::string>& warnings);
+
 /// Decodes an in-memory file of a known format; what loadScan does after mapping the file.
 /// Errors are not prefixed with a file name.
 LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,

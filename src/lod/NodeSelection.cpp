@@ -19,6 +19,7 @@
 
 #include "core/Error.h"
 #include "core/Parallel.h"
+#include "io/ScanLoader.h"
 
 namespace subscan::lod {
 
@@ -256,6 +257,8 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
         append(cloud.classifications, part.classifications, classifications);
         part = PointCloud{};
     }
+    // As a whole file's: a COPC file indexed from one with zeros holds them too.
+    ignoreZeroNormals(cloud, warnings);
     return cloud;
 }
 

@@ -111,5 +111,41 @@ TEST(NodeSelectionTest, ANodeThatCannotBeReadLeavesItsCubeAtItsParentsSpacing) {
     }
 }
 
+/// One node of three points whose normals are the zeros some exporters write (an index of
+/// such a file keeps them).
+class ZeroNormalSource final : public NodeSource {
+  public:
+    ZeroNormalSource() {
+        info_.name = "zeros";
+        info_.cube = OctreeCube{glm::dvec3(0.0), 1.0, kRootSpacing};
+        info_.bounds.add(glm::dvec3(-1.0));
+        info_.bounds.add(glm::dvec3(1.0));
+        info_.points = 3;
+        setNodes({{laz::VoxelKey{0, 0, 0, 0}, 3}});
+    }
+
+    PointCloud load(std::size_t) const override {
+        PointCloud cloud;
+        for (const glm::dvec3 position :
+             {glm::dvec3(0.0), glm::dvec3(0.5, 0, 0), glm::dvec3(0, 0.5, 0)}) {
+            cloud.positions.emplace_back(position);
+            cloud.bounds.add(position);
+            cloud.normals.emplace_back(0.0f);
+        }
+        return cloud;
+    }
+};
+
+TEST(NodeSelectionTest, NodesWhoseNormalsAreAllZeroHaveNone) {
+    // As a whole file's: the surface was shaded flat with them.
+    const ZeroNormalSource source;
+    std::vector<std::string> warnings;
+    const std::vector<std::size_t> nodes{0};
+    const PointCloud cloud = loadNodes(source, nodes, warnings);
+    EXPECT_EQ(cloud.size(), 3u);
+    EXPECT_FALSE(cloud.hasNormals());
+    EXPECT_THAT(warnings, ::testing::ElementsAre(::testing::HasSubstr("normals are all zero")));
+}
+
 }  // namespace
 }  // namespace subscan::lod
