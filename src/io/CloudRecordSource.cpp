@@ -9,7 +9,8 @@
 #include "io/ScanLoader.h"
 
 // Inputs read whole (ASCII PLY, PCD, E57, OFF, synthetic:NAME) as records: the cloud's
-// positions are its origin plus float offsets, quantized like writeLas quantizes them.
+// positions are its origin plus float offsets, quantized like writeLas quantizes them; colour,
+// normals, intensity and classification are kept.
 namespace subscan {
 
 namespace {
@@ -43,6 +44,9 @@ class CloudRecordSource final : public PointRecordSource {
             }
             if (cloud_.hasIntensities()) {
                 point.intensity = intensityWord(cloud_.intensities[i]);
+            }
+            if (cloud_.hasClassifications()) {
+                point.classification = cloud_.classifications[i];
             }
             writer_->append(records, point);
         }

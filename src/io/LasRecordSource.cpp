@@ -325,10 +325,7 @@ class LasRecordSource final : public PointRecordSource {
             info_.wkt = wktText(*wkt);
         }
         if (info_.wkt.empty() && findLasVlr(head_, header_, kProjectionUser, kGeoKeysRecord)) {
-            info_.warnings.push_back(fmt::format(
-                "{}: its coordinate system is given only as GeoTIFF keys, which subscan does not "
-                "translate into WKT; its records go on without one",
-                info_.name));
+            info_.warnings.push_back(fmt::format("{}: {}", info_.name, kGeoKeysOnly));
         }
     }
 

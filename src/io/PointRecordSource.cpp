@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <string>
 #include <string_view>
 
@@ -14,6 +15,7 @@
 #include "io/InputFile.h"
 #include "io/RecordSourceSupport.h"
 #include "io/ScanLoader.h"
+#include "lod/NodeSource.h"
 
 namespace subscan {
 
@@ -189,6 +191,90 @@ void checkCompatible(const PointRecordSourceInfo& input, const PointRecordSource
     }
 }
 
+/// An EPT dataset as the records of its tiles: LAZ files of LAS records on the dataset's one
+/// scale and offset, merged as `index` merges LAS inputs, so every record passes unchanged.
+/// Unlike a render, which leaves out a tile it cannot read, a conversion needs every tile.
+class EptRecordSource final : public PointRecordSource {
+  public:
+    EptRecordSource(const std::filesystem::path& path, unsigned threads) {
+        const std::string name = path.string();
+        const std::unique_ptr<lod::NodeSource> ept = lod::openEpt(path);
+        std::vector<std::unique_ptr<PointRecordSource>> tiles;
+        for (const lod::StreamedNode& node : ept->nodes()) {
+            const auto fail = [&](const std::string& what) {
+                return Error(fmt::format("{}: {}: {}", name, lod::nodeName(node.key), what));
+            };
+            try {
+                tiles.push_back(
+                    openLasRecordSource(lod::eptTilePath(ept->info().name, node.key), threads));
+            } catch (const Error& error) {
+                throw fail(error.what());
+            }
+            if (tiles.back()->info().pointCount != node.pointCount) {
+                throw fail(fmt::format("its tile holds {} points, but the hierarchy says {}",
+                                       tiles.back()->info().pointCount, node.pointCount));
+            }
+        }
+        merged_ = mergePointRecordSources(std::move(tiles));
+        info_ = merged_->info();
+        info_.name = name;
+        // Writers of EPT (Entwine, PDAL) give the coordinate system in ept.json; the tiles may
+        // carry only GeoTIFF keys, or nothing.
+        const bool wktFromDescription = info_.wkt.empty() && !ept->info().wkt.empty();
+        if (wktFromDescription) {
+            info_.wkt = ept->info().wkt;
+        }
+        std::vector<std::string> warnings;
+        for (const std::string& warning : ept->info().warnings) {
+            warnings.push_back(fmt::format("{}: {}", name, warning));
+        }
+        for (std::string& warning : tileWarnings(ept->info().name, std::move(info_.warnings))) {
+            if (!(wktFromDescription && warning.find(kGeoKeysOnly) != std::string::npos)) {
+                warnings.push_back(std::move(warning));
+            }
+        }
+        info_.warnings = std::move(warnings);
+    }
+
+    const PointRecordSourceInfo& info() const override { return info_; }
+    std::size_t read(std::vector<std::byte>& records, std::size_t maxPoints) override {
+        return merged_->read(records, maxPoints);
+    }
+    void rewind() override { merged_->rewind(); }
+
+  private:
+    /// One sentence for each thing the tiles warn about: a dataset of thousands of tiles, all
+    /// written by one program, would otherwise say the same thousands of times.
+    static std::vector<std::string> tileWarnings(const std::filesystem::path& folder,
+                                                 std::vector<std::string> warnings) {
+        const std::string tiles = (folder / "ept-data").string();
+        std::vector<std::string> first;
+        std::vector<std::size_t> repeats;
+        std::map<std::string, std::size_t> seen;  // what a warning says past its tile's name
+        for (std::string& warning : warnings) {
+            const std::size_t named =
+                warning.starts_with(tiles) ? warning.find(": ", tiles.size()) : std::string::npos;
+            const std::string said = named == std::string::npos ? warning : warning.substr(named);
+            const auto [at, added] = seen.try_emplace(said, first.size());
+            if (added) {
+                first.push_back(std::move(warning));
+                repeats.push_back(0);
+            } else {
+                ++repeats[at->second];
+            }
+        }
+        for (std::size_t i = 0; i < first.size(); ++i) {
+            if (repeats[i] > 0) {
+                first[i] += fmt::format(" (and so do {} more of its tiles)", repeats[i]);
+            }
+        }
+        return first;
+    }
+
+    std::unique_ptr<PointRecordSource> merged_;
+    PointRecordSourceInfo info_;
+};
+
 }  // namespace
 
 std::size_t PointRecordFormat::recordLength() const {
@@ -200,6 +286,9 @@ std::unique_ptr<PointRecordSource> openPointRecordSource(const std::filesystem::
     const std::string name = path.string();
     if (name.starts_with(kSyntheticSource)) {
         return openCloudRecordSource(name);
+    }
+    if (lod::isEpt(path)) {
+        return std::make_unique<EptRecordSource>(path, threads);
     }
     ScanFormat format = ScanFormat::Unknown;
     try {

@@ -232,6 +232,7 @@ void ConvertedRecordWriter::append(std::vector<std::byte>& records,
     std::memcpy(record, values.data(), sizeof(values));
     std::memcpy(record + las14::kIntensity, &point.intensity, sizeof(point.intensity));
     record[las14::kReturns] = std::byte{las14::kFirstOfOneReturn};
+    record[las14::kClassification] = static_cast<std::byte>(point.classification);
     if (format_.pointFormat == 7) {
         std::memcpy(record + las14::kRgb, point.rgb.data(), sizeof(point.rgb));
     }

@@ -65,6 +65,7 @@ std::string extraBytesFieldNames(std::span<const std::byte> descriptors);
 struct ConvertedPoint {
     glm::dvec3 position{0.0};  // file coordinates
     std::uint16_t intensity = 0;
+    std::uint8_t classification = 0;  // ASPRS class; 0 is "never classified"
     std::array<std::uint16_t, 3> rgb{};
     glm::vec3 normal{0.0f};
 };
@@ -80,7 +81,7 @@ std::uint16_t colorWordFromUnit(double value);  // 0..1
 std::uint16_t intensityWord(double value);
 
 /// Turns points of an input that is not LAS (PLY, text, a cloud loaded whole) into records of
-/// format 6, or 7 with colour: return 1 of 1, class 0 (never classified), no flags, and the
+/// format 6, or 7 with colour: return 1 of 1, the point's class, no flags, and the
 /// normal as PDAL names it (float extra bytes NormalX, NormalY, NormalZ). Positions are quantized
 /// with chooseLasScaling for the input's bounds: the finest power-of-ten step that fits.
 class ConvertedRecordWriter {
@@ -111,6 +112,11 @@ PointRecordSourceInfo convertedSourceInfo(std::string name, std::uint64_t pointC
 /// The warning of a converted input whose faces point records cannot hold: they were dropped
 /// without a word where LAZ, COPC and the octree took a mesh.
 std::string facesNotKept(const std::string& name, std::uint64_t faces);
+
+/// How an input's warning ends when its coordinate system is given only as GeoTIFF keys.
+inline constexpr std::string_view kGeoKeysOnly =
+    "its coordinate system is given only as GeoTIFF keys, which subscan does not translate into "
+    "WKT; its records go on without one";
 
 /// Throws subscan::Error with `name` before the message: "name: message".
 [[noreturn]] void throwNamed(const std::string& name, const Error& error);

@@ -197,6 +197,7 @@ class EptSource final : public NodeSource {
         info_.name = folder_.string();
         info_.format = "las";  // LAZ tiles: LAS-family data (Z up)
         info_.cube = ept.cube;
+        info_.wkt = ept.wkt;
         info_.bounds = sourcesBounds(folder_).value_or(ept.bounds);
         std::vector<StreamedNode> nodes;
         readHierarchy("0-0-0-0", nodes);
@@ -223,8 +224,7 @@ class EptSource final : public NodeSource {
 
     PointCloud load(std::size_t index) const override {
         const StreamedNode& node = nodes()[index];
-        const std::filesystem::path tile =
-            folder_ / "ept-data" / fmt::format("{}.laz", eptName(node.key));
+        const std::filesystem::path tile = eptTilePath(folder_, node.key);
         const auto fail = [&](const std::string& what) {
             return Error(fmt::format("{}: {}", nodeName(node.key), what));
         };
@@ -367,6 +367,9 @@ EptDescription parseEptDescription(std::string_view text) {
         description.bounds.add({conforming[3], conforming[4], conforming[5]});
         description.points = ept.at("points").get<std::uint64_t>();
         description.version = ept.value("version", "1.0.0");
+        if (const auto srs = ept.find("srs"); srs != ept.end() && srs->is_object()) {
+            description.wkt = srs->value("wkt", "");
+        }
     } catch (const nlohmann::json::exception& error) {
         throw Error(fmt::format("is not an EPT description ({})", error.what()));
     }
@@ -459,6 +462,10 @@ std::unique_ptr<NodeSource> openCopc(const std::filesystem::path& path) {
 
 std::unique_ptr<NodeSource> openEpt(const std::filesystem::path& path) {
     return std::make_unique<EptSource>(path.filename() == "ept.json" ? path : path / "ept.json");
+}
+
+std::filesystem::path eptTilePath(const std::filesystem::path& folder, const laz::VoxelKey& key) {
+    return folder / "ept-data" / fmt::format("{}-{}-{}-{}.laz", key.level, key.x, key.y, key.z);
 }
 
 LodMode parseLodMode(std::string_view name) {

@@ -34,6 +34,7 @@ struct NodeSourceInfo {
     OctreeCube cube;           // the octree's cube and root spacing
     Bounds bounds;             // of every point, as the header (or EPT's source list) says
     std::uint64_t points = 0;  // in all nodes
+    std::string wkt;           // the coordinate system where the source gives one (EPT's srs)
     /// What was left out when opening (a hierarchy page that cannot be read), one sentence
     /// each, naming the source's part but not the source.
     std::vector<std::string> warnings;
@@ -75,6 +76,9 @@ std::unique_ptr<NodeSource> openCopc(const std::filesystem::path& path);
 /// one sentence, as are hierarchies other than JSON.
 std::unique_ptr<NodeSource> openEpt(const std::filesystem::path& path);
 
+/// The LAZ tile of an EPT dataset's node: FOLDER/ept-data/LEVEL-X-Y-Z.laz.
+std::filesystem::path eptTilePath(const std::filesystem::path& folder, const laz::VoxelKey& key);
+
 /// What an EPT dataset's ept.json says: the octree's cube (`bounds`) and root spacing (its side
 /// over `span`), the points' bounds (`boundsConforming`), their count and the version.
 struct EptDescription {
@@ -82,6 +86,7 @@ struct EptDescription {
     Bounds bounds;
     std::uint64_t points = 0;
     std::string version;
+    std::string wkt;  // "srs": {"wkt": ...}, where it is given
 };
 /// Parses ept.json's text. Throws subscan::Error (without the file's name) for what is not an
 /// EPT description, for tiles other than LAZ and for hierarchies other than JSON.

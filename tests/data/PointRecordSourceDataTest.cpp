@@ -19,6 +19,7 @@
 #include "io/LasReader.h"
 #include "io/PointRecordSource.h"
 #include "io/ReadContext.h"
+#include "io/RecordSourceSupport.h"
 #include "support/PointRecordTestSupport.h"
 #include "support/TestSupport.h"
 
@@ -177,6 +178,33 @@ TEST(PointRecordSourceDataTest, LoneStarLazAndCopcHoldTheSameRecords) {
         }
     }
     EXPECT_EQ(different, 0u);
+}
+
+TEST(PointRecordSourceDataTest, AnEptDatasetNamedByItsFolderGivesTheRecordsOfItsSource) {
+    SUBSCAN_REQUIRE_TEST_DATA(data);
+    // PDAL's lone star EPT was built from lone_star.laz: its tiles are that file's records on
+    // the dataset's grid (classification, GPS time and returns included), which converting
+    // them to a cloud and back lost.
+    const auto laz = openPointRecordSource(data / "lone_star.laz", 2);
+    const auto ept = openPointRecordSource(data / "ept" / "lone-star-laszip", 2);
+    const PointRecordSourceInfo& info = ept->info();
+    EXPECT_EQ(info.name, (data / "ept" / "lone-star-laszip").string());
+    ASSERT_EQ(info.pointCount, laz->info().pointCount);
+    ASSERT_EQ(info.format.pointFormat, 6);
+    ASSERT_EQ(info.quantization.scale, laz->info().quantization.scale);
+    // The tiles hold GeoTIFF keys only; ept.json's srs gives the WKT, so nothing is lost.
+    EXPECT_THAT(info.wkt, StartsWith("PROJCS[\"NAD83 / UTM zone 12N\""));
+    EXPECT_THAT(info.warnings, IsEmpty());
+    // Entwine adds its OriginId (the source file's number) to every record as extra bytes.
+    EXPECT_EQ(info.format.extraBytes, 4u);
+    EXPECT_EQ(extraBytesFieldNames(info.format.extraBytesDescriptors), "OriginId");
+    const glm::dvec3 grid = laz->info().quantization.offset;
+    std::vector<std::vector<std::byte>> tiles = recordsOnGrid(*ept, grid);
+    for (std::vector<std::byte>& record : tiles) {
+        record.resize(30);
+    }
+    std::sort(tiles.begin(), tiles.end());
+    EXPECT_TRUE(recordsOnGrid(*laz, grid) == tiles);
 }
 
 TEST(PointRecordSourceDataTest, LazAndCopcMergeOntoOneGridWithTheCopcCoordinateSystem) {

@@ -21,6 +21,7 @@
 #include "io/WriterSupport.h"
 #include "io/XyzWriter.h"
 #include "lod/CopcWriter.h"
+#include "lod/NodeSource.h"
 #include "lod/OctreeIndexer.h"
 
 namespace subscan::cli {
@@ -53,11 +54,14 @@ constexpr std::array<OutputFormat, 4> kOutputFormats{{
 }};
 
 /// Outputs written from LAS 1.4 point records (io/PointRecordSource.h) rather than from a
-/// loaded cloud: LAZ and COPC always, LAS when the input is LAS, LAZ or COPC, so that its
-/// integer coordinates and every attribute pass unchanged.
+/// loaded cloud: LAZ and COPC always, LAS when the input is LAS, LAZ, COPC or EPT (whose tiles
+/// are LAZ), so that its integer coordinates and every attribute pass unchanged.
 enum class RecordOutput { None, Las, Laz, Copc };
 
 bool isLasFamily(const std::string& source) {
+    if (!source.starts_with("synthetic:") && lod::isEpt(source)) {
+        return true;
+    }
     std::ifstream file(source, std::ios::binary);
     char signature[4] = {};
     return file.read(signature, 4) && std::string_view(signature, 4) == "LASF";
@@ -77,17 +81,23 @@ RecordOutput recordOutput(const std::filesystem::path& output, const std::string
     return RecordOutput::None;
 }
 
-/// Writes `source` as LAS 1.4, LAZ or COPC from its records; returns the point count.
-std::uint64_t convertRecords(const std::string& source, const std::filesystem::path& output,
-                             RecordOutput kind) {
+struct RecordsWritten {
+    std::uint64_t points = 0;
+    bool everyAttributeKept = true;  // false where a warning said what was lost
+};
+
+/// Writes `source` as LAS 1.4, LAZ or COPC from its records.
+RecordsWritten convertRecords(const std::string& source, const std::filesystem::path& output,
+                              RecordOutput kind) {
     const std::unique_ptr<PointRecordSource> records = openPointRecordSource(source);
     const PointRecordSourceInfo& info = records->info();
     printSourceWarnings(info);
+    const RecordsWritten written{info.pointCount, info.warnings.empty()};
     if (kind == RecordOutput::Copc) {
         lod::IndexSettings settings;
         settings.temporaryDirectory = std::filesystem::absolute(output).parent_path();
         lod::writeCopc(*records, output, settings);
-        return info.pointCount;
+        return written;
     }
     std::vector<std::byte> all;
     all.reserve(info.pointCount * info.format.recordLength());
@@ -98,7 +108,7 @@ std::uint64_t convertRecords(const std::string& source, const std::filesystem::p
     } else {
         writeLas14(output, info, all);
     }
-    return info.pointCount;
+    return written;
 }
 
 /// The format named by the output's extension (any case), or nullptr.
@@ -157,13 +167,14 @@ int runConvert(const ConvertOptions& options) {
                 "normals is not supported yet",
                 options.output));
         }
-        const std::uint64_t points = convertRecords(options.source, output, kind);
-        fmt::print("{}: {} points written as {} (from {}), every attribute as LAS 1.4 holds it\n",
-                   options.output, points,
+        const RecordsWritten written = convertRecords(options.source, output, kind);
+        fmt::print("{}: {} points written as {} (from {}), {}\n", options.output, written.points,
                    kind == RecordOutput::Copc  ? "COPC"
                    : kind == RecordOutput::Laz ? "LAZ 1.4"
                                                : "LAS 1.4",
-                   options.source);
+                   options.source,
+                   written.everyAttributeKept ? "every attribute as LAS 1.4 holds it"
+                                              : "less what the warnings above say");
         return 0;
     }
     const OutputFormat& format = *outputFormat(output);  // the option's check accepted it

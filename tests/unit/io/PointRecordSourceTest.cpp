@@ -22,6 +22,7 @@
 #include "core/Error.h"
 #include "io/LazWriter.h"
 #include "io/PointRecordSource.h"
+#include "io/RecordSourceSupport.h"
 #include "support/PointRecordTestSupport.h"
 #include "support/TestSupport.h"
 
@@ -756,6 +757,20 @@ TEST(PointRecordSourceTest, ScansLoadedWholeBecomeRecordsToo) {
     EXPECT_THAT(test::errorMessage([] { open("synthetic:teapot"); }), HasSubstr("teapot"));
     EXPECT_THAT(test::errorMessage([] { open("/nonexistent/scan.las"); }),
                 HasSubstr("/nonexistent/scan.las"));
+}
+
+TEST(PointRecordSourceTest, ACloudsClassificationCodesAreKept) {
+    PointCloud cloud;
+    cloud.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}};
+    cloud.classifications = {2, 6, 0};
+    const auto source = cloudRecordSource(std::move(cloud), "classified");
+    const std::vector<std::byte> records = readAllRecords(*source, 2);
+    const std::size_t length = source->info().format.recordLength();
+    ASSERT_EQ(records.size(), 3 * length);
+    const std::array<int, 3> expected{2, 6, 0};
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(std::to_integer<int>(records[i * length + las14::kClassification]), expected[i]);
+    }
 }
 
 std::vector<std::byte> bytesOf(std::string_view text) {
