@@ -22,7 +22,9 @@ namespace {
 /// GPS time, a double, at 22.
 constexpr std::size_t kReturnsByte = 14;
 constexpr std::size_t kGpsTimeOffset = 22;
-/// Global encoding bit 4: the coordinate system is WKT, as point formats 6-10 require.
+/// Global encoding bit 4: the coordinate system is WKT, as point formats 6-10 require (R15,
+/// "Coordinate Reference System VLRs"), with a WKT VLR or none: PDAL and QGIS refuse formats
+/// 6-10 without the bit.
 constexpr std::uint16_t kWktGlobalEncoding = 1u << 4;
 constexpr std::size_t kLazChunkPoints = 50'000;
 
@@ -61,7 +63,11 @@ std::vector<std::byte> las14Header(const PointRecordSourceInfo& source, const La
                                    std::string_view software) {
     std::vector<std::byte> header(las::kHeaderSize14, std::byte{0});
     std::memcpy(header.data(), "LASF", 4);
-    storeLittleEndian(header.data() + las::header_field::kGlobalEncoding, kWktGlobalEncoding);
+    storeLittleEndian(header.data() + las::header_field::kFileSourceId, source.fileSourceId);
+    storeLittleEndian(header.data() + las::header_field::kGlobalEncoding,
+                      static_cast<std::uint16_t>(
+                          kWktGlobalEncoding |
+                          (source.standardGpsTime.value_or(false) ? las::kStandardGpsTime : 0)));
     header[las::header_field::kVersionMajor] = std::byte{1};
     header[las::header_field::kVersionMinor] = std::byte{4};
     std::memcpy(header.data() + las::header_field::kSystemIdentifier, "subscan", 7);

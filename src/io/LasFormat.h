@@ -11,6 +11,7 @@ namespace subscan::las {
 
 /// Byte offsets of the public header block fields, all little-endian.
 namespace header_field {
+inline constexpr std::size_t kFileSourceId = 4;
 inline constexpr std::size_t kGlobalEncoding = 6;
 inline constexpr std::size_t kVersionMajor = 24;
 inline constexpr std::size_t kVersionMinor = 25;
@@ -33,6 +34,9 @@ inline constexpr std::size_t kEvlrCount = 243;
 inline constexpr std::size_t kPointCount64 = 247;
 inline constexpr std::size_t kReturnCounts64 = 255;  // fifteen uint64
 }  // namespace header_field
+
+/// Global encoding bit 0: GPS times are Adjusted Standard GPS time, not GPS week seconds.
+inline constexpr std::uint16_t kStandardGpsTime = 1u << 0;
 
 inline constexpr std::size_t kHeaderSizeUpTo12 = 227;
 inline constexpr std::size_t kHeaderSize13 = 235;  // adds the waveform data offset

@@ -314,6 +314,14 @@ class LasRecordSource final : public PointRecordSource {
         info_.min = header_.declaredBounds.min;
         info_.max = header_.declaredBounds.max;
         const int format = header_.pointFormat;
+        // parseLasHeader has checked that the header is whole.
+        info_.fileSourceId =
+            loadLittleEndian<std::uint16_t>(head_.data() + las::header_field::kFileSourceId);
+        if (format == 1 || format >= 3) {
+            const auto encoding =
+                loadLittleEndian<std::uint16_t>(head_.data() + las::header_field::kGlobalEncoding);
+            info_.standardGpsTime = (encoding & las::kStandardGpsTime) != 0;
+        }
         if (format == 4 || format == 5 || format >= 9) {
             info_.warnings.push_back(fmt::format(
                 "{}: point format {} carries wave packets; their descriptors (which point into "

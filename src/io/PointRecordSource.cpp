@@ -334,10 +334,29 @@ std::unique_ptr<PointRecordSource> mergePointRecordSources(
     info.quantization = first.quantization;
     info.min = first.min;
     info.max = first.max;
+    info.fileSourceId = first.fileSourceId;
     const PointRecordSourceInfo* wktSource = nullptr;
+    const PointRecordSourceInfo* gpsTimeSource = nullptr;
     for (const auto& source : sources) {
         const PointRecordSourceInfo& input = source->info();
         checkCompatible(input, first);
+        if (input.standardGpsTime) {
+            // One header bit says what every record's GPS time means.
+            if (gpsTimeSource != nullptr &&
+                input.standardGpsTime != gpsTimeSource->standardGpsTime) {
+                const auto kind = [](const PointRecordSourceInfo& s) {
+                    return *s.standardGpsTime ? "Adjusted Standard GPS time" : "GPS week seconds";
+                };
+                throwIncompatible(input, *gpsTimeSource,
+                                  fmt::format("its GPS times are {} (global encoding bit 0), "
+                                              "but they are {} in",
+                                              kind(input), kind(*gpsTimeSource)));
+            }
+            gpsTimeSource = gpsTimeSource != nullptr ? gpsTimeSource : &input;
+        }
+        if (input.fileSourceId != info.fileSourceId) {
+            info.fileSourceId = 0;
+        }
         if (!input.wkt.empty()) {
             if (wktSource != nullptr && input.wkt != wktSource->wkt) {
                 throwIncompatible(input, *wktSource,
@@ -355,6 +374,7 @@ std::unique_ptr<PointRecordSource> mergePointRecordSources(
     }
     info.name = fmt::format("{}", fmt::join(names, ", "));
     info.wkt = wktSource != nullptr ? wktSource->wkt : std::string();
+    info.standardGpsTime = gpsTimeSource != nullptr ? gpsTimeSource->standardGpsTime : std::nullopt;
 
     std::vector<MergedInput> inputs;
     for (auto& source : sources) {

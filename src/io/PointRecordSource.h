@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,13 @@ struct PointRecordSourceInfo {
     glm::dvec3 min{0.0};
     glm::dvec3 max{0.0};
     std::string wkt;  // the coordinate reference system as OGC WKT; empty when unknown
+    /// For a LAS source whose records have GPS times, its global encoding bit 0: whether they are
+    /// Adjusted Standard GPS time (else GPS week seconds). nullopt where there are no GPS times
+    /// (inputs that are not LAS, LAS point formats 0 and 2).
+    std::optional<bool> standardGpsTime;
+    /// The LAS header's file source ID (a flight line's number, say); 0, "none assigned", for
+    /// inputs that are not LAS.
+    std::uint16_t fileSourceId = 0;
     /// What was dropped or assumed on the way to records (wave packets, a coordinate system
     /// given only as GeoTIFF keys, colour filled in by a merge), one sentence each naming the
     /// input.
@@ -80,7 +88,9 @@ std::unique_ptr<PointRecordSource> cloudRecordSource(PointCloud cloud, const std
 /// one has colour, 8 when one has NIR; extra bytes must be the same fields in all) and one
 /// quantization in which every input's stored integers are kept exactly (same scales, offsets a
 /// whole number of steps apart). Inputs that cannot share them are one error sentence naming
-/// both files and the field. The WKT must agree where both inputs have one.
+/// both files and the field. The WKT must agree where both inputs have one, and so must the kind
+/// of GPS time (standard or week seconds) where both have GPS times. The file source ID is the
+/// inputs' where they all have the same, else 0 (the records keep their own point source IDs).
 std::unique_ptr<PointRecordSource> mergePointRecordSources(
     std::vector<std::unique_ptr<PointRecordSource>> sources);
 

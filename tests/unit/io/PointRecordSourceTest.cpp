@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include "core/Error.h"
+#include "io/Las14Writer.h"
 #include "io/LazWriter.h"
 #include "io/PointRecordSource.h"
 #include "io/RecordSourceSupport.h"
@@ -72,6 +73,8 @@ struct TestLas {
     std::vector<Vlr> vlrs;
     std::vector<Vlr> evlrs;  // LAS 1.4 only
     std::optional<std::uint64_t> declaredCount;
+    std::uint16_t fileSourceId = 0;
+    std::uint16_t globalEncoding = 0;
     std::vector<std::string> records;
 
     std::size_t length() const {
@@ -81,7 +84,9 @@ struct TestLas {
     std::string bytes() const {
         const std::size_t headerSize = versionMinor >= 4 ? 375 : versionMinor == 3 ? 235 : 227;
         std::string out = "LASF";
-        out.append(20, '\0');  // file source id, global encoding, GUID
+        appendBytes(out, fileSourceId);
+        appendBytes(out, globalEncoding);
+        out.append(16, '\0');  // GUID
         out.push_back(1);
         out.push_back(static_cast<char>(versionMinor));
         out.append(64, '\0');  // system identifier, generating software
@@ -977,6 +982,58 @@ TEST(PointRecordSourceTest, NearInfraredMissingFromAnInputIsZero) {
     EXPECT_EQ(first.rgb, expectedFields(7, 1, 0).rgb);
     EXPECT_EQ(first.nir, 0);
     EXPECT_EQ(recordFields(records, merged->info().format, 4).nir, expectedFields(8, 1, 0).nir);
+}
+
+}  // namespace
+}  // namespace subscan
+
+namespace subscan {
+namespace {
+
+/// A three-point file of `format` with this header's file source ID and global encoding.
+std::string lasWithHeaderIds(int format, std::uint16_t fileSourceId, std::uint16_t encoding) {
+    TestLas las = lasWithEveryField(format, 0, 3);
+    las.fileSourceId = fileSourceId;
+    las.globalEncoding = encoding;
+    return las.bytes();
+}
+
+std::uint16_t headerWord(const std::vector<std::byte>& header, std::size_t offset) {
+    std::uint16_t value = 0;
+    std::memcpy(&value, header.data() + offset, sizeof value);
+    return value;
+}
+
+TEST(PointRecordSourceTest, TheKindOfGpsTimeAndTheFileSourceIdReachTheWrittenHeader) {
+    const test::TempDir dir;
+    const auto standard = open(dir.write("standard.las", lasWithHeaderIds(1, 1234, 1)));
+    EXPECT_EQ(standard->info().standardGpsTime, std::optional<bool>(true));
+    EXPECT_EQ(standard->info().fileSourceId, 1234);
+    const std::vector<std::byte> header = las14Header(standard->info(), {}, "test");
+    EXPECT_EQ(headerWord(header, 4), 1234);    // file source ID
+    EXPECT_EQ(headerWord(header, 6), 1 | 16);  // standard GPS time, and WKT as formats 6-8 need
+    const auto week = open(dir.write("week.las", lasWithHeaderIds(3, 7, 0)));
+    EXPECT_EQ(week->info().standardGpsTime, std::optional<bool>(false));
+    EXPECT_EQ(headerWord(las14Header(week->info(), {}, "test"), 6), 16);
+    // Format 2 has no GPS times: whatever its bit 0 says means nothing.
+    const auto none = open(dir.write("none.las", lasWithHeaderIds(2, 7, 1)));
+    EXPECT_EQ(none->info().standardGpsTime, std::nullopt);
+}
+
+TEST(PointRecordSourceTest, AMergeKeepsTheKindOfGpsTimeAndACommonFileSourceId) {
+    const test::TempDir dir;
+    const auto a = dir.write("a.las", lasWithHeaderIds(1, 5, 1));
+    const auto b = dir.write("b.las", lasWithHeaderIds(3, 5, 1));
+    const auto c = dir.write("c.las", lasWithHeaderIds(6, 6, 1));
+    const auto noTimes = dir.write("d.las", lasWithHeaderIds(2, 5, 0));
+    const auto same = mergePointRecordSources(openAll({a, b, noTimes}));
+    EXPECT_EQ(same->info().standardGpsTime, std::optional<bool>(true));
+    EXPECT_EQ(same->info().fileSourceId, 5);
+    EXPECT_EQ(mergePointRecordSources(openAll({a, c}))->info().fileSourceId, 0);
+    const auto week = dir.write("week.las", lasWithHeaderIds(1, 5, 0));
+    EXPECT_THAT(mergeError({a, week}),
+                AllOf(HasSubstr(week.string()), HasSubstr(a.string()),
+                      HasSubstr("GPS week seconds"), HasSubstr("global encoding bit 0")));
 }
 
 }  // namespace
