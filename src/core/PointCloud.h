@@ -59,6 +59,9 @@ struct PointCloud {
     std::vector<std::uint8_t> classifications;  // ASPRS LAS class codes (LAS files only)
     std::vector<Triangle> triangles;            // vertex indices; ground-truth meshes only
     Bounds bounds;                              // exact, in file coordinates
+    /// The finest step of the grid the file stored coordinates on (a LAS file's scale); 0 where
+    /// the file does not say (floats, doubles, text).
+    double coordinateStep = 0.0;
 
     std::size_t size() const { return positions.size(); }
     bool hasColors() const { return !colors.empty(); }

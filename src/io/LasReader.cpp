@@ -520,7 +520,10 @@ PointCloud lasRecordsToCloud(std::span<const std::byte> head, const LasHeader& h
             break;
     }
     context.reportProgress(count, count);
-    return builder.finish(warnings);
+    PointCloud cloud = builder.finish(warnings);
+    const glm::dvec3 step = glm::abs(header.scale);
+    cloud.coordinateStep = std::min({step.x, step.y, step.z});
+    return cloud;
 }
 
 PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {

@@ -1,14 +1,28 @@
 #include "io/WriterSupport.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace subscan {
 
 namespace {
 
-/// Relative rounding error of float coordinates we accept, as a fraction of the extent.
+/// Without a grid of the file's own, float output may round by this fraction of the extent: a
+/// micrometre on a metre-sized object scan, whose float files are no finer.
 constexpr double kFloatErrorFraction = 1e-6;
+
+/// How far rounding a coordinate of this magnitude to float moves it at most: half a step.
+double floatRounding(double magnitude) {
+    const auto value = static_cast<float>(magnitude);
+    return 0.5 *
+           static_cast<double>(std::nextafter(value, std::numeric_limits<float>::max()) - value);
+}
+
+double largestComponent(const glm::dvec3& a, const glm::dvec3& b) {
+    const glm::dvec3 magnitude = glm::max(glm::abs(a), glm::abs(b));
+    return std::max({magnitude.x, magnitude.y, magnitude.z});
+}
 
 }  // namespace
 
@@ -16,14 +30,17 @@ bool needsDoubleCoordinates(const PointCloud& cloud) {
     if (cloud.size() == 0 || cloud.bounds.empty()) {
         return false;
     }
-    const glm::dvec3 magnitude = glm::max(glm::abs(cloud.bounds.min), glm::abs(cloud.bounds.max));
-    const double largest = std::max({magnitude.x, magnitude.y, magnitude.z});
+    const double written = floatRounding(largestComponent(cloud.bounds.min, cloud.bounds.max));
     const glm::dvec3 extent = cloud.bounds.extent();
     const double size = std::max({extent.x, extent.y, extent.z});
-    // Rounding to float moves a coordinate by up to half a float step at the largest magnitude.
-    const double floatError =
-        0.5 * largest * static_cast<double>(std::numeric_limits<float>::epsilon());
-    return floatError > kFloatErrorFraction * size;
+    const double inMemory = floatRounding(
+        largestComponent(cloud.bounds.min - cloud.origin, cloud.bounds.max - cloud.origin));
+    // On a file's grid, less than half a step still rounds back to the stored integer; what
+    // memory already lost (floats relative to the centre) cannot be kept by doubles either.
+    const double allowed = cloud.coordinateStep > 0.0
+                               ? std::max(0.5 * cloud.coordinateStep, inMemory)
+                               : std::max(kFloatErrorFraction * size, inMemory);
+    return written > allowed;
 }
 
 bool hasTranslucentColors(const PointCloud& cloud) {

@@ -111,6 +111,23 @@ TEST(PlyWriterTest, FloatIsChosenWhileItKeepsAMillionthOfTheExtent) {
     EXPECT_TRUE(needsDoubleCoordinates(everyAttribute({1e5, 0.0, 0.0}, 1.0)));
 }
 
+TEST(PlyWriterTest, DoublesAreChosenWhereFloatLosesTheFilesGrid) {
+    // A LAS survey of 1 cm steps, 200 km wide, 850 km east: float rounds by 6 cm there. The old
+    // rule, a millionth of the extent (20 cm), took float.
+    PointCloud wide = everyAttribute({850000.0, 0.0, 100.0}, 200000.0);
+    EXPECT_FALSE(needsDoubleCoordinates(wide));  // without a grid: a millionth, 20 cm
+    wide.coordinateStep = 0.01;
+    EXPECT_TRUE(needsDoubleCoordinates(wide));
+    // 2 km at the origin, on a 1 cm grid: float's 61 microns round back to the same steps.
+    PointCloud near = everyAttribute({0.0, 0.0, 0.0}, 2000.0);
+    near.coordinateStep = 0.01;
+    EXPECT_FALSE(needsDoubleCoordinates(near));
+    // The same on a 0.1 mm grid 2 km from the origin: half a step is 50 microns, float's 122.
+    PointCloud fine = everyAttribute({2000.0, 0.0, 0.0}, 2000.0);
+    fine.coordinateStep = 1e-4;
+    EXPECT_TRUE(needsDoubleCoordinates(fine));
+}
+
 TEST(PlyWriterTest, PositionsOnlyAndNoFaces) {
     const test::TempDir dir;
     PointCloudBuilder builder({}, 2);
