@@ -20,7 +20,7 @@ struct Field {
 };
 
 /// The header; the fields in the order writePcd writes their values.
-std::string header(const PointCloud& cloud, bool doubles) {
+std::string header(const PointCloud& cloud, bool doubles, const glm::dvec3& viewpoint) {
     const int coordinateSize = doubles ? 8 : 4;
     std::vector<Field> fields{
         {"x", coordinateSize, 'F'}, {"y", coordinateSize, 'F'}, {"z", coordinateSize, 'F'}};
@@ -44,17 +44,19 @@ std::string header(const PointCloud& cloud, bool doubles) {
     return fmt::format(
         "# .PCD v0.7 - Point Cloud Data file format (written by subscan)\n"
         "VERSION 0.7\nFIELDS{}\nSIZE{}\nTYPE{}\nCOUNT{}\nWIDTH {}\nHEIGHT 1\n"
-        "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {}\nDATA binary\n",
-        names, sizes, types, counts, cloud.size(), cloud.size());
+        "VIEWPOINT {:.17g} {:.17g} {:.17g} 1 0 0 0\nPOINTS {}\nDATA binary\n",
+        names, sizes, types, counts, cloud.size(), viewpoint.x, viewpoint.y, viewpoint.z,
+        cloud.size());
 }
 
 }  // namespace
 
-void writePcd(const std::filesystem::path& path, const PointCloud& cloud) {
+void writePcd(const std::filesystem::path& path, const PointCloud& cloud,
+              std::optional<glm::dvec3> viewpoint) {
     const bool doubles = needsDoubleCoordinates(cloud);
     writeFileAtomically(path, [&](std::ostream& stream) {
         ChunkedOutput out(stream);
-        out.buffer() = header(cloud, doubles);
+        out.buffer() = header(cloud, doubles, viewpoint.value_or(glm::dvec3(0.0)));
         for (std::size_t i = 0; i < cloud.size(); ++i) {
             out.appendPosition(cloud.fileCoordinates(i), doubles);
             if (cloud.hasColors()) {

@@ -57,8 +57,8 @@ TEST(ConvertCommandTest, SyntheticSceneToEveryFormatAndBack) {
         EXPECT_EQ(read.cloud.colors, original.cloud.colors);
         if (name.ends_with(".las")) {
             EXPECT_FALSE(read.cloud.hasNormals());
-            EXPECT_THAT(result.err,
-                        HasSubstr("warning: " + output.string() + ": LAS 1.2 cannot hold normals"));
+            EXPECT_THAT(result.err, HasSubstr("warning: " + output.string() +
+                                              ": LAS 1.2 output holds no normals"));
         } else {
             EXPECT_EQ(read.cloud.normals, original.cloud.normals);
             EXPECT_TRUE(result.err.empty()) << result.err;
@@ -93,6 +93,13 @@ TEST(ConvertCommandTest, EstimatedNormalsReplaceTheFilesAndFollowTheSurface) {
     EXPECT_EQ(test::lineCount(refused.err), 1u) << refused.err;
     EXPECT_THAT(refused.err, HasSubstr("cannot hold normals"));
     EXPECT_FALSE(std::filesystem::exists(las));
+    // LAZ holds normals as extra bytes, but writes records, not estimates: the way there named.
+    const auto laz = dir / "sphere.laz";
+    const test::CommandResult twoSteps =
+        runSubscan({"convert", source, "-o", laz.string(), "--estimate-normals"});
+    EXPECT_EQ(twoSteps.exitCode, 1);
+    EXPECT_THAT(twoSteps.err, HasSubstr("then that PLY to LAZ or COPC"));
+    EXPECT_FALSE(std::filesystem::exists(laz));
 }
 
 TEST(ConvertCommandTest, NormalsSurviveLazAndCopcAsPdalsExtraBytes) {
@@ -170,8 +177,9 @@ TEST(ConvertCommandTest, ClassificationSurvivesLasToLasAndIsNamedWhereItCannot) 
     const test::CommandResult ply =
         runSubscan({"convert", source.string(), "-o", (dir / "a.ply").string()});
     ASSERT_EQ(ply.exitCode, 0) << ply.err;
-    EXPECT_THAT(ply.err, HasSubstr("warning: " + (dir / "a.ply").string() +
-                                   ": PLY cannot hold classification codes; they are not written"));
+    EXPECT_THAT(ply.err,
+                HasSubstr("warning: " + (dir / "a.ply").string() +
+                          ": PLY output holds no classification codes; they are not written"));
 }
 
 TEST(ConvertCommandTest, AMeshsFacesDroppedByLazAreNamed) {
@@ -199,6 +207,24 @@ TEST(ConvertCommandTest, AMeshsFacesDroppedByLazAreNamed) {
         ASSERT_EQ(result.exitCode, 0) << result.err;
         EXPECT_THAT(result.err, HasSubstr(input.string() + ": its faces (1) are not kept"));
     }
+}
+
+TEST(ConvertCommandTest, APcdKeepsItsSensorAndNamesTheGridItDrops) {
+    // A 2 x 2 organised cloud whose sensor stood 10 below it: the PCD written keeps the sensor
+    // (it was always the origin) and says that the grid is not kept (it was dropped unsaid).
+    const test::TempDir dir;
+    const auto input = dir.write("grid.pcd",
+                                 "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                                 "WIDTH 2\nHEIGHT 2\nVIEWPOINT 0.5 0.5 -10 1 0 0 0\nPOINTS 4\n"
+                                 "DATA ascii\n0 0 0\n1 0 0\n0 1 0\n1 1 0.1\n");
+    const auto output = dir / "list.pcd";
+    const test::CommandResult result =
+        runSubscan({"convert", input.string(), "-o", output.string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("the input's organised grid (2 x 2) is not kept"));
+    const LoadedScan read = loadScan(output.string());
+    ASSERT_TRUE(read.sensor.has_value());
+    EXPECT_EQ(read.sensor->position, glm::dvec3(0.5, 0.5, -10));
 }
 
 TEST(ConvertCommandTest, UnknownExtensionIsAUsageError) {

@@ -40,17 +40,29 @@ struct ConvertOptions {
 struct OutputFormat {
     std::string_view extension;  // lowercase
     std::string_view name;
-    void (*write)(const std::filesystem::path&, const PointCloud&);
+    void (*write)(const std::filesystem::path&, const LoadedScan&);
     bool normals;
     bool alphaAndFaces;
     bool classification;
 };
 
 constexpr std::array<OutputFormat, 4> kOutputFormats{{
-    {".ply", "PLY", writePly, true, true, false},
-    {".las", "LAS 1.2", writeLas, false, false, true},
-    {".pcd", "PCD", writePcd, true, false, false},
-    {".xyz", "XYZ text", writeXyz, true, false, false},
+    {".ply", "PLY",
+     [](const std::filesystem::path& path, const LoadedScan& scan) { writePly(path, scan.cloud); },
+     true, true, false},
+    {".las", "LAS 1.2",
+     [](const std::filesystem::path& path, const LoadedScan& scan) { writeLas(path, scan.cloud); },
+     false, false, true},
+    // The PCD VIEWPOINT is where the scan's sensor stood, where the input says.
+    {".pcd", "PCD",
+     [](const std::filesystem::path& path, const LoadedScan& scan) {
+         writePcd(path, scan.cloud,
+                  scan.sensor ? std::optional(scan.sensor->position) : std::nullopt);
+     },
+     true, false, false},
+    {".xyz", "XYZ text",
+     [](const std::filesystem::path& path, const LoadedScan& scan) { writeXyz(path, scan.cloud); },
+     true, false, false},
 }};
 
 /// Outputs written from LAS 1.4 point records (io/PointRecordSource.h) rather than from a
@@ -131,11 +143,18 @@ std::string supportedExtensions() {
 
 /// Data is dropped only with a warning, as loaders warn about what they could not read.
 void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& format,
-                               const PointCloud& cloud) {
+                               const LoadedScan& scan) {
+    const PointCloud& cloud = scan.cloud;
     const auto warn = [&](std::string_view what) {
-        fmt::print(stderr, "subscan: warning: {}: {} cannot hold {}; they are not written\n",
+        fmt::print(stderr, "subscan: warning: {}: {} output holds no {}; they are not written\n",
                    output, format.name, what);
     };
+    if (!scan.grid.empty()) {
+        fmt::print(stderr,
+                   "subscan: warning: {}: the input's organised grid ({} x {}) is not kept: the "
+                   "points are written as a list\n",
+                   output, scan.grid.width, scan.grid.height);
+    }
     if (cloud.hasNormals() && !format.normals) {
         warn("normals");
     }
@@ -163,8 +182,9 @@ int runConvert(const ConvertOptions& options) {
         kind != RecordOutput::None) {
         if (options.estimateNormals) {
             throw Error(fmt::format(
-                "{}: --estimate-normals writes PLY, PCD or XYZ; LAS, LAZ and COPC output with "
-                "normals is not supported yet",
+                "{}: --estimate-normals writes PLY, PCD or XYZ; for LAZ or COPC with estimated "
+                "normals convert to PLY with --estimate-normals, then that PLY to LAZ or COPC "
+                "(its normals become the extra bytes NormalX, NormalY, NormalZ)",
                 options.output));
         }
         const RecordsWritten written = convertRecords(options.source, output, kind);
@@ -193,8 +213,8 @@ int runConvert(const ConvertOptions& options) {
         }
         scan.cloud.normals = estimateNormals(scan.cloud, sensor);
     }
-    format.write(output, scan.cloud);
-    warnAboutWhatIsNotWritten(options.output, format, scan.cloud);
+    format.write(output, scan);
+    warnAboutWhatIsNotWritten(options.output, format, scan);
     fmt::print("{}: {} points written as {} (from {})\n", options.output, scan.cloud.size(),
                format.name, options.source);
     return 0;

@@ -54,6 +54,20 @@ TEST(PcdWriterTest, UtmCloudIsWrittenWithDoublesAndReadsBack) {
     EXPECT_EQ(read.cloud.normals, cloud.normals);
 }
 
+TEST(PcdWriterTest, TheSensorIsTheViewpoint) {
+    // A scan's sensor written as VIEWPOINT, read back as the sensor: it was always the origin,
+    // so normals estimated from the written file faced another point (found from outside).
+    const test::TempDir dir;
+    const PointCloud cloud = test::utmCloudWithEveryAttribute();
+    const glm::dvec3 sensor(500001.25, 5400002.5, 31.75);
+    const auto path = dir / "seen.pcd";
+    writePcd(path, cloud, sensor);
+    EXPECT_THAT(headerOf(path), HasSubstr("VIEWPOINT 500001.25 5400002.5 31.75 1 0 0 0\n"));
+    const LoadedScan read = loadScan(path.string());
+    ASSERT_TRUE(read.sensor.has_value());
+    EXPECT_EQ(read.sensor->position, sensor);  // printed with 17 digits: exact
+}
+
 TEST(PcdWriterTest, SmallCoordinatesAreFloatAndOnlyPresentFieldsAreWritten) {
     const test::TempDir dir;
     PointCloudBuilder builder({.color = true}, 2);
