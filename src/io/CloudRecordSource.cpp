@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +73,10 @@ class CloudRecordSource final : public PointRecordSource {
         if (!cloud_.triangles.empty()) {
             info_.warnings.push_back(facesNotKept(source, cloud_.triangles.size()));
             cloud_.triangles = {};
+        }
+        if (!std::all_of(cloud_.intensities.begin(), cloud_.intensities.end(),
+                         [](float value) { return fitsIntensityWord(value); })) {
+            info_.warnings.push_back(intensitiesNotKept(source));
         }
     }
 

@@ -83,7 +83,8 @@ class PlyRecordSource final : public PointRecordSource {
         // The first pass, over every vertex, also tells how to read the colour, as the
         // whole-file reader decides it.
         bool largeColorValues = false;
-        const Bounds bounds = findBounds(vertex, largeColorValues);
+        bool intensitiesFit = true;
+        const Bounds bounds = findBounds(vertex, largeColorValues, intensitiesFit);
         if (layout_.color) {
             for (int k = 0; k < 3; ++k) {
                 colorScales_[k] =
@@ -96,6 +97,9 @@ class PlyRecordSource final : public PointRecordSource {
             if (element.name == "face" && element.count > 0) {
                 info_.warnings.push_back(facesNotKept(info_.name, element.count));
             }
+        }
+        if (!intensitiesFit) {
+            info_.warnings.push_back(intensitiesNotKept(info_.name));
         }
     }
 
@@ -138,8 +142,9 @@ class PlyRecordSource final : public PointRecordSource {
                 access_.value(vertex, layout_.position[2])};
     }
 
-    /// Also sets `largeColorValues` when a colour value is large (isLargePlyColorValue).
-    Bounds findBounds(const PlyElement& vertex, bool& largeColorValues) {
+    /// Also sets `largeColorValues` when a colour value is large (isLargePlyColorValue), and
+    /// clears `intensitiesFit` when an intensity does not fit LAS's (fitsIntensityWord).
+    Bounds findBounds(const PlyElement& vertex, bool& largeColorValues, bool& intensitiesFit) {
         const std::vector<std::size_t> colorChannels = layout_.colorChannels();
         Bounds bounds;
         forEachVertex(0, static_cast<std::size_t>(vertexCount_),
@@ -159,6 +164,10 @@ class PlyRecordSource final : public PointRecordSource {
                               largeColorValues =
                                   largeColorValues ||
                                   isLargePlyColorValue(access_.types[c], access_.value(data, c));
+                          }
+                          if (layout_.intensity) {
+                              intensitiesFit = intensitiesFit && fitsIntensityWord(access_.value(
+                                                                     data, *layout_.intensity));
                           }
                       });
         return bounds;

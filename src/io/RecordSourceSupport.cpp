@@ -180,6 +180,17 @@ std::uint16_t intensityWord(double value) {
     return clampedWord(value, 65535.0);
 }
 
+bool fitsIntensityWord(double value) {
+    return value >= 0.0 && value <= 65535.0 && value == std::floor(value);
+}
+
+std::string intensitiesNotKept(const std::string& name) {
+    return fmt::format(
+        "{}: its intensities are not all whole numbers within 0..65535, which LAS holds: they "
+        "are written rounded and clamped to that range",
+        name);
+}
+
 ConvertedRecordWriter::ConvertedRecordWriter(bool color, bool normals, const Bounds& bounds)
     : normals_(normals) {
     format_.pointFormat = color ? 7 : 6;

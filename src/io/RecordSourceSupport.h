@@ -79,6 +79,11 @@ std::uint16_t colorWordFromWord(double value);
 std::uint16_t colorWordFromUnit(double value);  // 0..1
 /// Intensity as writeLas stores it: rounded and clamped to 0..65535.
 std::uint16_t intensityWord(double value);
+/// Whether intensityWord keeps `value` as it is: a whole number within 0..65535.
+bool fitsIntensityWord(double value);
+/// The warning for a source whose intensities do not all fit (a scanner's 0..1 confidence, a
+/// Leica PTS file's -2048..2047): written rounded and clamped.
+std::string intensitiesNotKept(const std::string& name);
 
 /// Turns points of an input that is not LAS (PLY, text, a cloud loaded whole) into records of
 /// format 6, or 7 with colour: return 1 of 1, the point's class, no flags, and the

@@ -109,11 +109,15 @@ class TextRecordSource final : public PointRecordSource {
         Bounds bounds;
         std::uint64_t count = 0;
         TextColorRange colors;
+        bool intensitiesFit = true;
         parseAll([&](std::span<const double> values, std::size_t line) {
             if (layout.color) {
                 for (const std::size_t column : *layout.color) {
                     colors.add(values[column]);
                 }
+            }
+            if (layout.intensity) {
+                intensitiesFit = intensitiesFit && fitsIntensityWord(values[*layout.intensity]);
             }
             const glm::dvec3 p = position(values);
             for (int axis = 0; axis < 3; ++axis) {
@@ -131,9 +135,12 @@ class TextRecordSource final : public PointRecordSource {
         }
         colorEncoding_ = layout.colorEncodingFromName ? layout.colorEncoding : colors.encoding();
         writer_.emplace(layout.color.has_value(), layout.normal.has_value(), bounds);
-        const std::vector<std::string> warnings = std::move(info_.warnings);
+        std::vector<std::string> warnings = std::move(info_.warnings);
+        if (!intensitiesFit) {
+            warnings.push_back(intensitiesNotKept(info_.name));
+        }
         info_ = convertedSourceInfo(info_.name, count, *writer_, bounds);
-        info_.warnings = warnings;
+        info_.warnings = std::move(warnings);
         rewind();
     }
 

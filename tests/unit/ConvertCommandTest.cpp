@@ -227,6 +227,22 @@ TEST(ConvertCommandTest, APcdKeepsItsSensorAndNamesTheGridItDrops) {
     EXPECT_EQ(read.sensor->position, glm::dvec3(0.5, 0.5, -10));
 }
 
+TEST(ConvertCommandTest, IntensitiesLasCannotHoldAreNamed) {
+    // Rounded and clamped to LAS's whole 0..65535 without a word, while LAZ's line said every
+    // attribute was kept (found by the outside hunt).
+    const test::TempDir dir;
+    const auto input = dir.write("confidence.xyz", "x y z i\n0 0 0 0.25\n1 0 0 0.5\n0 1 0 1\n");
+    for (const char* name : {"out.las", "out.laz"}) {
+        const test::CommandResult result =
+            runSubscan({"convert", input.string(), "-o", (dir / name).string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        EXPECT_THAT(result.err, HasSubstr("intensities are not all whole numbers within "
+                                          "0..65535, which LAS holds"))
+            << name;
+        EXPECT_THAT(result.out, ::testing::Not(HasSubstr("every attribute"))) << name;
+    }
+}
+
 TEST(ConvertCommandTest, UnknownExtensionIsAUsageError) {
     const test::TempDir dir;
     const auto output = dir / "sphere.obj";

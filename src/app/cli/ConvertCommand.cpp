@@ -17,6 +17,7 @@
 #include "io/LasWriter.h"
 #include "io/PcdWriter.h"
 #include "io/PlyWriter.h"
+#include "io/RecordSourceSupport.h"
 #include "io/TextParsing.h"
 #include "io/WriterSupport.h"
 #include "io/XyzWriter.h"
@@ -149,6 +150,12 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
         fmt::print(stderr, "subscan: warning: {}: {} output holds no {}; they are not written\n",
                    output, format.name, what);
     };
+    // LAS holds whole intensities in 0..65535 (writeLas rounds and clamps the others).
+    if (format.extension == ".las" &&
+        !std::all_of(cloud.intensities.begin(), cloud.intensities.end(),
+                     [](float value) { return fitsIntensityWord(value); })) {
+        fmt::print(stderr, "subscan: warning: {}\n", intensitiesNotKept(output));
+    }
     if (!scan.grid.empty()) {
         fmt::print(stderr,
                    "subscan: warning: {}: the input's organised grid ({} x {}) is not kept: the "

@@ -602,6 +602,37 @@ TEST(PointRecordSourceTest, AsciiPlyIsLoadedWholeWithTheSameRecords) {
     }
 }
 
+TEST(PointRecordSourceTest, IntensitiesLasCannotHoldAreNamed) {
+    // A scanner's 0..1 confidence and a Leica PTS file's -2048..2047 were written rounded and
+    // clamped without a word (the bunny's 7,277 intensities became 0 and 1): each kind of
+    // source says so, and whole numbers within 0..65535 pass without a word.
+    const test::TempDir dir;
+    auto intensityWarnings = [](const PointRecordSource& source) {
+        int count = 0;
+        for (const std::string& warning : source.info().warnings) {
+            count += warning.find("intensities are not all whole numbers") != std::string::npos;
+        }
+        return count;
+    };
+    std::vector<std::array<float, 10>> whole = plyVertices(20);
+    for (std::size_t i = 0; i < whole.size(); ++i) {
+        whole[i][9] = static_cast<float>(1000 * i);
+    }
+    EXPECT_EQ(intensityWarnings(*open(dir.write("whole.ply", binaryPly(whole)))), 0);
+    EXPECT_EQ(intensityWarnings(*open(dir.write("fraction.ply", binaryPly(plyVertices(20))))), 1);
+    EXPECT_EQ(intensityWarnings(*open(dir.write("whole.xyz", "x y z i\n0 0 0 7\n1 0 0 65535\n"))),
+              0);
+    EXPECT_EQ(intensityWarnings(*open(dir.write("pts.xyz", "x y z i\n0 0 0 -2048\n1 0 0 2047\n"))),
+              1);
+    // Loaded whole (ascii PLY).
+    EXPECT_EQ(intensityWarnings(
+                  *open(dir.write("ascii.ply",
+                                  "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                  "property float y\nproperty float z\nproperty float intensity\n"
+                                  "end_header\n0 0 0 0.25\n1 0 0 0.5\n"))),
+              1);
+}
+
 /// A binary PLY of float x y z and colour channels of `type`, one vertex per colour.
 template <class Channel>
 std::string binaryColorPly(const char* type, const std::vector<std::array<Channel, 3>>& colors) {
