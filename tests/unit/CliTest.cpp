@@ -55,8 +55,9 @@ TEST(CliTest, ACameraFileExcludesTheOptionsItFixes) {
     }
 }
 
-TEST(CliTest, OptionsThePictureWouldIgnoreAreRefusedOrNamed) {
-    // All were accepted and ignored without a word (found by an outside test).
+TEST(CliTest, OptionsTheViewWouldIgnoreAreRefused) {
+    // Accepted and ignored without a word (found by an outside test). Those the mode ignores
+    // are named in a warning: RenderCommandGLTest, since those pictures are drawn.
     const test::TempDir dir;
     const std::string out = (dir / "x.png").string();
     auto render = [&](std::vector<std::string> options) {
@@ -76,19 +77,6 @@ TEST(CliTest, OptionsThePictureWouldIgnoreAreRefusedOrNamed) {
     EXPECT_EQ(sensorAlone.exitCode, 1);
     EXPECT_THAT(sensorAlone.err, HasSubstr("add --view sensor"));
     EXPECT_FALSE(std::filesystem::exists(out));
-    // A mode's own options in another mode: drawn, with a warning (--save-settings keeps them).
-    const test::CommandResult material = render({"--mode", "surface", "--material", "skin1"});
-    EXPECT_EQ(material.exitCode, 0) << material.err;
-    EXPECT_THAT(material.err,
-                HasSubstr("--material sets the subsurface scattering of the sss mode: it has no "
-                          "effect on the surface mode's picture"));
-    const test::CommandResult size = render({"--mode", "points", "--point-size", "4"});
-    EXPECT_EQ(size.exitCode, 0) << size.err;
-    EXPECT_THAT(size.err, HasSubstr("--point-size is the splats' size"));
-    const test::CommandResult used =
-        render({"--mode", "sss", "--material", "skin1", "--point-size", "4"});
-    EXPECT_EQ(used.exitCode, 0) << used.err;
-    EXPECT_THAT(used.err, ::testing::Not(HasSubstr("--material")));
 }
 
 TEST(CliTest, InfoJsonHasExactlyTheDocumentedKeys) {
