@@ -98,6 +98,13 @@ TEST(RealScansDataTest, InfoGivesExactCountsOrTheClearRefusal) {
         const nlohmann::json json = info(file);
         EXPECT_EQ(json["points"], expected.points);
         EXPECT_EQ(json["faces"], expected.faces);
+        // "format" names the reader, "las" for LAZ and COPC too; the detail tells them apart.
+        const std::string name = expected.file;
+        if (name.ends_with(".laz")) {
+            EXPECT_EQ(json["format"], "las");
+            EXPECT_THAT(json["format_detail"].get<std::string>(),
+                        HasSubstr(name.ends_with(".copc.laz") ? "COPC" : "LAZ"));
+        }
     }
 }
 

@@ -87,10 +87,11 @@ TEST(CliTest, InfoJsonHasExactlyTheDocumentedKeys) {
     for (const auto& [key, value] : info.items()) {
         keys.push_back(key);
     }
-    EXPECT_THAT(keys,
-                ::testing::UnorderedElementsAre("format", "points", "bounds_min", "bounds_max",
-                                                "attributes", "faces", "spacing", "load_ms"));
+    EXPECT_THAT(keys, ::testing::UnorderedElementsAre("format", "format_detail", "points",
+                                                      "bounds_min", "bounds_max", "attributes",
+                                                      "faces", "spacing", "load_ms"));
     EXPECT_EQ(info["format"], "synthetic");
+    EXPECT_THAT(info["format_detail"].get<std::string>(), HasSubstr("sphere"));
     EXPECT_EQ(info["points"], 4000);
     // A virtual scan: the scene's colour and the true normals.
     EXPECT_EQ(info["attributes"], nlohmann::json({"position", "color", "normal"}));

@@ -107,6 +107,9 @@ int runInfo(const InfoOptions& options) {
     if (options.json) {
         nlohmann::json info = {
             {"format", scan.format},
+            // "las" stands for LAS, LAZ, COPC and EPT alike (it says how points are read): the
+            // text line, as the plain output prints it, tells them apart.
+            {"format_detail", scan.formatDetail},
             {"points", summary.points},
             {"bounds_min", {lo.x, lo.y, lo.z}},
             {"bounds_max", {hi.x, hi.y, hi.z}},
