@@ -74,8 +74,7 @@ class CloudRecordSource final : public PointRecordSource {
             info_.warnings.push_back(facesNotKept(source, cloud_.triangles.size()));
             cloud_.triangles = {};
         }
-        if (!std::all_of(cloud_.intensities.begin(), cloud_.intensities.end(),
-                         [](float value) { return fitsIntensityWord(value); })) {
+        if (!fitIntensityWords(cloud_.intensities)) {
             info_.warnings.push_back(intensitiesNotKept(source));
         }
     }

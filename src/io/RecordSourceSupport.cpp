@@ -184,6 +184,11 @@ bool fitsIntensityWord(double value) {
     return value >= 0.0 && value <= 65535.0 && value == std::floor(value);
 }
 
+bool fitIntensityWords(std::span<const float> intensities) {
+    return std::all_of(intensities.begin(), intensities.end(),
+                       [](float value) { return fitsIntensityWord(value); });
+}
+
 std::string intensitiesNotKept(const std::string& name) {
     return fmt::format(
         "{}: its intensities are not all whole numbers within 0..65535, which LAS holds: they "

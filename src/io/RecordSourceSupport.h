@@ -81,6 +81,8 @@ std::uint16_t colorWordFromUnit(double value);  // 0..1
 std::uint16_t intensityWord(double value);
 /// Whether intensityWord keeps `value` as it is: a whole number within 0..65535.
 bool fitsIntensityWord(double value);
+/// Whether it keeps every one of a cloud's intensities.
+bool fitIntensityWords(std::span<const float> intensities);
 /// The warning for a source whose intensities do not all fit (a scanner's 0..1 confidence, a
 /// Leica PTS file's -2048..2047): written rounded and clamped.
 std::string intensitiesNotKept(const std::string& name);

@@ -151,9 +151,7 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
                    output, format.name, what);
     };
     // LAS holds whole intensities in 0..65535 (writeLas rounds and clamps the others).
-    if (format.extension == ".las" &&
-        !std::all_of(cloud.intensities.begin(), cloud.intensities.end(),
-                     [](float value) { return fitsIntensityWord(value); })) {
+    if (format.extension == ".las" && !fitIntensityWords(cloud.intensities)) {
         fmt::print(stderr, "subscan: warning: {}\n", intensitiesNotKept(output));
     }
     if (!scan.grid.empty()) {
