@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 #include <system_error>
+#include <utility>
 
 #include <fmt/format.h>
 #include <glm/common.hpp>
@@ -124,6 +125,7 @@ void addResolutionOption(CLI::App& command, std::string& resolution) {
 }
 
 void ScatteringOptions::add(CLI::App& command) {
+    const std::size_t before = command.get_options().size();
     command
         .add_option("--scattering", method,
                     "Light transport of the sss mode: gaussian (blur of the diffuse light) | "
@@ -164,6 +166,9 @@ void ScatteringOptions::add(CLI::App& command) {
                     "Where single scattering finds a directional light's entry: light_map (the "
                     "light's own reconstruction, default) | screen (a march through the camera's)")
         ->check(CLI::IsMember({"screen", "light_map"}));
+    // The options just added: CLI11 keeps a command's options in the order they were added.
+    const std::vector<const CLI::Option*> all = std::as_const(command).get_options();
+    added.assign(all.begin() + static_cast<std::ptrdiff_t>(before), all.end());
 }
 
 void ScatteringOptions::apply(ScatteringSettings& settings) const {

@@ -84,6 +84,7 @@ struct ScatteringOptions {
     std::optional<float> phaseG;
     std::optional<int> singleSamples;
     std::string lightPath;
+    std::vector<const CLI::Option*> added;  // by add(): which of them were given
 
     void add(CLI::App& command);
     /// Writes the given options over `settings`; throws subscan::Error naming the option or the

@@ -33,10 +33,8 @@ glm::vec3 parseBackground(const std::string& text) {
 void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
     defaultMode = modeByDefault;
     command.add_option("scan", source, "Scan file, or synthetic:NAME")->required();
-    widthOption =
-        command.add_option("--width", width, "Image width in pixels")->check(CLI::Range(1, 65536));
-    heightOption = command.add_option("--height", height, "Image height in pixels")
-                       ->check(CLI::Range(1, 65536));
+    command.add_option("--width", width, "Image width in pixels")->check(CLI::Range(1, 65536));
+    command.add_option("--height", height, "Image height in pixels")->check(CLI::Range(1, 65536));
     command
         .add_option("--mode", mode,
                     fmt::format("points | points-gl | splats | surface | sss (surface with "
@@ -98,16 +96,6 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
     this->command = &command;
 }
 
-namespace {
-
-/// The options that only the sss mode's scattering reads.
-constexpr const char* kScatteringOptions[] = {"--scattering",     "--material",  "--unit",
-                                              "--sss-scale",      "--albedo",    "--coefficients",
-                                              "--mean-free-path", "--eta",       "--phase-g",
-                                              "--single-samples", "--light-path"};
-
-}  // namespace
-
 RenderSettings FrameOptions::settings() const {
     RenderSettings defaults;
     defaults.raster.mode = defaultMode;
@@ -140,10 +128,11 @@ RenderSettings FrameOptions::settings() const {
     return settings;
 }
 
+bool FrameOptions::given(const char* name) const {
+    return command != nullptr && command->get_option(name)->count() > 0;
+}
+
 void FrameOptions::checkIgnoredOptions(RenderMode effectiveMode) const {
-    auto given = [this](const char* name) {
-        return command != nullptr && command->get_option(name)->count() > 0;
-    };
     // Each of these was accepted and then ignored without a word. The view's are refused; the
     // mode's are only warned of, since --save-settings keeps them for the other modes.
     if (sensorView.wanted()) {
@@ -163,12 +152,12 @@ void FrameOptions::checkIgnoredOptions(RenderMode effectiveMode) const {
                    toString(effectiveMode));
     }
     if (effectiveMode != RenderMode::Sss) {
-        for (const char* option : kScatteringOptions) {
-            if (given(option)) {
+        for (const CLI::Option* option : scattering.added) {
+            if (option->count() > 0) {
                 fmt::print(stderr,
                            "subscan: warning: {} sets the subsurface scattering of the sss mode: "
                            "it has no effect on the {} mode's picture\n",
-                           option, toString(effectiveMode));
+                           option->get_name(), toString(effectiveMode));
             }
         }
     }
@@ -192,7 +181,7 @@ Camera FrameOptions::camera(const LoadedScan& scan, Framing framing) const {
     }
     if (sensorView.wanted()) {
         return sensorView.camera(scan, source, upAxis(scan), width, height,
-                                 widthOption->count() > 0 || heightOption->count() > 0, fovy);
+                                 given("--width") || given("--height"), fovy);
     }
     OrbitView orbit;
     orbit.yawDegrees = yaw;

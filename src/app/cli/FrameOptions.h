@@ -29,8 +29,6 @@ struct FrameOptions {
     std::optional<double> distance;
     std::string up = "auto";
     SensorViewOptions sensorView;
-    CLI::Option* widthOption = nullptr;  // to tell a given size from the default
-    CLI::Option* heightOption = nullptr;
     double fovy = 45.0;
     std::string cameraFile;
     std::string background;
@@ -72,6 +70,8 @@ struct FrameOptions {
     void saveSettings(const RenderSettings& settings) const;
 
   private:
+    /// Whether the option `name` was given (not its default).
+    bool given(const char* name) const;
     void checkIgnoredOptions(RenderMode effectiveMode) const;
 };
 
