@@ -93,7 +93,7 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
     command.add_flag("--software", software,
                      "Use Mesa's software rasterizer even when a GPU exists");
     streaming.add(command);
-    this->command = &command;
+    parsedBy = &command;
 }
 
 RenderSettings FrameOptions::settings() const {
@@ -129,7 +129,7 @@ RenderSettings FrameOptions::settings() const {
 }
 
 bool FrameOptions::given(const char* name) const {
-    return command != nullptr && command->get_option(name)->count() > 0;
+    return parsedBy != nullptr && parsedBy->get_option(name)->count() > 0;
 }
 
 void FrameOptions::checkIgnoredOptions(RenderMode effectiveMode) const {

@@ -42,7 +42,7 @@ struct FrameOptions {
     bool software = false;
     StreamingOptions streaming;
     RenderMode defaultMode = RenderMode::Points;  // set by add()
-    const CLI::App* command = nullptr;            // set by add(): which options were given
+    const CLI::App* parsedBy = nullptr;           // set by add(): which options were given
 
     /// The options on `command`; `modeByDefault` is the mode where neither --mode nor the
     /// settings file names one.
