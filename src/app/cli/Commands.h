@@ -26,7 +26,8 @@ Command addTurntableCommand(CLI::App& parent);
 Command addViewCommand(CLI::App& parent);
 
 /// Parses the command line and runs the chosen subcommand. Exit codes: 0 success, 1 an error
-/// with the input or the machine (one sentence on stderr), 2 bad command-line usage.
+/// with the input or the machine (one sentence on stderr), 2 bad command-line usage, 128 + the
+/// signal for a command stopped by Ctrl-C (130) or SIGTERM (143).
 int run(int argc, char** argv);
 
 }  // namespace subscan::cli

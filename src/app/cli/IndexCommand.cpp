@@ -78,7 +78,16 @@ int runIndex(const IndexOptions& options) {
                                          static_cast<double>(info.pointCount) * 1e-6));
     };
 
-    const lod::CopcFile written = lod::writeCopc(*source, output, settings);
+    const lod::CopcFile written = [&] {
+        try {
+            return lod::writeCopc(*source, output, settings);
+        } catch (const Error& error) {
+            if (interrupts.interrupted()) {  // the indexer's own sentence says what it left
+                throw interrupts.stopped(fmt::format("{}: {}", options.output, error.what()));
+            }
+            throw;
+        }
+    }();
     const lod::IndexSummary& summary = written.summary;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "app/cli/Commands.h"
+#include "app/cli/InterruptWatcher.h"
 #include "core/Error.h"
 
 namespace subscan::cli {
@@ -75,6 +76,9 @@ int run(int argc, char** argv) {
                 return command.run();
             }
         }
+    } catch (const Interrupted& interrupted) {
+        fmt::print(stderr, "subscan: {}\n", interrupted.what());
+        return interrupted.exitStatus();
     } catch (const Error& error) {
         fmt::print(stderr, "subscan: {}\n", error.what());
         return kExitError;

@@ -272,8 +272,8 @@ int runTurntable(const TurntableOptions& options) {
     ProgressBar bar("turntable", options.frames > 1);
     auto stopIfInterrupted = [&] {
         if (interrupts.interrupted()) {
-            throw Error(fmt::format("{}: interrupted{}", output.string(),
-                                    video ? "; no video written" : ""));
+            throw interrupts.stopped(fmt::format("{}: interrupted{}", output.string(),
+                                                 video ? "; no video written" : ""));
         }
     };
     for (int index = 0; index < options.frames; ++index) {
