@@ -1,5 +1,6 @@
 // `subscan turntable`: numbered PNGs or an MP4 through the temporal filter, the first frame
 // already converged, the yaw growing by degrees / frames, per-frame buffers, and refusals.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -125,30 +126,68 @@ TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "SPIN.MP4"));
 }
 
+/// Starts an endless turntable of `output` (and `more` options), sends it a terminal's Ctrl-C
+/// once `written` (a shell glob) matches a file, and returns its exit status and stderr.
+test::CommandResult interruptTurntable(const std::filesystem::path& output,
+                                       const std::string& written, const std::string& more = "") {
+    const test::TempDir capture;
+    const std::string command = fmt::format(
+        "SUBSCAN_GL_DEBUG=1 '{}' turntable synthetic:sphere?points=4000 --mode surface "
+        "--width 64 --height 48 --frames 100000 -o '{}' {} 2> '{}' & pid=$!; "
+        "for i in $(seq 600); do ls -d {} > /dev/null 2>&1 && break; sleep 0.1; done; "
+        "kill -INT $pid; wait $pid",
+        test::subscanExecutable(), output.string(), more, (capture / "err").string(), written);
+    test::CommandResult run = test::runProgram("/bin/sh", {"-c", command});
+    run.err = test::fileBytes(capture / "err");
+    return run;
+}
+
 TEST(TurntableCommandGLTest, CtrlCLeavesNoFramesBehind) {
     if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
         GTEST_SKIP() << "ffmpeg is not installed (scripts/setup-deps.sh installs it)";
     }
     // A terminal's Ctrl-C while the frames are rendered: they lay in a hidden folder beside the
-    // video, which used to stay, with every frame so far. Sent once that folder exists.
+    // video, which used to stay, with every frame so far. Sent once that folder holds a frame.
     const test::TempDir dir;
-    const std::string command = fmt::format(
-        "SUBSCAN_GL_DEBUG=1 '{}' turntable synthetic:sphere?points=4000 --mode surface "
-        "--width 64 --height 48 --frames 100000 -o '{}' 2> '{}' & pid=$!; "
-        "for i in $(seq 600); do ls -a '{}' | grep -q frames && break; sleep 0.1; done; "
-        "kill -INT $pid; wait $pid; echo $?",
-        test::subscanExecutable(), (dir / "spin.mp4").string(), (dir / "err").string(),
-        dir.path().string());
-    const auto run = test::runProgram("/bin/sh", {"-c", command});
-    EXPECT_EQ(run.out, "130\n") << run.err;  // the shell's status for Ctrl-C (it was 1)
-    std::ifstream errors(dir / "err");
-    const std::string said((std::istreambuf_iterator<char>(errors)), {});
-    EXPECT_THAT(said, HasSubstr("interrupted; no video written"));
-    std::vector<std::string> left;
-    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
-        left.push_back(entry.path().filename().string());
+    const auto run =
+        interruptTurntable(dir / "spin.mp4", (dir / ".spin.mp4.frames-*/0000.png").string());
+    EXPECT_EQ(run.exitCode, 130) << run.err;  // the shell's status for Ctrl-C (it was 1)
+    EXPECT_EQ(run.err, "subscan: " + (dir / "spin.mp4").string() +
+                           ": interrupted; no video written, and what was there is left as it "
+                           "was\n");
+    EXPECT_EQ(test::folderEntries(dir.path()), std::vector<std::string>{});
+}
+
+TEST(TurntableCommandGLTest, CtrlCLeavesAFolderAsItWas) {
+    // Frames were written in place and the earlier turntable's beyond them removed only at the
+    // end: Ctrl-C left this run's first frames beside the earlier run's later ones, a sequence
+    // that looked whole.
+    const test::TempDir dir;
+    const auto earlier = runSubscan(
+        with(with({"turntable"}, kScene), {"-o", (dir / "frames").string(), "--frames", "3"}));
+    ASSERT_EQ(earlier.exitCode, 0) << earlier.err;
+    std::vector<std::string> frames;
+    for (const std::string& name : test::folderEntries(dir / "frames")) {
+        frames.push_back(test::fileBytes(dir / "frames" / name));
     }
-    EXPECT_EQ(left, std::vector<std::string>{"err"});
+    const auto run =
+        interruptTurntable(dir / "frames", (dir / "frames" / ".frames-*/0003.png").string());
+    EXPECT_EQ(run.exitCode, 130) << run.err;
+    EXPECT_EQ(run.err, "subscan: " + (dir / "frames").string() +
+                           ": interrupted; no frames written, and what was there is left as it "
+                           "was\n");
+    ASSERT_EQ(test::folderEntries(dir / "frames"),
+              (std::vector<std::string>{"0000.png", "0001.png", "0002.png"}));
+    for (int index = 0; index < 3; ++index) {
+        EXPECT_EQ(test::fileBytes(dir / "frames" / fmt::format("{:04}.png", index)),
+                  frames[static_cast<std::size_t>(index)])
+            << index;
+    }
+    // A folder the interrupted run made is gone with its frames.
+    const auto fresh =
+        interruptTurntable(dir / "new", (dir / "new" / ".frames-*/0000.png").string());
+    EXPECT_EQ(fresh.exitCode, 130) << fresh.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "new"));
 }
 
 TEST(TurntableCommandGLTest, AFolderHoldsThisSequenceAlone) {

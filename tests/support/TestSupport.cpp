@@ -110,6 +110,15 @@ std::size_t lineCount(std::string_view text) {
     return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
 }
 
+std::vector<std::string> folderEntries(const std::filesystem::path& folder) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+        names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
 void expectUnwritablePathIsAnErrorNamingIt(
     const std::function<void(const std::filesystem::path&)>& write, std::string_view fileName) {
     const TempDir dir;

@@ -46,6 +46,9 @@ std::string fileBytes(const std::filesystem::path& file);
 /// The number of newline characters in `text`.
 std::size_t lineCount(std::string_view text);
 
+/// The names of the entries in `folder`, sorted: "nothing but ... is left".
+std::vector<std::string> folderEntries(const std::filesystem::path& folder);
+
 /// Expects `write` to a file in a folder that does not exist to throw subscan::Error naming the
 /// path, and to leave nothing behind.
 void expectUnwritablePathIsAnErrorNamingIt(

@@ -24,16 +24,6 @@ using test::runSubscan;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
-/// The folder's entries, for "nothing but the input is left".
-std::vector<std::string> entries(const std::filesystem::path& folder) {
-    std::vector<std::string> names;
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-        names.push_back(entry.path().filename().string());
-    }
-    std::sort(names.begin(), names.end());
-    return names;
-}
-
 /// A LAS file of many points with every attribute (UTM coordinates), in `folder`.
 std::filesystem::path lasInput(const test::TempDir& folder) {
     const std::filesystem::path input = folder / "input.las";
@@ -50,7 +40,8 @@ TEST(IndexCommandTest, ALasFileBecomesACopcFileWithEveryRecord) {
     ASSERT_EQ(result.exitCode, 0) << result.err;
     EXPECT_THAT(result.out, StartsWith(output.string() + ": "));
     EXPECT_THAT(result.out, HasSubstr(" levels, "));
-    EXPECT_EQ(entries(folder.path()), (std::vector<std::string>{"input.las", "out.copc.laz"}));
+    EXPECT_EQ(test::folderEntries(folder.path()),
+              (std::vector<std::string>{"input.las", "out.copc.laz"}));
 
     // The input's records as LAS 1.4 (what the source gives) against the COPC file's.
     const std::unique_ptr<PointRecordSource> source = openPointRecordSource(input);
@@ -79,7 +70,8 @@ TEST(IndexCommandTest, TheOutputMustBeACopcFileAndNotAnInput) {
     EXPECT_EQ(over.exitCode, 1);
     EXPECT_EQ(over.err,
               "subscan: " + copc.string() + ": refusing to write the index over its input\n");
-    EXPECT_EQ(entries(folder.path()), (std::vector<std::string>{"in.copc.laz", "input.las"}));
+    EXPECT_EQ(test::folderEntries(folder.path()),
+              (std::vector<std::string>{"in.copc.laz", "input.las"}));
 }
 
 TEST(IndexCommandTest, MissingAndTruncatedInputsLeaveNothing) {
@@ -101,7 +93,7 @@ TEST(IndexCommandTest, MissingAndTruncatedInputsLeaveNothing) {
     EXPECT_EQ(cut.exitCode, 1);
     EXPECT_THAT(cut.err, StartsWith("subscan: " + truncated.string()));
     EXPECT_EQ(test::lineCount(cut.err), 1u) << cut.err;
-    EXPECT_EQ(entries(folder.path()), (std::vector<std::string>{"truncated.las"}));
+    EXPECT_EQ(test::folderEntries(folder.path()), (std::vector<std::string>{"truncated.las"}));
 }
 
 TEST(IndexCommandTest, AFullDiskIsOneSentenceAndLeavesNothing) {

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -64,22 +65,67 @@ void checkOutputName(const std::filesystem::path& output) {
     }
 }
 
-/// Removes the numbered frames (NNNN.png) beyond the first `frames` that an earlier, longer
-/// turntable left in `folder`, so the folder holds this sequence alone; returns how many.
-int removeFramesBeyond(const std::filesystem::path& folder, int frames) {
-    int removed = 0;
-    for (int index = frames;; ++index) {
-        const std::filesystem::path stale = folder / fmt::format("{:04}.png", index);
+/// Frame `index`'s name: 0000.png, 0001.png, ... with `extension` ".png".
+std::string frameName(int index, std::string_view extension) {
+    return fmt::format("{:04}{}", index, extension);
+}
+
+/// The index of the frame named `name`, where frameName gives that name; else nullopt.
+std::optional<int> frameIndexOf(const std::string& name, std::string_view extension) {
+    if (!name.ends_with(extension)) {
+        return std::nullopt;
+    }
+    const std::string_view digits(name.data(), name.size() - extension.size());
+    int index = -1;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), index);
+    if (error != std::errc() || end != digits.data() + digits.size() || index < 0 ||
+        frameName(index, extension) != name) {
+        return std::nullopt;
+    }
+    return index;
+}
+
+/// The paths of the frames named as frameName names them in `folder` (none where it does not
+/// exist).
+std::vector<std::filesystem::path> framesIn(const std::filesystem::path& folder,
+                                            std::string_view extension) {
+    std::vector<std::filesystem::path> frames;
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+        if (frameIndexOf(entry.path().filename().string(), extension)) {
+            frames.push_back(entry.path());
+        }
+    }
+    return frames;
+}
+
+/// Puts the first `frames` frames of this run from `staging` into `folder`, in place of an
+/// earlier turntable's, and removes that one's frames beyond them, so that the folder holds
+/// this sequence alone; returns how many were beyond.
+int replaceFrames(const std::filesystem::path& staging, const std::filesystem::path& folder,
+                  int frames, std::string_view extension) {
+    for (int index = 0; index < frames; ++index) {
+        const std::string name = frameName(index, extension);
         std::error_code error;
-        if (!std::filesystem::remove(stale, error)) {
+        std::filesystem::rename(staging / name, folder / name, error);
+        if (error) {
+            throw Error(fmt::format("{}: cannot put the frame in place: {}",
+                                    (folder / name).string(), error.message()));
+        }
+    }
+    int removed = 0;
+    for (const std::filesystem::path& earlier : framesIn(folder, extension)) {
+        if (*frameIndexOf(earlier.filename().string(), extension) >= frames) {
+            std::error_code error;
+            std::filesystem::remove(earlier, error);
             if (error) {
                 throw Error(fmt::format("{}: cannot remove this frame of an earlier turntable: {}",
-                                        stale.string(), error.message()));
+                                        earlier.string(), error.message()));
             }
-            return removed;
+            ++removed;
         }
-        ++removed;
     }
+    return removed;
 }
 
 /// The ffmpeg on PATH, or nullopt.
@@ -160,23 +206,32 @@ void createFolder(const std::filesystem::path& folder, std::string_view what) {
     }
 }
 
-/// A temporary folder beside `output` for the frames of a video, removed when done.
-class FrameFolder {
+/// A hidden folder in `folder` (made if missing) that holds a run's frames until they are
+/// complete, removed with what is left in it when the run ends, and `folder` too where the run
+/// made it and put nothing else there: an interrupted or failed turntable leaves none of its
+/// output.
+class StagingFolder {
   public:
-    explicit FrameFolder(const std::filesystem::path& output)
-        : path_(output.parent_path() /
-                fmt::format(".{}.frames-{}", output.filename().string(), ::getpid())) {
+    StagingFolder(const std::filesystem::path& folder, std::string_view name)
+        : folder_(folder),
+          madeFolder_(!folder.empty() && !std::filesystem::exists(folder)),
+          path_(folder / fmt::format(".{}-{}", name, ::getpid())) {
         createFolder(path_, "frames");
     }
-    ~FrameFolder() {
+    ~StagingFolder() {
         std::error_code ignored;
         std::filesystem::remove_all(path_, ignored);
+        if (madeFolder_) {
+            std::filesystem::remove(folder_, ignored);  // a folder that is not empty stays
+        }
     }
-    FrameFolder(const FrameFolder&) = delete;
-    FrameFolder& operator=(const FrameFolder&) = delete;
+    StagingFolder(const StagingFolder&) = delete;
+    StagingFolder& operator=(const StagingFolder&) = delete;
     const std::filesystem::path& path() const { return path_; }
 
   private:
+    std::filesystem::path folder_;
+    bool madeFolder_;
     std::filesystem::path path_;
 };
 
@@ -193,13 +248,15 @@ int runTurntable(const TurntableOptions& options) {
         requireOutputFolder(output);
     }
     requireOutputFolder(frame.saveSettingsFile);
-    // Nor over an input that lies in the frames' folder under a frame's name.
-    for (int index = 0; !video && index < options.frames; ++index) {
-        frame.refuseToOverwriteInputs(output / fmt::format("{:04}.png", index), "a frame");
+    // Nor over (or removing, as an earlier turntable's) an input that lies in the frames'
+    // folder under a frame's name.
+    for (const std::filesystem::path& earlier :
+         video ? std::vector<std::filesystem::path>() : framesIn(output, ".png")) {
+        frame.refuseToOverwriteInputs(earlier, "a frame");
     }
     for (int index = 0; !options.exportDirectory.empty() && index < options.frames; ++index) {
         refuseToOverwriteCameraInputs(
-            frame, std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index));
+            frame, std::filesystem::path(options.exportDirectory) / frameName(index, ""));
     }
     std::optional<std::filesystem::path> ffmpeg;
     if (video) {
@@ -254,14 +311,10 @@ int runTurntable(const TurntableOptions& options) {
                                                  : settings.surface.normals);
     // From the frames' folder on an interrupt stops at the next frame, which cleans up.
     interrupts.defer();
-    std::optional<FrameFolder> temporary;
-    std::filesystem::path folder = output;
-    if (video) {
-        temporary.emplace(output);
-        folder = temporary->path();
-    } else {
-        createFolder(folder, "frames");
-    }
+    // A video's frames beside it, a folder's in it (so that they move in by renaming).
+    const StagingFolder frames =
+        video ? StagingFolder(output.parent_path(), output.filename().string() + ".frames")
+              : StagingFolder(output, "frames");
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
     // The first written frame is already converged: the mean of `warmup` frames, itself
@@ -272,8 +325,9 @@ int runTurntable(const TurntableOptions& options) {
     ProgressBar bar("turntable", options.frames > 1);
     auto stopIfInterrupted = [&] {
         if (interrupts.interrupted()) {
-            throw interrupts.stopped(fmt::format("{}: interrupted{}", output.string(),
-                                                 video ? "; no video written" : ""));
+            throw interrupts.stopped(
+                fmt::format("{}: interrupted; no {} written, and what was there is left as it was",
+                            output.string(), video ? "video" : "frames"));
         }
     };
     for (int index = 0; index < options.frames; ++index) {
@@ -282,10 +336,10 @@ int runTurntable(const TurntableOptions& options) {
         renderer.render(camera, settings, outputs);
         const Image8 picture{camera.width, camera.height, 4, renderer.readImage()};
         context->throwOnErrors(fmt::format("while rendering frame {}", index));
-        writePng(folder / fmt::format("{:04}.png", index), picture);
+        writePng(frames.path() / frameName(index, ".png"), picture);
         if (!options.exportDirectory.empty()) {
             const std::filesystem::path buffers =
-                std::filesystem::path(options.exportDirectory) / fmt::format("{:04}", index);
+                std::filesystem::path(options.exportDirectory) / frameName(index, "");
             createFolder(buffers, "buffers");
             exportBuffers(buffers, renderer, settings, camera);
         }
@@ -297,7 +351,7 @@ int runTurntable(const TurntableOptions& options) {
             output.parent_path() / fmt::format(".{}.partial", output.filename().string());
         std::error_code error;
         try {
-            encodeVideo(*ffmpeg, folder, partial, options.fps, interrupts.interrupted());
+            encodeVideo(*ffmpeg, frames.path(), partial, options.fps, interrupts.interrupted());
             stopIfInterrupted();
             std::filesystem::rename(partial, output, error);
         } catch (const Error&) {
@@ -310,11 +364,12 @@ int runTurntable(const TurntableOptions& options) {
             throw Error(
                 fmt::format("{}: cannot write the video: {}", output.string(), error.message()));
         }
-    }
-    if (!video) {
-        if (const int removed = removeFramesBeyond(folder, options.frames); removed > 0) {
+    } else {
+        stopIfInterrupted();
+        if (const int removed = replaceFrames(frames.path(), output, options.frames, ".png");
+            removed > 0) {
             fmt::print(stderr, "subscan: removed {} frames of an earlier turntable from {}\n",
-                       removed, folder.string());
+                       removed, output.string());
         }
     }
     frame.saveSettings(settings);
