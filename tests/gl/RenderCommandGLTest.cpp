@@ -806,6 +806,50 @@ TEST(RenderCommandGLTest, AnExportedCameraRendersItsPictureAgain) {
     EXPECT_FALSE(std::filesystem::exists(dir / "first" / "buffers_camera.json"));
 }
 
+TEST(RenderCommandGLTest, AReusedExportFolderHoldsThisExportAlone) {
+    // An export into the folder of an earlier one of another mode kept that one's buffers
+    // (single.pfm, normals.pfm, ...), which passed for this picture's.
+    const test::TempDir dir;
+    const auto exported = dir / "buffers";
+    auto render = [&](std::vector<std::string> options) {
+        std::vector<std::string> arguments{"render",           "synthetic:sphere?points=4000",
+                                           "--width",          "32",
+                                           "--height",         "24",
+                                           "--export-buffers", exported.string()};
+        arguments.insert(arguments.end(), options.begin(), options.end());
+        return runSubscan(arguments);
+    };
+    const auto single =
+        render({"-o", (dir / "single.png").string(), "--mode", "sss", "--scattering", "single"});
+    ASSERT_EQ(single.exitCode, 0) << single.err;
+    EXPECT_TRUE(std::filesystem::exists(exported / "sigma_a.pfm"));
+    // The picture and the settings may lie in the folder, and stay there when it is reused.
+    const auto picture = exported / "points.png";
+    const auto settings = exported / "settings.json";
+    for (int run = 0; run < 2; ++run) {
+        const auto points = render(
+            {"-o", picture.string(), "--mode", "points", "--save-settings", settings.string()});
+        ASSERT_EQ(points.exitCode, 0) << points.err;
+        EXPECT_EQ(test::folderEntries(exported),
+                  (std::vector<std::string>{"camera.json", "color.png", "depth.pfm", "points.png",
+                                            "settings.json"}));
+    }
+
+    // Anything else there might be someone's: refused before anything is written.
+    const auto notes = dir.write("buffers/notes.txt", "mine");
+    std::filesystem::remove(picture);
+    std::filesystem::remove(settings);
+    const auto refused = render({"-o", picture.string(), "--mode", "surface"});
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_EQ(refused.err, "subscan: " + notes.string() +
+                               ": --export-buffers replaces the files of an earlier export in its "
+                               "folder, and this is none of them; give --export-buffers a new or "
+                               "empty folder\n");
+    EXPECT_EQ(test::fileBytes(notes), "mine");
+    EXPECT_FALSE(std::filesystem::exists(picture));
+    EXPECT_FALSE(std::filesystem::exists(exported / "normals.pfm"));
+}
+
 TEST(RenderCommandGLTest, AModesOwnOptionsInAnotherModeAreNamed) {
     // Accepted and ignored without a word (found by an outside test); drawn, with a warning,
     // since --save-settings keeps them for the other modes.

@@ -164,18 +164,24 @@ TEST(TurntableCommandGLTest, CtrlCLeavesAFolderAsItWas) {
     // that looked whole.
     const test::TempDir dir;
     const auto earlier = runSubscan(
-        with(with({"turntable"}, kScene), {"-o", (dir / "frames").string(), "--frames", "3"}));
+        with(with({"turntable"}, kScene), {"-o", (dir / "frames").string(), "--frames", "3",
+                                           "--export-buffers", (dir / "buffers").string()}));
     ASSERT_EQ(earlier.exitCode, 0) << earlier.err;
     std::vector<std::string> frames;
     for (const std::string& name : test::folderEntries(dir / "frames")) {
         frames.push_back(test::fileBytes(dir / "frames" / name));
     }
+    const std::string depth = test::fileBytes(dir / "buffers" / "0002" / "depth.pfm");
     const auto run =
-        interruptTurntable(dir / "frames", (dir / "frames" / ".frames-*/0003.png").string());
+        interruptTurntable(dir / "frames", (dir / "frames" / ".frames-*/0003.png").string(),
+                           "--export-buffers '" + (dir / "buffers").string() + "'");
     EXPECT_EQ(run.exitCode, 130) << run.err;
     EXPECT_EQ(run.err, "subscan: " + (dir / "frames").string() +
-                           ": interrupted; no frames written, and what was there is left as it "
-                           "was\n");
+                           ": interrupted; no frames or buffers written, and what was there is "
+                           "left as it was\n");
+    EXPECT_EQ(test::folderEntries(dir / "buffers"),
+              (std::vector<std::string>{"0000", "0001", "0002"}));
+    EXPECT_EQ(test::fileBytes(dir / "buffers" / "0002" / "depth.pfm"), depth);
     ASSERT_EQ(test::folderEntries(dir / "frames"),
               (std::vector<std::string>{"0000.png", "0001.png", "0002.png"}));
     for (int index = 0; index < 3; ++index) {
@@ -206,6 +212,41 @@ TEST(TurntableCommandGLTest, AFolderHoldsThisSequenceAlone) {
     EXPECT_FALSE(std::filesystem::exists(dir / "frames" / "0002.png"));
     EXPECT_FALSE(std::filesystem::exists(dir / "frames" / "0003.png"));
     EXPECT_EQ(test::fileBytes(other), "mine");  // nothing else is touched
+}
+
+TEST(TurntableCommandGLTest, AReusedExportFolderHoldsThisTurntableAlone) {
+    // Into the folder of a longer turntable of another mode: its frame folders beyond this
+    // one's and its buffers this mode does not write stayed beside this turntable's.
+    const test::TempDir dir;
+    const auto exported = dir / "buffers";
+    auto turntable = [&](int frames, const std::string& mode) {
+        return runSubscan({"turntable", "synthetic:sphere?points=4000", "--width", "40", "--height",
+                           "32", "--warmup", "1", "--mode", mode, "--frames",
+                           std::to_string(frames), "-o", (dir / mode).string(), "--export-buffers",
+                           exported.string()});
+    };
+    const auto longer = turntable(3, "surface");
+    ASSERT_EQ(longer.exitCode, 0) << longer.err;
+    EXPECT_TRUE(std::filesystem::exists(exported / "0000" / "normals.pfm"));
+    const auto shorter = turntable(2, "points");
+    ASSERT_EQ(shorter.exitCode, 0) << shorter.err;
+    EXPECT_THAT(shorter.err, HasSubstr("removed the buffers of 1 frames of an earlier turntable"));
+    EXPECT_EQ(test::folderEntries(exported), (std::vector<std::string>{"0000", "0001"}));
+    for (const char* frame : {"0000", "0001"}) {
+        EXPECT_EQ(test::folderEntries(exported / frame),
+                  (std::vector<std::string>{"camera.json", "color.png", "depth.pfm"}))
+            << frame;
+    }
+
+    // Anything else there might be someone's: refused before anything is written.
+    const auto notes = dir.write("buffers/0001/notes.txt", "mine");
+    const auto refused = turntable(1, "surface");
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_THAT(refused.err, HasSubstr(notes.string() + ": --export-buffers replaces the files "
+                                                        "of an earlier export in its folder"));
+    EXPECT_EQ(test::fileBytes(notes), "mine");
+    EXPECT_EQ(test::folderEntries(exported / "0001"),
+              (std::vector<std::string>{"camera.json", "color.png", "depth.pfm", "notes.txt"}));
 }
 
 TEST(TurntableCommandGLTest, TurnsAStreamedSurveyWithinItsBudget) {

@@ -41,6 +41,14 @@ void requireOutputFolder(const std::filesystem::path& output) {
     }
 }
 
+void removeEarlierOutput(const std::filesystem::path& path, std::string_view what) {
+    std::error_code error;
+    std::filesystem::remove(path, error);
+    if (error) {
+        throw Error(fmt::format("{}: cannot remove {}: {}", path.string(), what, error.message()));
+    }
+}
+
 LoadedScan loadScanForCommand(std::string_view source) {
     constexpr std::uintmax_t kProgressBarBytes = 50u << 20;
     std::error_code ignored;

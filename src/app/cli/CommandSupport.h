@@ -34,6 +34,11 @@ CLI::Validator finiteNumber();
 /// exist: said before the work, not after it, with other outputs already written.
 void requireOutputFolder(const std::filesystem::path& output);
 
+/// Removes `path`, a file or an empty folder an earlier run wrote (`what` names it: "this frame of
+/// an earlier turntable"); throws subscan::Error saying why it cannot. One that does not exist
+/// is no error.
+void removeEarlierOutput(const std::filesystem::path& path, std::string_view what);
+
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
 /// reader's warnings printed as "subscan: warning: ...".
 LoadedScan loadScanForCommand(std::string_view source);

@@ -107,7 +107,10 @@ int runRender(const RenderOptions& options) {
     requireOutputFolder(output);
     requireOutputFolder(frame.saveSettingsFile);
     if (!options.exportDirectory.empty()) {
-        refuseToOverwriteCameraInputs(frame, options.exportDirectory);
+        // The picture and the settings may go into the folder beside the buffers.
+        checkExportFolder(frame, options.exportDirectory, [&](const std::filesystem::path& entry) {
+            return sameFile(entry, output) || sameFile(entry, frame.saveSettingsFile);
+        });
     }
     RenderSettings settings = frame.settings();
     const RasterSettings& raster = settings.raster;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <system_error>
@@ -99,33 +100,51 @@ std::vector<std::filesystem::path> framesIn(const std::filesystem::path& folder,
     return frames;
 }
 
-/// Puts the first `frames` frames of this run from `staging` into `folder`, in place of an
-/// earlier turntable's, and removes that one's frames beyond them, so that the folder holds
-/// this sequence alone; returns how many were beyond.
+/// Puts the first `frames` frames of this run from `staging` into `folder` in place of an
+/// earlier turntable's, which `removeEarlier` removes, as it does that one's frames beyond
+/// them, so that the folder holds this sequence alone; returns how many were beyond.
 int replaceFrames(const std::filesystem::path& staging, const std::filesystem::path& folder,
-                  int frames, std::string_view extension) {
+                  int frames, std::string_view extension,
+                  const std::function<void(const std::filesystem::path&)>& removeEarlier) {
     for (int index = 0; index < frames; ++index) {
-        const std::string name = frameName(index, extension);
+        const std::filesystem::path target = folder / frameName(index, extension);
         std::error_code error;
-        std::filesystem::rename(staging / name, folder / name, error);
+        if (std::filesystem::exists(std::filesystem::symlink_status(target))) {
+            removeEarlier(target);  // a folder cannot be renamed over
+        }
+        std::filesystem::rename(staging / target.filename(), target, error);
         if (error) {
-            throw Error(fmt::format("{}: cannot put the frame in place: {}",
-                                    (folder / name).string(), error.message()));
+            throw Error(fmt::format("{}: cannot put this frame in place: {}", target.string(),
+                                    error.message()));
         }
     }
     int removed = 0;
     for (const std::filesystem::path& earlier : framesIn(folder, extension)) {
         if (*frameIndexOf(earlier.filename().string(), extension) >= frames) {
-            std::error_code error;
-            std::filesystem::remove(earlier, error);
-            if (error) {
-                throw Error(fmt::format("{}: cannot remove this frame of an earlier turntable: {}",
-                                        earlier.string(), error.message()));
-            }
+            removeEarlier(earlier);
             ++removed;
         }
     }
     return removed;
+}
+
+/// Throws subscan::Error where the folder of --export-buffers holds more than an earlier
+/// turntable's frame folders, which this run replaces, and this run's other outputs, or where
+/// replacing them would write over or remove an input.
+void checkExportFolders(const TurntableOptions& options) {
+    const FrameOptions& frame = options.frame;
+    const std::filesystem::path folder = options.exportDirectory;
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+        const std::string name = entry.path().filename().string();
+        if (entry.is_directory() && frameIndexOf(name, "")) {
+            checkExportFolder(frame, entry.path());
+        } else if (!sameFile(entry.path(), options.output) &&
+                   !sameFile(entry.path(), frame.saveSettingsFile) &&
+                   !(frameIndexOf(name, ".png") && sameFile(folder, options.output))) {
+            throw notAnExport(entry.path());
+        }
+    }
 }
 
 /// The ffmpeg on PATH, or nullopt.
@@ -254,9 +273,8 @@ int runTurntable(const TurntableOptions& options) {
          video ? std::vector<std::filesystem::path>() : framesIn(output, ".png")) {
         frame.refuseToOverwriteInputs(earlier, "a frame");
     }
-    for (int index = 0; !options.exportDirectory.empty() && index < options.frames; ++index) {
-        refuseToOverwriteCameraInputs(
-            frame, std::filesystem::path(options.exportDirectory) / frameName(index, ""));
+    if (!options.exportDirectory.empty()) {
+        checkExportFolders(options);
     }
     std::optional<std::filesystem::path> ffmpeg;
     if (video) {
@@ -315,6 +333,10 @@ int runTurntable(const TurntableOptions& options) {
     const StagingFolder frames =
         video ? StagingFolder(output.parent_path(), output.filename().string() + ".frames")
               : StagingFolder(output, "frames");
+    std::optional<StagingFolder> buffers;
+    if (!options.exportDirectory.empty()) {
+        buffers.emplace(options.exportDirectory, "buffers");
+    }
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
     // The first written frame is already converged: the mean of `warmup` frames, itself
@@ -325,9 +347,9 @@ int runTurntable(const TurntableOptions& options) {
     ProgressBar bar("turntable", options.frames > 1);
     auto stopIfInterrupted = [&] {
         if (interrupts.interrupted()) {
-            throw interrupts.stopped(
-                fmt::format("{}: interrupted; no {} written, and what was there is left as it was",
-                            output.string(), video ? "video" : "frames"));
+            throw interrupts.stopped(fmt::format(
+                "{}: interrupted; no {}{} written, and what was there is left as it was",
+                output.string(), video ? "video" : "frames", buffers ? " or buffers" : ""));
         }
     };
     for (int index = 0; index < options.frames; ++index) {
@@ -337,11 +359,8 @@ int runTurntable(const TurntableOptions& options) {
         const Image8 picture{camera.width, camera.height, 4, renderer.readImage()};
         context->throwOnErrors(fmt::format("while rendering frame {}", index));
         writePng(frames.path() / frameName(index, ".png"), picture);
-        if (!options.exportDirectory.empty()) {
-            const std::filesystem::path buffers =
-                std::filesystem::path(options.exportDirectory) / frameName(index, "");
-            createFolder(buffers, "buffers");
-            exportBuffers(buffers, renderer, settings, camera);
+        if (buffers) {
+            exportBuffers(buffers->path() / frameName(index, ""), renderer, settings, camera);
         }
         bar.update((index + 1.0) / options.frames);
     }
@@ -366,10 +385,24 @@ int runTurntable(const TurntableOptions& options) {
         }
     } else {
         stopIfInterrupted();
-        if (const int removed = replaceFrames(frames.path(), output, options.frames, ".png");
+        if (const int removed = replaceFrames(
+                frames.path(), output, options.frames, ".png",
+                [](const std::filesystem::path& earlier) {
+                    removeEarlierOutput(earlier, "this frame of an earlier turntable");
+                });
             removed > 0) {
             fmt::print(stderr, "subscan: removed {} frames of an earlier turntable from {}\n",
                        removed, output.string());
+        }
+    }
+    if (buffers) {
+        if (const int removed = replaceFrames(buffers->path(), options.exportDirectory,
+                                              options.frames, "", removeExport);
+            removed > 0) {
+            fmt::print(
+                stderr,
+                "subscan: removed the buffers of {} frames of an earlier turntable from {}\n",
+                removed, options.exportDirectory);
         }
     }
     frame.saveSettings(settings);
