@@ -1,6 +1,10 @@
 #include "render/ScatteringSettings.h"
 
 #include <cmath>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
 
 #include "render/SettingsJson.h"
 #include "sss/MaterialLibrary.h"
@@ -103,39 +107,63 @@ void to_json(nlohmann::json& json, const ScatteringSettings& settings) {
     };
 }
 
-void checkScatteringSettings(const ScatteringSettings& settings) {
+std::optional<std::string> scaleProblem(float scale) {
+    if (scale > 0.0f && scale <= 1000.0f) {
+        return std::nullopt;
+    }
+    return "is outside 0..1000 (exclusive of 0)";
+}
+
+std::optional<std::string> meanFreePathProblem(const glm::vec3& millimetres) {
     for (int c = 0; c < 3; ++c) {
-        const float path = settings.meanFreePathMm[c];
-        if (!(path > 0.0f) || !std::isfinite(path)) {
-            throw Error(fmt::format(
-                "the setting 'mean_free_path_mm' must be positive millimetres in every channel, "
-                "not {}",
-                path));
+        if (!(millimetres[c] > 0.0f) || !std::isfinite(millimetres[c])) {
+            return fmt::format("must be positive millimetres in every channel, not {}",
+                               millimetres[c]);
         }
     }
-    if (settings.eta && !(*settings.eta >= 1.0f && *settings.eta <= 3.0f)) {
-        throw Error(fmt::format(
-            "the setting 'eta' = {} is outside 1..3 (the relative index of refraction of a "
-            "medium denser than air)",
-            *settings.eta));
+    return std::nullopt;
+}
+
+std::optional<std::string> etaProblem(float eta) {
+    if (eta >= 1.0f && eta <= 3.0f) {
+        return std::nullopt;
     }
-    if (!(std::abs(settings.phaseG) < 1.0f)) {
-        throw Error(fmt::format(
-            "the setting 'phase_g' = {} must lie strictly between -1 and 1 (Henyey-Greenstein)",
-            settings.phaseG));
+    return "is outside 1..3 (the relative index of refraction of a medium denser than air)";
+}
+
+std::optional<std::string> phaseGProblem(float g) {
+    if (std::abs(g) < 1.0f) {
+        return std::nullopt;
     }
-    if (!(settings.singleSamples >= 1 && settings.singleSamples <= 64)) {
-        throw Error(fmt::format("the setting 'single_samples' = {} is outside 1..64",
-                                settings.singleSamples));
+    return "must lie strictly between -1 and 1 (Henyey-Greenstein)";
+}
+
+std::optional<std::string> singleSamplesProblem(int samples) {
+    if (samples >= 1 && samples <= 64) {
+        return std::nullopt;
     }
+    return "is outside 1..64";
+}
+
+void checkScatteringSettings(const ScatteringSettings& settings) {
+    // Named as the settings file names them: the key, and where it is one number its value.
+    const auto refuse = [](const std::optional<std::string>& problem, const std::string& named) {
+        if (problem) {
+            throw Error(fmt::format("the setting {} {}", named, *problem));
+        }
+    };
+    refuse(meanFreePathProblem(settings.meanFreePathMm), "'mean_free_path_mm'");
+    if (settings.eta) {
+        refuse(etaProblem(*settings.eta), fmt::format("'eta' = {}", *settings.eta));
+    }
+    refuse(phaseGProblem(settings.phaseG), fmt::format("'phase_g' = {}", settings.phaseG));
+    refuse(singleSamplesProblem(settings.singleSamples),
+           fmt::format("'single_samples' = {}", settings.singleSamples));
     if (settings.method != ScatteringMethod::Gaussian &&
         settings.coefficients == CoefficientSource::Material) {
         measuredMaterial(settings.material);
     }
-    if (!(settings.scale > 0.0f && settings.scale <= 1000.0f)) {
-        throw Error(fmt::format("the setting 'scale' = {} is outside 0..1000 (exclusive of 0)",
-                                settings.scale));
-    }
+    refuse(scaleProblem(settings.scale), fmt::format("'scale' = {}", settings.scale));
 }
 
 void from_json(const nlohmann::json& json, ScatteringSettings& settings) {

@@ -77,9 +77,18 @@ AlbedoPlacement parseAlbedoPlacement(std::string_view text);
 std::string toString(SceneUnit unit);
 SceneUnit parseSceneUnit(std::string_view text);
 
-/// Throws subscan::Error naming the first impossible value (ld <= 0, eta < 1, |g| >= 1, ...);
-/// from_json calls it, and so do the CLI's overrides.
+/// Throws subscan::Error naming the first impossible value (ld <= 0, eta < 1, |g| >= 1, ...) by
+/// its key; from_json calls it, and so do the CLI's overrides.
 void checkScatteringSettings(const ScatteringSettings& settings);
+
+/// Why each value cannot be its setting's, as the rest of a sentence naming the value ("is
+/// outside 1..3 (...)"), or nullopt where it can: the ranges checkScatteringSettings holds the
+/// settings to, one at a time, for the command line to name its options instead of the keys.
+std::optional<std::string> scaleProblem(float scale);
+std::optional<std::string> meanFreePathProblem(const glm::vec3& millimetres);
+std::optional<std::string> etaProblem(float eta);
+std::optional<std::string> phaseGProblem(float g);
+std::optional<std::string> singleSamplesProblem(int samples);
 
 void to_json(nlohmann::json& json, const ScatteringSettings& settings);
 void from_json(const nlohmann::json& json, ScatteringSettings& settings);

@@ -42,6 +42,45 @@ TEST(CliTest, NumbersThatAreNotFiniteAreRefused) {
     }
 }
 
+TEST(CliTest, BadScatteringValuesNameTheirOptionAsUsageErrors) {
+    // They were refused after the parse, with exit 1, naming the settings' key ('eta') for an
+    // option the user had typed as --eta. Refused while parsing, nothing renders.
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+        {{"--sss-scale", "0"}, "--sss-scale: 0 is outside 0..1000 (exclusive of 0)"},
+        {{"--sss-scale", "-1"}, "--sss-scale: -1 is outside 0..1000 (exclusive of 0)"},
+        {{"--mean-free-path", "1,-2,3"},
+         "--mean-free-path: 1,-2,3 must be positive millimetres in every channel, not -2"},
+        {{"--eta", "0.5"}, "--eta: 0.5 is outside 1..3"},
+        {{"--phase-g", "1"}, "--phase-g: 1 must lie strictly between -1 and 1"},
+        {{"--single-samples", "0"}, "--single-samples: 0 is outside 1..64"},
+        {{"--material", "jade"}, "--material: there is no material 'jade'"},
+    };
+    for (const std::string command : {"render", "turntable", "bench", "view"}) {
+        for (const auto& [option, message] : cases) {
+            std::vector<std::string> arguments{command, "synthetic:sphere", "--mode", "sss"};
+            if (command == "render" || command == "turntable") {
+                arguments.insert(arguments.end(), {"-o", "never-written"});
+            }
+            arguments.insert(arguments.end(), option.begin(), option.end());
+            const test::CommandResult result = runSubscan(arguments);
+            EXPECT_EQ(result.exitCode, 2) << command << " " << option.front();
+            EXPECT_THAT(result.err, ::testing::StartsWith(message)) << command;
+        }
+    }
+    EXPECT_FALSE(std::filesystem::exists("never-written"));
+
+    // From a settings file the value is named by its key in the file.
+    const test::TempDir dir;
+    const auto settings = dir.write("settings.json", R"({"scattering": {"eta": 0.5}})");
+    const test::CommandResult fromFile =
+        runSubscan({"render", "synthetic:sphere", "-o", (dir / "x.png").string(), "--settings",
+                    settings.string()});
+    EXPECT_EQ(fromFile.exitCode, 1);
+    EXPECT_EQ(fromFile.err, "subscan: " + settings.string() +
+                                ": the setting 'eta' = 0.5 is outside 1..3 (the relative index of "
+                                "refraction of a medium denser than air)\n");
+}
+
 TEST(CliTest, ACameraFileExcludesTheOptionsItFixes) {
     // The file's size and view won without a word: --width 640 rendered at the file's width.
     const test::TempDir dir;

@@ -567,8 +567,8 @@ TEST(ViewerWithoutDisplayTest, BadScriptOrOptionsFailBeforeAnyWindow) {
 
     const CommandResult badMaterial =
         runSubscan({"view", kScan, "--material", "cheese"}, {"DISPLAY="});
-    EXPECT_EQ(badMaterial.exitCode, 1);
-    EXPECT_THAT(badMaterial.err, HasSubstr("cheese"));
+    EXPECT_EQ(badMaterial.exitCode, 2);  // a bad option value: a usage error
+    EXPECT_THAT(badMaterial.err, HasSubstr("--material: there is no material 'cheese'"));
 
     const CommandResult badUsage = runSubscan({"view", kScan, "--mode", "mesh"});
     EXPECT_EQ(badUsage.exitCode, 2);

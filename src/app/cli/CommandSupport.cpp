@@ -132,6 +132,26 @@ void addResolutionOption(CLI::App& command, std::string& resolution) {
         ->check(CLI::IsMember({"full", "half", "auto"}));
 }
 
+namespace {
+
+/// A check of a number option against its scattering setting's range (`problem`, which says
+/// why a value is outside it): a bad value is a usage error, and CLI11 names the option.
+template <class Number>
+CLI::Validator scatteringRange(std::optional<std::string> (*problem)(Number)) {
+    return CLI::Validator(
+        [problem](std::string& text) {
+            Number value{};
+            if (!CLI::detail::lexical_cast(text, value)) {
+                return std::string();  // not a number: the option's conversion says so
+            }
+            const std::optional<std::string> why = problem(value);
+            return why ? fmt::format("{} {}", text, *why) : std::string();
+        },
+        "");
+}
+
+}  // namespace
+
 void ScatteringOptions::add(CLI::App& command) {
     const std::size_t before = command.get_options().size();
     command
@@ -139,15 +159,26 @@ void ScatteringOptions::add(CLI::App& command) {
                     "Light transport of the sss mode: gaussian (blur of the diffuse light) | "
                     "single (single scattering) | both")
         ->check(CLI::IsMember({"gaussian", "single", "both"}));
-    command.add_option("--material", material,
-                       "Translucent material of the sss mode (see `subscan materials`)");
+    command
+        .add_option("--material", material,
+                    "Translucent material of the sss mode (see `subscan materials`)")
+        ->check(CLI::Validator(
+            [](std::string& name) {
+                try {
+                    findMaterial(name);
+                    return std::string();
+                } catch (const Error& error) {
+                    return std::string(error.what());
+                }
+            },
+            ""));
     command.add_option("--unit", unit, "Length unit of the scan: mm | cm | m | in")
         ->check(CLI::IsMember({"mm", "cm", "m", "in"}));
     command
         .add_option("--sss-scale", scale,
-                    "Multiplies every scattering radius and mean free path (> 0)")
+                    "Multiplies every scattering radius and mean free path (0 < scale <= 1000)")
         ->check(finiteNumber())
-        ->check(CLI::Range(0.0f, 1000.0f));
+        ->check(scatteringRange(scaleProblem));
     command
         .add_option("--albedo", albedo,
                     "Where the colour enters the Gaussian blur: pre | post | split")
@@ -157,18 +188,33 @@ void ScatteringOptions::add(CLI::App& command) {
                     "Single scattering's σs′ and σa: color (from the scan's colour, default) | "
                     "material (measured, see `subscan materials`)")
         ->check(CLI::IsMember({"material", "color"}));
-    command.add_option("--mean-free-path", meanFreePath,
-                       "R,G,B diffuse mean free path in mm for --coefficients color (default: "
-                       "measured marble's 8.51,5.57,3.95)");
+    command
+        .add_option("--mean-free-path", meanFreePath,
+                    "R,G,B diffuse mean free path in mm for --coefficients color (default: "
+                    "measured marble's 8.51,5.57,3.95)")
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                const std::optional<glm::vec3> path = parseCommaSeparatedRgb(text);
+                if (!path) {
+                    return fmt::format("'{}' is not R,G,B (three millimetre values)", text);
+                }
+                const std::optional<std::string> why = meanFreePathProblem(*path);
+                return why ? fmt::format("{} {}", text, *why) : std::string();
+            },
+            ""));
     command
         .add_option("--eta", eta,
                     "Relative index of refraction (default: the material's); overrides the "
                     "material's for both coefficient sources")
-        ->check(finiteNumber());
+        ->check(finiteNumber())
+        ->check(scatteringRange(etaProblem));
     command.add_option("--phase-g", phaseG, "Henyey-Greenstein asymmetry g, -1 < g < 1")
-        ->check(finiteNumber());
-    command.add_option("--single-samples", singleSamples,
-                       "Samples along the refracted view ray (1..64)");
+        ->check(finiteNumber())
+        ->check(scatteringRange(phaseGProblem));
+    command
+        .add_option("--single-samples", singleSamples,
+                    "Samples along the refracted view ray (1..64)")
+        ->check(scatteringRange(singleSamplesProblem));
     command
         .add_option("--light-path", lightPath,
                     "Where single scattering finds a directional light's entry: light_map (the "
@@ -199,12 +245,7 @@ void ScatteringOptions::apply(ScatteringSettings& settings) const {
         settings.coefficients = parseCoefficientSource(coefficients);
     }
     if (!meanFreePath.empty()) {
-        const std::optional<glm::vec3> path = parseCommaSeparatedRgb(meanFreePath);
-        if (!path) {
-            throw Error(fmt::format("--mean-free-path '{}' is not R,G,B (three millimetre values)",
-                                    meanFreePath));
-        }
-        settings.meanFreePathMm = *path;
+        settings.meanFreePathMm = *parseCommaSeparatedRgb(meanFreePath);  // as add() checked
     }
     if (eta) {
         settings.eta = *eta;

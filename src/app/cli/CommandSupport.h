@@ -92,8 +92,9 @@ struct ScatteringOptions {
     std::vector<const CLI::Option*> added;  // by add(): which of them were given
 
     void add(CLI::App& command);
-    /// Writes the given options over `settings`; throws subscan::Error naming the option or the
-    /// impossible combination (checkScatteringSettings).
+    /// Writes the given options over `settings`; throws subscan::Error naming the impossible
+    /// combination (checkScatteringSettings). A bad value of one option is a usage error,
+    /// refused while the command line is parsed, with the option's name.
     void apply(ScatteringSettings& settings) const;
 };
 
