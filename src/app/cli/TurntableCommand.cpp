@@ -231,11 +231,15 @@ void createFolder(const std::filesystem::path& folder, std::string_view what) {
 /// output.
 class StagingFolder {
   public:
-    StagingFolder(const std::filesystem::path& folder, std::string_view name)
+    /// `what` names the output in errors: "frames", "buffers".
+    StagingFolder(const std::filesystem::path& folder, std::string_view name, std::string_view what)
         : folder_(folder),
           madeFolder_(!folder.empty() && !std::filesystem::exists(folder)),
           path_(folder / fmt::format(".{}-{}", name, ::getpid())) {
-        createFolder(path_, "frames");
+        if (!folder.empty()) {
+            createFolder(folder, what);  // said of the folder given, not of the hidden one
+        }
+        createFolder(path_, what);
     }
     ~StagingFolder() {
         std::error_code ignored;
@@ -331,11 +335,12 @@ int runTurntable(const TurntableOptions& options) {
     interrupts.defer();
     // A video's frames beside it, a folder's in it (so that they move in by renaming).
     const StagingFolder frames =
-        video ? StagingFolder(output.parent_path(), output.filename().string() + ".frames")
-              : StagingFolder(output, "frames");
+        video
+            ? StagingFolder(output.parent_path(), output.filename().string() + ".frames", "frames")
+            : StagingFolder(output, "frames", "frames");
     std::optional<StagingFolder> buffers;
     if (!options.exportDirectory.empty()) {
-        buffers.emplace(options.exportDirectory, "buffers");
+        buffers.emplace(options.exportDirectory, "buffers", "buffers");
     }
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
