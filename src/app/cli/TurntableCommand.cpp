@@ -66,7 +66,8 @@ void checkOutputName(const std::filesystem::path& output) {
     }
 }
 
-/// Frame `index`'s name: 0000.png, 0001.png, ... with `extension` ".png".
+/// Frame `index`'s name: 0000.png, 0001.png, ... with `extension` ".png", and its buffers'
+/// folder's 0000, 0001, ... with none.
 std::string frameName(int index, std::string_view extension) {
     return fmt::format("{:04}{}", index, extension);
 }
@@ -231,11 +232,12 @@ void createFolder(const std::filesystem::path& folder, std::string_view what) {
 /// output.
 class StagingFolder {
   public:
-    /// `what` names the output in errors: "frames", "buffers".
-    StagingFolder(const std::filesystem::path& folder, std::string_view name, std::string_view what)
+    /// `what` ("frames", "buffers") names it, after `prefix`, and the folder in errors.
+    StagingFolder(const std::filesystem::path& folder, std::string_view what,
+                  std::string_view prefix = "")
         : folder_(folder),
           madeFolder_(!folder.empty() && !std::filesystem::exists(folder)),
-          path_(folder / fmt::format(".{}-{}", name, ::getpid())) {
+          path_(folder / fmt::format(".{}{}-{}", prefix, what, ::getpid())) {
         if (!folder.empty()) {
             createFolder(folder, what);  // said of the folder given, not of the hidden one
         }
@@ -335,12 +337,11 @@ int runTurntable(const TurntableOptions& options) {
     interrupts.defer();
     // A video's frames beside it, a folder's in it (so that they move in by renaming).
     const StagingFolder frames =
-        video
-            ? StagingFolder(output.parent_path(), output.filename().string() + ".frames", "frames")
-            : StagingFolder(output, "frames", "frames");
+        video ? StagingFolder(output.parent_path(), "frames", output.filename().string() + ".")
+              : StagingFolder(output, "frames");
     std::optional<StagingFolder> buffers;
     if (!options.exportDirectory.empty()) {
-        buffers.emplace(options.exportDirectory, "buffers", "buffers");
+        buffers.emplace(options.exportDirectory, "buffers");
     }
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
