@@ -1,7 +1,7 @@
 #version 450
 // Fill removal: pull-push also fills the background around the object. A pixel belongs to the
 // surface when it holds a visible point (unless it lies beyond a dense cloud's outline:
-// FillRemoval.glsl's centreBeyondOutline), or when points surround it: in (by default) all 8
+// FillRemoval.glsl's surfaceCoverage), or when points surround it: in (by default) all 8
 // directions, some level up to the expected-gap level L(x) (at least 1) finds pull weight in
 // the neighbouring texel, or from level 1 on any point, hidden ones too (FillRemoval.glsl's
 // weighted). This replaces the paper's threshold on the pull weight at L(x), which spreads the
@@ -15,11 +15,12 @@
 //                values per pixel instead of walking up to 8 x (L(x) + 1) texels: on
 //                close-ups, where L(x) is large, that walk dominated the frame. On level 1
 //                also "fillSparse" (FillRemoval.glsl's sparseEnclosure).
-//   STAGE_MASK   writes "mask" (1 = surface) and "surfaceDepth" (the filled depth there, +inf
-//                elsewhere), unless FinishSurface.comp tests level 0 itself.
-//   STAGE_SURFACE_DEPTH  "surfaceDepth" alone, from the push's level 0 (which FinishSurface.comp
-//                computes for itself): for a FinishSurface whose normals look for the outline
-//                around each pixel, which one dispatch cannot know of its neighbours.
+//   STAGE_MASK   writes "mask" (the share of the pixel the surface covers: 0 off it, 1 on
+//                it but at the sub-pixel outline) and "surfaceDepth" (the filled depth on the
+//                surface, +inf elsewhere), unless FinishSurface.comp tests level 0 itself.
+//   STAGE_SURFACE_DEPTH  the same from the push's level 0 (which FinishSurface.comp computes
+//                for itself): for a FinishSurface whose normals look for the outline around
+//                each pixel, which one dispatch cannot know of its neighbours.
 #include "render/FillRemoval.glsl"
 #include "shared/region.glsl"
 
@@ -36,9 +37,9 @@ layout(std430, binding = SUBSCAN_SSBO_FILL_SPARSE) writeonly buffer FillSparse {
 #endif
 #if STAGE_MASK
 layout(binding = SUBSCAN_IMAGE_IN0, r32f) readonly uniform image2D inFilledDepth;
-layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outMask;
 #endif
 #if STAGE_MASK || STAGE_SURFACE_DEPTH
+layout(binding = SUBSCAN_IMAGE_OUT0, r8) writeonly uniform image2D outMask;
 layout(binding = SUBSCAN_IMAGE_OUT1, r32f) writeonly uniform image2D outSurfaceDepth;
 #endif
 
@@ -62,10 +63,8 @@ void main() {
 #else
     float depth = pushedValue(0u, pixel).x;
 #endif
-    bool surfacePixel = onSurface(pixel, depth);
-#if STAGE_MASK
-    imageStore(outMask, pixel, vec4(surfacePixel ? 1.0 : 0.0));
-#endif
-    imageStore(outSurfaceDepth, pixel, vec4(surfacePixel ? depth : kInfinity));
+    float coverage = surfaceCoverage(pixel, depth);
+    imageStore(outMask, pixel, vec4(coverage));
+    imageStore(outSurfaceDepth, pixel, vec4(coverage > 0.0 ? depth : kInfinity));
 #endif
 }

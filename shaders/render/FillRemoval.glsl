@@ -378,17 +378,17 @@ uint occupiedCells(ivec2 pixel) {
     return uint(bitCount(occupancy[uint(pixel.y) * uint(frame.viewport.x) + uint(pixel.x)]));
 }
 
-/// Whether `pixel`, holding a visible point, lies on the outline of the cloud with its centre
-/// outside it. A straight outline leaves more than half of a pixel inside exactly when
-/// it passes the centre; the points' cells show that area plus the cells the outline cuts,
-/// half a column of them on average (1/8 of a pixel): so the centre lies outside when at most
-/// 1/2 + 1/8 of the densest neighbour's cells hold points. Only beside a pixel without any
-/// point that the fill leaves empty (the background: an outline, not a gap between points),
-/// and only where the densest neighbour holds points in 3 cells or more: with 2, one cell more
-/// or less is half of the count, noise rather than area. Sparse clouds show the area less
-/// exactly (a cell holds one point or several alike), yet the rule still moves their outlines
-/// closer to the truth (docs/eval.md, "Measured quality").
-bool centreBeyondOutline(ivec2 pixel) {
+/// The share of `pixel` (holding points) that the cloud's outline leaves inside it, where the
+/// pixel lies on the outline; else -1. A straight outline leaves more than half of a pixel
+/// inside exactly when it passes the centre; the points' cells show the inside area plus the
+/// cells the outline cuts, half a column of them on average (1/8 of a pixel): so the share is
+/// the pixel's occupied cells against the densest neighbour's, less 1/8. Only beside a pixel
+/// without any point that the fill leaves empty (the background: an outline, not a gap
+/// between points), and only where the densest neighbour holds points in 3 cells or more: with
+/// 2, one cell more or less is half of the count, noise rather than area. Sparse clouds show
+/// the area less exactly (a cell holds one point or several alike), yet the rule still moves
+/// their outlines closer to the truth (docs/eval.md, "Measured quality").
+float outlineShare(ivec2 pixel) {
     // The 4-neighbours without points first: off the outline (nearly every pixel) none is, and
     // the counts and the fill's reach below are skipped (llvmpipe skips a loop only where
     // none of its lanes enters it). Off the image's border the surface goes on.
@@ -400,7 +400,7 @@ bool centreBeyondOutline(ivec2 pixel) {
         }
     }
     if (emptyBeside == 0u) {
-        return false;
+        return -1.0;
     }
     uint own = occupiedCells(pixel);
     uint densest = own;
@@ -410,22 +410,27 @@ bool centreBeyondOutline(ivec2 pixel) {
             densest = max(densest, occupiedCells(neighbour));
         }
     }
-    if (densest < 3u || float(own) > 0.625 * float(densest)) {
-        return false;
+    if (densest < 3u) {
+        return -1.0;
     }
     for (int k = 0; k < 8; k += 2) {
-        if ((emptyBeside & (1u << (k / 2))) != 0u &&
-            !fillsGap(pixel + kDirections[k])) {
-            return true;
+        if ((emptyBeside & (1u << (k / 2))) != 0u && !fillsGap(pixel + kDirections[k])) {
+            return clamp(float(own) / float(densest) - 0.125, 0.0, 1.0);
         }
     }
-    return false;
+    return -1.0;
 }
 
-/// Whether `pixel`, filled to `depth` by pull-push, belongs to the surface (the "mask").
-bool onSurface(ivec2 pixel, float depth) {
+/// How much of `pixel`, filled to `depth` by pull-push, the surface covers (the "mask"): 0 off
+/// it, else 1, except on the sub-pixel outline, where a pixel is surface when more than half of
+/// it lies inside (its centre does, on a straight outline) and is covered by that share (the
+/// anti-aliased outline, pipeline.md). The pixels beyond the mask stay background though up to
+/// half covered: shown with a neighbour's colour over their share, they made the converged and
+/// the filtered pictures of every object scan worse (noisy points beyond an outline fill more
+/// cells than the surface covers).
+float surfaceCoverage(ivec2 pixel, float depth) {
     if (!(depth > 0.0 && !isinf(depth) && !isnan(depth))) {
-        return false;
+        return 0.0;
     }
     // A pixel whose points the hidden-point test all removed still shows a surface: its
     // points' own where the test erred (beside a near surface's edge it hides a band of the
@@ -433,8 +438,9 @@ bool onSurface(ivec2 pixel, float depth) {
     // the outline as a visible point's do (the cells are known only with the sub-pixel rule).
     bool holdsPoints = pullWeightAt(texelIndex(0u, pixel)) > 0.0 ||
                        (surface.fill.w != 0.0 && occupiedCells(pixel) > 0u);
-    if (holdsPoints) {
-        return surface.fill.w == 0.0 || !centreBeyondOutline(pixel);
+    if (!holdsPoints) {
+        return fillsGap(pixel) ? 1.0 : 0.0;
     }
-    return fillsGap(pixel);
+    float share = surface.fill.w != 0.0 ? outlineShare(pixel) : -1.0;
+    return share < 0.0 ? 1.0 : (share > 0.5 ? share : 0.0);
 }

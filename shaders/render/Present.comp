@@ -2,8 +2,10 @@
 // Final image: linear colour -> sRGB 8-bit, scaled up to the output when the pipeline ran at
 // 1/divisor of its resolution (bilinear, the background standing in for empty texels so the
 // silhouette blends into it instead of taking a colour from outside the surface).
-//   STAGE_DEPTH  pixels where the depth input is +inf show the background
-//   STAGE_COLOR  the colour already includes the background
+//   STAGE_DEPTH     pixels where the depth input is +inf show the background
+//   STAGE_COLOR     the colour already includes the background
+//   STAGE_COVERAGE  the colour's alpha is the share of the pixel the surface covers
+//                   (OutlineCoverage.comp), the background shows through the rest
 #include "shared/common.glsl"
 #include "shared/region.glsl"
 
@@ -21,7 +23,12 @@ vec3 colorAt(ivec2 texel) {
         return frame.background.rgb;
     }
 #endif
+#if STAGE_COVERAGE
+    vec4 color = imageLoad(inColor, texel);
+    return mix(frame.background.rgb, color.rgb, color.a);
+#else
     return imageLoad(inColor, texel).rgb;
+#endif
 }
 
 void main() {

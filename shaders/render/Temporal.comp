@@ -9,7 +9,9 @@
 // resolution). Defined by TemporalPass:
 //   TEMPORAL_DEPTH_IN_ALPHA  1: the frame's depth is its colour image's alpha (FinishSurface's
 //                            moving frames), one image load a texel instead of two (on
-//                            llvmpipe the loads are most of this pass's cost); 0: "surfaceDepth"
+//                            llvmpipe the loads are most of this pass's cost); 0: "surfaceDepth",
+//                            and the colour's alpha is the share of the pixel the surface
+//                            covers (OutlineCoverage.comp)
 #define MODE_STILL (STAGE_STILL || STAGE_STILL_PICTURE)
 #define MODE_MOVING (STAGE_MOVING || STAGE_MOVING_PICTURE)
 #define WRITE_PICTURE (STAGE_RESTART_PICTURE || STAGE_STILL_PICTURE || STAGE_MOVING_PICTURE)
@@ -36,8 +38,11 @@ vec4 frameSampleAt(ivec2 texel, out float depth) {
     return frameSample(value.rgb, depth);
 #else
     depth = imageLoad(inDepth, texel).r;
-    return isinf(depth) ? vec4(frame.background.rgb, 0.0)
-                        : frameSample(imageLoad(inRadiance, texel).rgb, depth);
+    if (isinf(depth)) {
+        return vec4(frame.background.rgb, 0.0);
+    }
+    vec4 color = imageLoad(inRadiance, texel);
+    return frameSample(mix(frame.background.rgb, color.rgb, color.a), depth);
 #endif
 }
 

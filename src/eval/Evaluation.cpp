@@ -46,7 +46,7 @@ class ImageShader {
         : context_(context),
           cloud_(cloud),
           shade_(sources_, ShadeOutputs::Radiance),
-          present_(sources_, "radiance", "surfaceDepth") {}
+          present_(sources_, "radiance", PresentBackground::WhereNoDepth, "surfaceDepth") {}
 
     std::vector<std::uint8_t> shade(const Camera& camera, const RenderSettings& settings,
                                     const std::vector<float>& depth,

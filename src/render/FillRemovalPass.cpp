@@ -34,7 +34,7 @@ std::vector<std::string_view> FillRemovalPass::outputs(const RenderSettings& set
         return {"fillReach", "fillSparse", "mask", "surfaceDepth"};
     }
     if (followsNormalsToOutline(settings)) {
-        return {"fillReach", "fillSparse", "surfaceDepth"};
+        return {"fillReach", "fillSparse", "mask", "surfaceDepth"};
     }
     return {"fillReach", "fillSparse"};
 }
@@ -77,14 +77,13 @@ void FillRemovalPass::execute(FrameContext& frame) {
         resources.buffer("occupancy").bindStorage(SUBSCAN_SSBO_OCCUPANCY);
     }
     surfaceDepth.bindImage(SUBSCAN_IMAGE_OUT1, GL_WRITE_ONLY);
+    frame.imageOverRegion("mask", TextureFormat::R8).bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     if (fused) {
         // Level 0 of the push, as FinishSurface computes it.
         resources.buffer("pullValues")
             .bindTexels(SUBSCAN_TEXELS_PULL_VALUES, TextureFormat::RGBA32F);
     } else {
-        Texture& mask = frame.imageOverRegion("mask", TextureFormat::R8);
         resources.texture("filledDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-        mask.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);
     }
     stages_.runOverRegion(fused ? SurfaceDepth : Mask, frame.region(0));
     glMemoryBarrier(kImageWritesBarrier);

@@ -32,7 +32,7 @@ FinishSurfacePass::FinishSurfacePass(const ShaderSources& sources, Output output
 std::vector<std::string_view> FinishSurfacePass::inputs(const RenderSettings& settings) const {
     std::vector<std::string_view> names{"pullValues", "pullWeights", "pushValues", "normalPyramid"};
     if (followsNormalsToOutline(settings)) {
-        names.push_back("surfaceDepth");  // the mask, FillRemovalPass's
+        names.insert(names.end(), {"surfaceDepth", "mask"});  // FillRemovalPass's
         return names;
     }
     names.insert(names.end(), {"fillReach", "fillSparse"});
@@ -89,6 +89,7 @@ void FinishSurfacePass::execute(FrameContext& frame) {
     const bool seesOutline = followsNormalsToOutline(frame.settings);
     if (seesOutline) {
         resources.texture("surfaceDepth").bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
+        resources.texture("mask").bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     } else {
         resources.buffer("fillReach").bindTexels(SUBSCAN_TEXELS_FILL_REACH, TextureFormat::R32UI);
         resources.buffer("fillSparse").bindTexels(SUBSCAN_TEXELS_FILL_SPARSE, TextureFormat::R32UI);

@@ -40,14 +40,31 @@ void PresentPass::clearToBackground(const FrameContext& frame, Texture& image) {
                                  linearToSrgb(srgbToLinear(background.b)), 1.0f));
 }
 
+namespace {
+
+const char* variantFor(PresentBackground background) {
+    switch (background) {
+        case PresentBackground::InColor:
+            return "COLOR";
+        case PresentBackground::WhereNoDepth:
+            return "DEPTH";
+        case PresentBackground::ByCoverage:
+            return "COVERAGE";
+    }
+    return "COLOR";
+}
+
+}  // namespace
+
 PresentPass::PresentPass(const ShaderSources& sources, std::string colorInput,
-                         std::string depthInput)
+                         PresentBackground background, std::string depthInput)
     : colorInput_(std::move(colorInput)),
+      background_(background),
       depthInput_(std::move(depthInput)),
-      stages_(sources, "render/Present.comp", {depthInput_.empty() ? "COLOR" : "DEPTH"}) {}
+      stages_(sources, "render/Present.comp", {variantFor(background)}) {}
 
 std::vector<std::string_view> PresentPass::inputs(const RenderSettings&) const {
-    if (depthInput_.empty()) {
+    if (background_ != PresentBackground::WhereNoDepth) {
         return {colorInput_};
     }
     return {colorInput_, depthInput_};
@@ -56,12 +73,12 @@ std::vector<std::string_view> PresentPass::inputs(const RenderSettings&) const {
 void PresentPass::execute(FrameContext& frame) {
     const glm::ivec2 size = frame.outputSize();
     Texture& image = frame.resources.ensureTexture("image", TextureFormat::RGBA8, size.x, size.y);
-    const bool whole = depthInput_.empty() || !frame.restricted();
+    const bool whole = background_ == PresentBackground::InColor || !frame.restricted();
     if (!whole) {
         clearToBackground(frame, image);
     }
     frame.resources.texture(colorInput_).bindImage(SUBSCAN_IMAGE_IN0, GL_READ_ONLY);
-    if (!depthInput_.empty()) {
+    if (background_ == PresentBackground::WhereNoDepth) {
         frame.resources.texture(depthInput_).bindImage(SUBSCAN_IMAGE_IN1, GL_READ_ONLY);
     }
     image.bindImage(SUBSCAN_IMAGE_OUT0, GL_WRITE_ONLY);

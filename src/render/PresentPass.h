@@ -7,12 +7,22 @@
 
 namespace subscan {
 
-/// The final picture "image": the linear colour input encoded to sRGB 8-bit. When a depth input
-/// is named, pixels where it is +inf show the background, and a frame restricted to the points'
-/// bounds is encoded only there (the rest is cleared to the background).
+/// Where the background shows in Present's colour input.
+enum class PresentBackground {
+    InColor,       // the colour already holds it
+    WhereNoDepth,  // where the depth input is +inf
+    ByCoverage,    // under the colour's alpha, the share of the pixel the surface covers
+                   // (OutlineCoveragePass)
+};
+
+/// The final picture "image": the linear colour input over the background, encoded to sRGB
+/// 8-bit. Unless the colour holds the background, a frame restricted to the points' bounds is
+/// encoded only there (the rest is cleared to the background).
 class PresentPass final : public RenderPass {
   public:
-    PresentPass(const ShaderSources& sources, std::string colorInput, std::string depthInput);
+    /// `depthInput` names the depth image for PresentBackground::WhereNoDepth.
+    PresentPass(const ShaderSources& sources, std::string colorInput, PresentBackground background,
+                std::string depthInput = {});
 
     std::string_view name() const override { return "Present"; }
     std::vector<std::string_view> inputs(const RenderSettings&) const override;
@@ -26,6 +36,7 @@ class PresentPass final : public RenderPass {
 
   private:
     std::string colorInput_;
+    PresentBackground background_;
     std::string depthInput_;
     ComputeStages stages_;
 };

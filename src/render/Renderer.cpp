@@ -9,6 +9,7 @@
 #include "core/NormalEstimation.h"
 #include "render/DrawPointsPass.h"
 #include "render/FinishSurfacePass.h"
+#include "render/OutlineCoveragePass.h"
 #include "render/PresentPass.h"
 #include "render/RasterizePointsPass.h"
 #include "render/ShadePass.h"
@@ -131,8 +132,9 @@ RenderSettings Renderer::resolvedSettings(const RenderSettings& settings) const 
     return resolved;
 }
 
-PresentPass& Renderer::present(const std::string& color, const std::string& depth) {
-    return lazyPass(presents_[{color, depth}], sources_, color, depth);
+PresentPass& Renderer::present(const std::string& color, PresentBackground background,
+                               const std::string& depth) {
+    return lazyPass(presents_[{color, background, depth}], sources_, color, background, depth);
 }
 
 void Renderer::appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes) {
@@ -167,15 +169,18 @@ void Renderer::appendShading(bool split, std::vector<RenderPass*>& passes) {
 
 void Renderer::appendPresent(const RenderSettings& settings, int divisor, const std::string& color,
                              std::vector<RenderPass*>& passes, TemporalDepth depth) {
+    if (depth == TemporalDepth::SurfaceDepth) {
+        passes.push_back(&lazyPass(outlineCoverages_[color], sources_, color));
+    }
     if (!filtersTemporally(settings)) {
-        passes.push_back(&present(color, "surfaceDepth"));
+        passes.push_back(&present(color, PresentBackground::ByCoverage));
         return;
     }
     TemporalPass& temporal = lazyPass(temporal_, sources_, temporalHistory_);
     temporal.setInput(color, depth, divisor == 1);
     passes.push_back(&temporal);
     if (divisor != 1) {
-        passes.push_back(&present("history", ""));
+        passes.push_back(&present("history", PresentBackground::InColor));
     }
 }
 
@@ -219,14 +224,14 @@ std::vector<RenderPass*> Renderer::passesFor(const RenderSettings& settings, int
     }
     if (stageView) {
         passes.push_back(&lazyPass(stageViews_[raster.stage], sources_, raster.stage));
-        passes.push_back(&present("stage", ""));
+        passes.push_back(&present("stage", PresentBackground::InColor));
     } else if (scatters) {
         appendScattering(settings.scattering.method, passes);
         appendPresent(settings, divisor, "scatteredRadiance", passes);
     } else if (surface) {
         appendPresent(settings, divisor, "radiance", passes);
     } else {
-        passes.push_back(&present("color", "depth"));
+        passes.push_back(&present("color", PresentBackground::WhereNoDepth, "depth"));
     }
     return passes;
 }

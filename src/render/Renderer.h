@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "core/Camera.h"
@@ -19,6 +20,7 @@
 #include "render/GpuPointCloud.h"
 #include "render/LightMaps.h"
 #include "render/PassRunner.h"
+#include "render/PresentPass.h"
 #include "render/Reconstruction.h"
 #include "render/ReducedResolution.h"
 #include "render/RenderSettings.h"
@@ -34,7 +36,7 @@ class ShadePass;
 class StageViewPass;
 class SubsurfaceScatteringPass;
 class SingleScatteringPass;
-class PresentPass;
+class OutlineCoveragePass;
 
 /// The normals a renderer of `cloud` needs estimated (estimateNormals) for `requested`: where the
 /// cloud has none of its own, for Points always, for Auto up to kAlwaysEstimateNormalsPoints
@@ -154,13 +156,15 @@ class Renderer {
     void appendShading(bool split, std::vector<RenderPass*>& passes);
     /// The scattering passes of the sss mode's final picture, by ScatteringSettings::method.
     void appendScattering(ScatteringMethod method, std::vector<RenderPass*>& passes);
-    /// Present of the linear colour `color` (over the background where "surfaceDepth" is
-    /// +inf), through the temporal filter when the settings ask for it, which finds the depth
-    /// where `depth` says (only the filter reads `color`'s alpha).
+    /// Present of the surface's linear colour `color` over the background by the share of each
+    /// pixel the surface covers (OutlineCoveragePass, "mask"), through the temporal filter when
+    /// the settings ask for it, which finds the depth where `depth` says (FinishSurface's
+    /// "radianceAndDepth" holds the colour over the background already).
     void appendPresent(const RenderSettings& settings, int divisor, const std::string& color,
                        std::vector<RenderPass*>& passes,
                        TemporalDepth depth = TemporalDepth::SurfaceDepth);
-    PresentPass& present(const std::string& color, const std::string& depth);
+    PresentPass& present(const std::string& color, PresentBackground background,
+                         const std::string& depth = {});
     FrameResources& resourcesFor(int divisor) {
         return divisor == 1 ? fullResources_ : reducedResources_;
     }
@@ -197,7 +201,9 @@ class Renderer {
     std::unique_ptr<SingleScatteringPass> singleScattering_;
     std::unique_ptr<SingleScatteringPass> singleAfterGaussian_;
     std::map<Stage, std::unique_ptr<StageViewPass>> stageViews_;
-    std::map<std::pair<std::string, std::string>, std::unique_ptr<PresentPass>> presents_;
+    std::map<std::tuple<std::string, PresentBackground, std::string>, std::unique_ptr<PresentPass>>
+        presents_;
+    std::map<std::string, std::unique_ptr<OutlineCoveragePass>> outlineCoverages_;  // by colour
     std::unique_ptr<PassRunner> runner_;
     TimingMode runnerTiming_ = TimingMode::Auto;
 };

@@ -70,8 +70,10 @@ class TemporalHistory {
 
 /// Where TemporalPass finds the frame's depth.
 enum class TemporalDepth {
-    SurfaceDepth,  // the image "surfaceDepth"
-    ColorAlpha,    // the colour input's alpha (RGBA32F; FinishSurface's "radianceAndDepth")
+    SurfaceDepth,  // the image "surfaceDepth"; the colour's alpha is the share of the pixel
+                   // the surface covers (OutlineCoveragePass)
+    ColorAlpha,    // the colour input's alpha (RGBA32F; FinishSurface's "radianceAndDepth",
+                   // its colour over the background)
 };
 
 /// The temporal filter as its own pass, after shading or scattering (the sss mode, reduced

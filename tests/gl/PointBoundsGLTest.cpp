@@ -80,7 +80,8 @@ std::optional<glm::ivec4> runFrame(PassHarness& harness) {
     NormalsPass(sources).execute(frame);
     ShadePass(sources, ShadeOutputs::Split).execute(frame);
     SubsurfaceScatteringPass(sources).execute(frame);
-    PresentPass(sources, "scatteredRadiance", "surfaceDepth").execute(frame);
+    PresentPass(sources, "scatteredRadiance", PresentBackground::WhereNoDepth, "surfaceDepth")
+        .execute(frame);
     return frame.pointBounds;
 }
 

@@ -17,17 +17,18 @@
 namespace subscan {
 namespace {
 
-/// Present's scaling on the CPU: bilinear over the reduced radiance, the background standing
-/// in where the surface depth is +inf, then 8-bit sRGB.
+/// Present's scaling on the CPU: bilinear over the reduced radiance shown over the background
+/// by its alpha (the share of the texel the surface covers, OutlineCoveragePass's), then
+/// 8-bit sRGB.
 std::vector<std::uint8_t> scaledUp(const Camera& output, const Camera& reduced,
                                    const std::vector<float>& radiance,
-                                   const std::vector<float>& depth, const glm::vec3& background) {
+                                   const glm::vec3& background) {
     auto colorAt = [&](glm::ivec2 texel) {
         texel = glm::clamp(texel, glm::ivec2(0), glm::ivec2(reduced.width, reduced.height) - 1);
         const std::size_t i = static_cast<std::size_t>(texel.y * reduced.width + texel.x);
-        return std::isinf(depth[i])
-                   ? background
-                   : glm::vec3(radiance[4 * i], radiance[4 * i + 1], radiance[4 * i + 2]);
+        return glm::mix(background,
+                        glm::vec3(radiance[4 * i], radiance[4 * i + 1], radiance[4 * i + 2]),
+                        radiance[4 * i + 3]);
     };
     std::vector<std::uint8_t> image;
     for (int y = 0; y < output.height; ++y) {
@@ -67,7 +68,7 @@ TEST(ReducedResolutionGLTest, HalfResolutionIsTheReducedFrameScaledUp) {
 
     const glm::vec3& background = settings.raster.backgroundSrgb;
     const std::vector<std::uint8_t> expected = scaledUp(
-        camera, reduced, radiance, depth,
+        camera, reduced, radiance,
         {srgbToLinear(background.r), srgbToLinear(background.g), srgbToLinear(background.b)});
     ASSERT_EQ(image.size(), expected.size());
     int surfacePixels = 0;
@@ -80,6 +81,11 @@ TEST(ReducedResolutionGLTest, HalfResolutionIsTheReducedFrameScaledUp) {
     }
     EXPECT_GT(surfacePixels, 81 * 49 / 10) << "the surface should fill part of the frame";
     EXPECT_LT(surfacePixels, 81 * 49 * 9 / 10) << "the frame should show background too";
+    int partlyCovered = 0;
+    for (std::size_t i = 3; i < radiance.size(); i += 4) {
+        partlyCovered += radiance[i] > 0.0f && radiance[i] < 1.0f ? 1 : 0;
+    }
+    EXPECT_GT(partlyCovered, 0) << "the outline should be anti-aliased";
 
     // The same reduced camera at full resolution: the very same pipeline images.
     settings.raster.resolution = Resolution::Full;

@@ -1263,6 +1263,45 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
     // Most of the hidden points' pixels are surface: without them, the gap rule would find
     // too few directions enclosed this far out.
     EXPECT_GT(hiddenKept, 10);
+
+    // The mask's values (the anti-aliased outline): a pixel of the mask where the rule acts is
+    // covered by its share, its cells against the densest neighbour's less 1/8; the rest of
+    // the mask wholly.
+    int partlyCovered = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const int i = y * kWidth + x;
+            std::optional<float> share;
+            int densest = cellsAt(x, y);
+            for (int dy = -1; dy <= 1; ++dy) {
+                for (int dx = -1; dx <= 1; ++dx) {
+                    densest = inside(x + dx, y + dy) ? std::max(densest, cellsAt(x + dx, y + dy))
+                                                     : densest;
+                }
+            }
+            bool tie = false;
+            for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {-1, 0}, {0, -1}}) {
+                if (cellsAt(x, y) == 0 || densest < 3 || !inside(x + dx, y + dy) ||
+                    cellsAt(x + dx, y + dy) != 0) {
+                    continue;
+                }
+                const std::optional<bool> gap = cpuFillsGap(harness, inputs, x + dx, y + dy);
+                tie = tie || !gap;
+                if (gap && !*gap) {
+                    share = std::clamp(float(cellsAt(x, y)) / float(densest) - 0.125f, 0.0f, 1.0f);
+                }
+            }
+            if (tie && !share) {
+                continue;  // as above
+            }
+            const float coverage = mask[i] > 0.5f ? share.value_or(1.0f) : 0.0f;
+            partlyCovered += coverage > 0.0f && coverage < 1.0f ? 1 : 0;
+            // The mask is 8-bit: half a step of 1/255.
+            EXPECT_NEAR(mask[i], coverage, 0.5f / 255.0f + 1e-6f) << x << "," << y;
+        }
+    }
+    // Often enough that a share taken wrongly fails here.
+    EXPECT_GT(partlyCovered, 3);
 }
 
 /// The fill removal's mask of a `size` x `size` frame of `depth` and `color` (RGBA, alpha the

@@ -81,6 +81,7 @@ glm::vec3 pattern(const glm::dvec3& world) {
 struct Inputs {
     std::vector<float> radiance;  // RGBA
     std::vector<float> depth;
+    std::vector<float> coverage;  // OutlineCoverage's share per pixel; empty: the mask's
 };
 
 /// The plane seen through `camera`: colour from `colorOf(world, x, y)`, +inf where `hole`.
@@ -127,8 +128,16 @@ class TemporalHarness {
             resources.ensureTexture("radianceAndDepth", TextureFormat::RGBA32F, kWidth, kHeight)
                 .uploadFloats(packed);
         } else {
+            // OutlineCoverage's alpha: the covered share, where the inputs do not give one
+            // the mask's.
+            std::vector<float> radiance = inputs.radiance;
+            for (std::size_t i = 0; i < inputs.depth.size(); ++i) {
+                radiance[4 * i + 3] = !inputs.coverage.empty()      ? inputs.coverage[i]
+                                      : std::isinf(inputs.depth[i]) ? 0.0f
+                                                                    : 1.0f;
+            }
             resources.ensureTexture("radiance", TextureFormat::RGBA16F, kWidth, kHeight)
-                .uploadFloats(inputs.radiance);
+                .uploadFloats(radiance);
             resources.ensureTexture("surfaceDepth", TextureFormat::R32F, kWidth, kHeight)
                 .uploadFloats(inputs.depth);
         }
@@ -574,6 +583,32 @@ TEST(TemporalGLTest, AFastMoveLeavesNoGhostOnceTheCameraStops) {
     // the difference between 8 and 32 jitter offsets at the silhouette (~0.2): within half a
     // level of 255 on average. Weighing the motion's history as all its frames leaves ~0.75.
     EXPECT_LT(settled, 0.5) << "just arrived: " << justArrived;
+}
+
+TEST(TemporalGLTest, OutlineCoverageBlendsTheColourOverTheBackground) {
+    RenderSettings settings;
+    settings.temporal.enabled = true;
+    TemporalHarness harness(settings, kSpacing, TemporalDepth::SurfaceDepth);
+    const Camera camera = harness.camera();
+    // Column 1 lies on the outline, covered 0.6, the columns after it whole; column 0 is off
+    // the mask, which decides the background whatever its alpha.
+    Inputs inputs = planeInputs(
+        camera, Plane{}, [](glm::dvec3, int, int) { return glm::vec3(0.8f); },
+        [](int x, int) { return x == 0; });
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            inputs.coverage.push_back(x == 0 ? 0.25f : x == 1 ? 0.6f : 1.0f);
+        }
+    }
+    const std::vector<float> history = harness.run(camera, inputs).first;
+    const double background = srgbToLinear(settings.raster.backgroundSrgb.r);
+    const std::size_t row = 4 * static_cast<std::size_t>(kHeight / 2 * kWidth);
+    // Half floats: 2^-11 relative on values below 1. The history's alpha is the mask's.
+    EXPECT_NEAR(history[row], background, 1e-3);
+    EXPECT_NEAR(history[row + 3], 0.0, 1e-3);
+    EXPECT_NEAR(history[row + 4], background + 0.6 * (0.8 - background), 1e-3);
+    EXPECT_NEAR(history[row + 7], 1.0, 1e-3);
+    EXPECT_NEAR(history[row + 8], 0.8, 1e-3);
 }
 
 }  // namespace
