@@ -59,9 +59,12 @@ struct PointCloud {
     std::vector<std::uint8_t> classifications;  // ASPRS LAS class codes (LAS files only)
     std::vector<Triangle> triangles;            // vertex indices; ground-truth meshes only
     Bounds bounds;                              // exact, in file coordinates
-    /// The finest step of the grid the file stored coordinates on (a LAS file's scale); 0 where
-    /// the file does not say (floats, doubles, text).
+    /// The finest step of the grid the file stored coordinates on: a LAS file's scale, or 10^-d
+    /// for text whose coordinates have at most d decimals; 0 where the file has no grid.
     double coordinateStep = 0.0;
+    /// Whether the file stored coordinates as doubles (a PLY or PCD double property, E57): finer
+    /// than floats hold, on no grid.
+    bool doubleCoordinates = false;
 
     std::size_t size() const { return positions.size(); }
     bool hasColors() const { return !colors.empty(); }

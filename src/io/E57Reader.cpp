@@ -1092,7 +1092,11 @@ PointCloud readE57(std::span<const std::byte> file, ReadContext& context) {
                         sink.invalid, totalRecords));
     }
     context.reportProgress(totalRecords, totalRecords);
-    return builder.finish(context.warnings);
+    PointCloud cloud = builder.finish(context.warnings);
+    // Positions are computed in double (scaled integers, spherical coordinates, each scan's
+    // pose), so they are doubles whatever the fields' types; keeping them so is simplest.
+    cloud.doubleCoordinates = true;
+    return cloud;
 }
 
 }  // namespace subscan

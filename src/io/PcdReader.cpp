@@ -934,6 +934,9 @@ PointCloud readPcd(std::span<const std::byte> file, ReadContext& context) {
     }
     context.reportProgress(header.points, header.points);
     PointCloud cloud = sink.finish(context.warnings);
+    cloud.doubleCoordinates = std::any_of(
+        layout.position.begin(), layout.position.end(),
+        [&](std::size_t field) { return header.fields[field].type == PcdType::Float64; });
     context.sensor = SensorPose{header.viewpoint, header.viewpointGiven
                                                       ? "the PCD VIEWPOINT"
                                                       : "the PCD default VIEWPOINT (none given)"};

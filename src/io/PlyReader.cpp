@@ -766,6 +766,10 @@ PointCloud PlyBodyReader::read() {
     }
     context_.reportProgress(file_.size(), file_.size());
     PointCloud cloud = builder.finish(context_.warnings);
+    cloud.doubleCoordinates =
+        std::any_of(layout.position.begin(), layout.position.end(), [&](std::size_t property) {
+            return vertex->properties[property].type == PlyType::Float64;
+        });
     if (largeColorValues) {
         cloud.colors = std::move(largeValueColors);
     }

@@ -35,11 +35,13 @@ bool needsDoubleCoordinates(const PointCloud& cloud) {
     const double size = std::max({extent.x, extent.y, extent.z});
     const double inMemory = floatRounding(
         largestComponent(cloud.bounds.min - cloud.origin, cloud.bounds.max - cloud.origin));
-    // On a file's grid, less than half a step still rounds back to the stored integer; what
-    // memory already lost (floats relative to the centre) cannot be kept by doubles either.
-    const double allowed = cloud.coordinateStep > 0.0
-                               ? std::max(0.5 * cloud.coordinateStep, inMemory)
-                               : std::max(kFloatErrorFraction * size, inMemory);
+    // On a file's grid, less than half a step still rounds back to the stored integer; doubles
+    // from the file are kept as far as memory kept them; what memory already lost (floats
+    // relative to the centre) cannot be kept by doubles either.
+    const double allowed =
+        cloud.coordinateStep > 0.0 ? std::max(0.5 * cloud.coordinateStep, inMemory)
+        : cloud.doubleCoordinates  ? inMemory
+                                   : std::max(kFloatErrorFraction * size, inMemory);
     return written > allowed;
 }
 

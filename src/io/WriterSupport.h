@@ -12,10 +12,11 @@
 namespace subscan {
 
 /// Whether float would round the cloud's file coordinates by more than the data's own
-/// resolution: half a step of the file's grid (PointCloud::coordinateStep, a LAS scale) but no
-/// less than memory keeps (floats relative to the centre), else a millionth of the extent. UTM
-/// coordinates, where a float step is half a metre, are so; the writers of formats that can
-/// choose (PLY, PCD) then store doubles.
+/// resolution, but no less than memory keeps (floats relative to the centre): half a step of
+/// the file's grid (PointCloud::coordinateStep: a LAS scale, a text's decimals); nothing where
+/// the file held doubles; else, for floats, a millionth of the extent. UTM coordinates, where a
+/// float step is half a metre, are so; the writers of formats that can choose (PLY, PCD) then
+/// store doubles.
 bool needsDoubleCoordinates(const PointCloud& cloud);
 
 /// Whether any point's colour has an alpha below 255 (only PLY stores alpha).

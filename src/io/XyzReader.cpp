@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
+#include <climits>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -117,6 +119,25 @@ const char* parseValue(const char* first, const char* last, char decimalPoint, d
     const double magnitude = static_cast<double>(mantissa) / kPowersOfTen[decimals];
     value = negative ? -magnitude : magnitude;
     return p;
+}
+
+/// How many decimals a number's text gives, less its exponent: 3 for "512345.125" and
+/// "512345.000", 0 for "17", -2 for "1.5e3". 10^-decimals is the step the text resolves.
+int writtenDecimals(const char* first, const char* last, char decimalPoint) {
+    const char* p = std::find(first, last, decimalPoint);
+    int decimals = 0;
+    if (p != last) {
+        for (++p; p != last && isDigit(*p); ++p) {
+            ++decimals;
+        }
+    }
+    p = std::find_if(first, last, [](char c) { return c == 'e' || c == 'E'; });
+    if (p != last) {
+        int exponent = 0;
+        std::from_chars(p + 1 + (p + 1 != last && p[1] == '+'), last, exponent);
+        decimals -= exponent;
+    }
+    return decimals;
 }
 
 /// True when all of `field` is one number.
@@ -814,7 +835,12 @@ class PointLineParser {
           columnCount_(layout.columnCount),
           lineNumber_(prelude.linesBeforeData),
           // A PTS file with count lines only still needs room for the count.
-          values_(layout.columnCount == 0 ? 1 : layout.usedColumns(), 0.0) {}
+          values_(layout.columnCount == 0 ? 1 : layout.usedColumns(), 0.0),
+          positionColumn_(values_.size(), false) {
+        for (const std::size_t column : layout.position) {
+            positionColumn_[column] = column < positionColumn_.size();
+        }
+    }
 
     void parse(std::string_view text,
                const std::function<void(std::span<const double>, std::size_t)>& point);
@@ -822,6 +848,10 @@ class PointLineParser {
         if (block_) {
             block_->check();
         }
+    }
+    /// 10^-d for the most decimals d of a coordinate parsed so far; 0 before the first point.
+    double coordinateStep() const {
+        return mostDecimals_ ? std::pow(10.0, -std::clamp(*mostDecimals_, -300, 300)) : 0.0;
     }
 
   private:
@@ -836,6 +866,8 @@ class PointLineParser {
     std::size_t columnCount_;
     std::size_t lineNumber_;
     std::vector<double> values_;
+    std::vector<bool> positionColumn_;  // per kept value: whether it is x, y or z
+    std::optional<int> mostDecimals_;   // of the coordinates (writtenDecimals)
     std::optional<PtsBlock> block_;
 };
 
@@ -852,6 +884,10 @@ std::size_t PointLineParser::parseLine(const char* p, const char* end, std::stri
         }
         if (count < values_.size()) {
             values_[count] = value;
+            if (positionColumn_[count]) {
+                mostDecimals_ = std::max(mostDecimals_.value_or(INT_MIN),
+                                         writtenDecimals(p, next, decimalPoint));
+            }
         }
         ++count;
         p = next;
@@ -1026,6 +1062,10 @@ void PointTextReader::finish() const {
     state_->parser->finish();
 }
 
+double PointTextReader::coordinateStep() const {
+    return state_->parser->coordinateStep();
+}
+
 void PointTextReader::restart(TextColorEncoding encoding, ReadContext& context) {
     State& state = *state_;
     state.layout.colorEncoding = encoding;
@@ -1066,7 +1106,9 @@ PointCloud readPoints(std::string_view text, PointTextReader& reader, ReadContex
         position = end;
     }
     reader.finish();
-    return builder.finish(context.warnings);
+    PointCloud cloud = builder.finish(context.warnings);
+    cloud.coordinateStep = reader.coordinateStep();
+    return cloud;
 }
 
 }  // namespace

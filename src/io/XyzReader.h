@@ -101,6 +101,10 @@ class PointTextReader {
                const std::function<void(std::span<const double>, std::size_t)>& point);
     /// At the end of the file: checks the point count of the last PTS block.
     void finish() const;
+    /// The step of the decimal grid the coordinates parsed so far are written on: 10^-d for the
+    /// most decimals d of any of them (a number's exponent counts: 1.5e3 has -2); 0 before the
+    /// first point. Text keeps what its writer wrote, so this is the precision it carries.
+    double coordinateStep() const;
     /// Starts again at dataOffset(), with the colour columns read as `encoding`: for a file
     /// whose later lines showed that the first ones misled the guess. The format detail in
     /// `context` says so.

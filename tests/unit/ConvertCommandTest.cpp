@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
@@ -225,6 +226,31 @@ TEST(ConvertCommandTest, APcdKeepsItsSensorAndNamesTheGridItDrops) {
     const LoadedScan read = loadScan(output.string());
     ASSERT_TRUE(read.sensor.has_value());
     EXPECT_EQ(read.sensor->position, glm::dvec3(0.5, 0.5, -10));
+}
+
+TEST(ConvertCommandTest, TextOfMillimetresKeepsThemInPlyAndPcd) {
+    // 18 km of millimetre coordinates about 509 km from the origin: float rounds by 16 mm
+    // there, less than the millionth of the extent (18 mm) that was allowed for every input
+    // without a grid (found by the outside hunt). The text's decimals say millimetres, so
+    // doubles are written.
+    const test::TempDir dir;
+    std::vector<glm::dvec3> positions{{509000.0, 509000.0, 100.0}};  // the centre: memory's origin
+    for (int i = -50; i <= 50; ++i) {
+        positions.emplace_back(509000.0 + 180.001 * i, 509000.0 - 170.007 * i, 100.0 + 0.013 * i);
+    }
+    std::string text;
+    for (const glm::dvec3& p : positions) {
+        text += fmt::format("{:.3f} {:.3f} {:.3f}\n", p.x, p.y, p.z);
+    }
+    const auto input = dir.write("mm.xyz", text);
+    for (const std::string name : {"mm.ply", "mm.pcd"}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / name;
+        convert(input.string(), output);
+        // Floats relative to the centre, 9 km at most, round by 0.49 mm when the text is read
+        // and again when the output is.
+        test::expectPositionsNear(loadScan(output.string()).cloud, test::cloudOf(positions), 1e-3);
+    }
 }
 
 TEST(ConvertCommandTest, IntensitiesLasCannotHoldAreNamed) {

@@ -187,6 +187,7 @@ void expectSamplePoints(const LoadedScan& scan, bool alphaFromFile) {
     // Bounds are kept in double: exact.
     EXPECT_EQ(cloud.bounds.min, glm::dvec3(499999.0, 5399999.75, -2.25));
     EXPECT_EQ(cloud.bounds.max, glm::dvec3(500001.875, 5400002.5, 1.5));
+    EXPECT_TRUE(cloud.doubleCoordinates);  // SIZE 8, TYPE F
     EXPECT_TRUE(scan.warnings.empty()) << scan.warnings.front();
 }
 

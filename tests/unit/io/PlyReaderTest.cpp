@@ -52,6 +52,8 @@ TEST(PlyReaderTest, AsciiPositionsAnyPropertyOrderWithColorNormalIntensity) {
     EXPECT_EQ(cloud.intensities[1], 7.0f);
     EXPECT_EQ(cloud.bounds.min, glm::dvec3(1, -20, -3.5));
     EXPECT_EQ(cloud.bounds.max, glm::dvec3(4.25, 2, 3));
+    // x is a double: writers keep it one (needsDoubleCoordinates).
+    EXPECT_TRUE(cloud.doubleCoordinates);
 }
 
 /// Writes the same three points in both binary byte orders with mixed scalar types.

@@ -126,6 +126,11 @@ TEST(PlyWriterTest, DoublesAreChosenWhereFloatLosesTheFilesGrid) {
     PointCloud fine = everyAttribute({2000.0, 0.0, 0.0}, 2000.0);
     fine.coordinateStep = 1e-4;
     EXPECT_TRUE(needsDoubleCoordinates(fine));
+    // Doubles from the file, 20 km wide at 500 km: float's 16 mm there, a millionth 2 cm.
+    PointCloud doubles = everyAttribute({500000.0, 500000.0, 0.0}, 20000.0);
+    EXPECT_FALSE(needsDoubleCoordinates(doubles));
+    doubles.doubleCoordinates = true;
+    EXPECT_TRUE(needsDoubleCoordinates(doubles));
 }
 
 TEST(PlyWriterTest, PositionsOnlyAndNoFaces) {

@@ -365,6 +365,15 @@ TEST(XyzReaderTest, LargeCoordinatesKeepTheirPrecision) {
     EXPECT_NEAR(scan.cloud.fileCoordinates(1).y, 5400020.75, 4e-6);
 }
 
+TEST(XyzReaderTest, TheCoordinatesDecimalsAreTheirStep) {
+    // The most decimals of any coordinate, less the exponent (2.5e-2 has 3); the colour's and
+    // intensity's decimals do not count.
+    EXPECT_EQ(decode("500000.12 5400000.5 250\n1 2.5e-2 3\n", "a.xyz").cloud.coordinateStep, 1e-3);
+    EXPECT_EQ(decode("500000 5400000 250 0.123456\n", "i.xyz").cloud.coordinateStep, 1.0);
+    EXPECT_EQ(decode("1.5e3 2e2 3E+2\n", "e.xyz").cloud.coordinateStep, 100.0);
+    EXPECT_EQ(decode("1,25;2,5;3\n", "comma.csv").cloud.coordinateStep, 0.01);
+}
+
 TEST(XyzReaderTest, ContentDetectionForUnhelpfulExtensions) {
     EXPECT_EQ(decode("1 2 3\n4 5 6\n", "scan.dat").format, "xyz");
     EXPECT_EQ(decode("X,Y,Z,R,G,B\n1,2,3,4,5,6\n", "scan.dat").format, "xyz");
