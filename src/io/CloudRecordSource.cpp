@@ -16,22 +16,23 @@ namespace subscan {
 
 namespace {
 
-class CloudRecordSource final : public PointRecordSource {
+class CloudRecordSource final : public ConvertedRecordSource {
   public:
     explicit CloudRecordSource(const std::string& source) {
         LoadedScan scan = loadScan(source);
-        start(std::move(scan.cloud), source);
+        std::vector<std::string> warnings;
         for (const std::string& warning : scan.warnings) {
-            info_.warnings.push_back(fmt::format("{}: {}", source, warning));
+            warnings.push_back(fmt::format("{}: {}", source, warning));
         }
+        start(std::move(scan.cloud), source, std::move(warnings));
     }
-    CloudRecordSource(PointCloud cloud, const std::string& name) { start(std::move(cloud), name); }
-
-    const PointRecordSourceInfo& info() const override { return info_; }
+    CloudRecordSource(PointCloud cloud, const std::string& name) {
+        start(std::move(cloud), name, {});
+    }
 
     std::size_t read(std::vector<std::byte>& records, std::size_t maxPoints) override {
         const std::size_t count = std::min(maxPoints, cloud_.size() - next_);
-        records.reserve(records.size() + count * info_.format.recordLength());
+        records.reserve(records.size() + count * info().format.recordLength());
         for (std::size_t i = next_; i < next_ + count; ++i) {
             ConvertedPoint point;
             point.position = cloud_.fileCoordinates(i);
@@ -49,7 +50,7 @@ class CloudRecordSource final : public PointRecordSource {
             if (cloud_.hasClassifications()) {
                 point.classification = cloud_.classifications[i];
             }
-            writer_->append(records, point);
+            writer().append(records, point);
         }
         next_ += count;
         return count;
@@ -58,30 +59,24 @@ class CloudRecordSource final : public PointRecordSource {
     void rewind() override { next_ = 0; }
 
   private:
-    void start(PointCloud cloud, const std::string& source) {
+    void start(PointCloud cloud, const std::string& source, std::vector<std::string> warnings) {
         cloud_ = std::move(cloud);
         Bounds bounds;
         for (std::size_t i = 0; i < cloud_.size(); ++i) {
             bounds.add(cloud_.fileCoordinates(i));
         }
-        try {
-            writer_.emplace(cloud_.hasColors(), cloud_.hasNormals(), bounds);
-        } catch (const Error& error) {
-            throwNamed(source, error);
-        }
-        info_ = convertedSourceInfo(source, cloud_.size(), *writer_, bounds);
         if (!cloud_.triangles.empty()) {
-            info_.warnings.push_back(facesNotKept(source, cloud_.triangles.size()));
+            warnings.push_back(facesNotKept(source, cloud_.triangles.size()));
             cloud_.triangles = {};
         }
         if (!fitIntensityWords(cloud_.intensities)) {
-            info_.warnings.push_back(intensitiesNotKept(source));
+            warnings.push_back(intensitiesNotKept(source));
         }
+        startRecords(source, cloud_.size(), cloud_.hasColors(), cloud_.hasNormals(), bounds,
+                     cloud_.coordinateStep, std::move(warnings));
     }
 
     PointCloud cloud_;
-    std::optional<ConvertedRecordWriter> writer_;
-    PointRecordSourceInfo info_;
     std::size_t next_ = 0;
 };
 

@@ -64,7 +64,7 @@ std::string readHeaderText(const InputFile& file) {
     }
 }
 
-class PlyRecordSource final : public PointRecordSource {
+class PlyRecordSource final : public ConvertedRecordSource {
   public:
     PlyRecordSource(InputFile file, std::string name, const PlyHeader& header,
                     const PlyElement& vertex, std::uint64_t vertexOffset, std::size_t stride)
@@ -91,32 +91,32 @@ class PlyRecordSource final : public PointRecordSource {
                     plyColorScale(access_.types[(*layout_.color)[k]], largeColorValues);
             }
         }
-        writer_.emplace(layout_.color.has_value(), layout_.normal.has_value(), bounds);
-        info_ = convertedSourceInfo(std::move(name), vertexCount_, *writer_, bounds);
+        std::vector<std::string> warnings;
         for (const PlyElement& element : header.elements) {
             if (element.name == "face" && element.count > 0) {
-                info_.warnings.push_back(facesNotKept(info_.name, element.count));
+                warnings.push_back(facesNotKept(name, element.count));
             }
         }
         if (!intensitiesFit) {
-            info_.warnings.push_back(intensitiesNotKept(info_.name));
+            warnings.push_back(intensitiesNotKept(name));
         }
+        // Binary values have no decimals to keep (PointCloud::coordinateStep).
+        startRecords(std::move(name), vertexCount_, layout_.color.has_value(),
+                     layout_.normal.has_value(), bounds, 0.0, std::move(warnings));
     }
-
-    const PointRecordSourceInfo& info() const override { return info_; }
 
     std::size_t read(std::vector<std::byte>& records, std::size_t maxPoints) override {
         try {
             const auto count = static_cast<std::size_t>(
                 std::min<std::uint64_t>(maxPoints, vertexCount_ - nextVertex_));
-            records.reserve(records.size() + count * info_.format.recordLength());
+            records.reserve(records.size() + count * info().format.recordLength());
             forEachVertex(nextVertex_, count, [&](const std::byte* vertex, std::uint64_t) {
-                writer_->append(records, point(vertex));
+                writer().append(records, point(vertex));
             });
             nextVertex_ += count;
             return count;
         } catch (const Error& error) {
-            throwNamed(info_.name, error);
+            throwNamed(info().name, error);
         }
     }
 
@@ -201,8 +201,6 @@ class PlyRecordSource final : public PointRecordSource {
     PlyVertexLayout layout_;
     VertexAccess access_;
     std::array<PlyColorScale, 3> colorScales_{};
-    std::optional<ConvertedRecordWriter> writer_;
-    PointRecordSourceInfo info_;
     std::uint64_t nextVertex_ = 0;
     std::vector<std::byte> block_;
 };

@@ -13,6 +13,7 @@
 
 #include "core/Error.h"
 #include "io/InputFile.h"
+#include "io/LasWriter.h"
 #include "io/RecordSourceSupport.h"
 #include "io/ScanLoader.h"
 #include "lod/NodeSource.h"
@@ -172,6 +173,29 @@ bool fitsGrid(const std::vector<MergedInput>& inputs, const PointRecordSourceInf
     return true;
 }
 
+/// Puts the inputs that are not LAS on one grid, the finest that holds them all
+/// (chooseLasScaling over their combined bounds): each got the finest its own bounds allow,
+/// which inputs of other sizes or places cannot share, and no finer grid of 32-bit integers
+/// holds them all. LAS inputs keep their own grid.
+void shareOneGrid(const std::vector<std::unique_ptr<PointRecordSource>>& sources) {
+    std::vector<ConvertedRecordSource*> converted;
+    Bounds combined;
+    for (const auto& source : sources) {
+        if (auto* input = dynamic_cast<ConvertedRecordSource*>(source.get())) {
+            converted.push_back(input);
+            combined.add(input->bounds().min);
+            combined.add(input->bounds().max);
+        }
+    }
+    if (converted.size() < 2) {
+        return;
+    }
+    const LasScaling scaling = chooseLasScaling(combined);
+    for (ConvertedRecordSource* input : converted) {
+        input->useQuantization({scaling.scale, scaling.offset});
+    }
+}
+
 void checkCompatible(const PointRecordSourceInfo& input, const PointRecordSourceInfo& first) {
     if (input.quantization.scale != first.quantization.scale) {
         throwIncompatible(input, first,
@@ -327,6 +351,7 @@ std::unique_ptr<PointRecordSource> mergePointRecordSources(
     if (sources.size() == 1) {
         return std::move(sources.front());
     }
+    shareOneGrid(sources);
     const PointRecordSourceInfo& first = sources.front()->info();
     PointRecordSourceInfo info;
     std::vector<std::string> names;

@@ -86,11 +86,14 @@ std::unique_ptr<PointRecordSource> cloudRecordSource(PointCloud cloud, const std
 
 /// Several inputs as one source: one record format (the widest any input needs: format 7 when
 /// one has colour, 8 when one has NIR; extra bytes must be the same fields in all) and one
-/// quantization in which every input's stored integers are kept exactly (same scales, offsets a
-/// whole number of steps apart). Inputs that cannot share them are one error sentence naming
-/// both files and the field. The WKT must agree where both inputs have one, and so must the kind
-/// of GPS time (standard or week seconds) where both have GPS times. The file source ID is the
-/// inputs' where they all have the same, else 0 (the records keep their own point source IDs).
+/// quantization. Inputs that are not LAS have no grid of their own: they share the finest that
+/// holds them all (a warning names one whose decimals it does not keep). LAS inputs keep their
+/// stored integers exactly (same scales, offsets a whole number of steps apart), and so must
+/// the shared grid of the others where both are merged. Inputs that cannot share them are one
+/// error sentence naming both files and the field. The WKT must agree where both inputs have one,
+/// and so must the kind of GPS time (standard or week seconds) where both have GPS times. The file
+/// source ID is the inputs' where they all have the same, else 0 (the records keep their own point
+/// source IDs).
 std::unique_ptr<PointRecordSource> mergePointRecordSources(
     std::vector<std::unique_ptr<PointRecordSource>> sources);
 

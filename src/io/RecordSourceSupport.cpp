@@ -80,6 +80,10 @@ std::uint16_t clampedWord(double value, double largest) {
     return static_cast<std::uint16_t>(std::lround(std::min(value, largest)));
 }
 
+double coarsestStep(const Quantization& quantization) {
+    return std::max({quantization.scale.x, quantization.scale.y, quantization.scale.z});
+}
+
 }  // namespace
 
 std::size_t las14::standardSize(int pointFormat) {
@@ -263,18 +267,45 @@ std::string facesNotKept(const std::string& name, std::uint64_t faces) {
                        faces);
 }
 
-PointRecordSourceInfo convertedSourceInfo(std::string name, std::uint64_t pointCount,
-                                          const ConvertedRecordWriter& writer,
-                                          const Bounds& bounds) {
-    PointRecordSourceInfo info;
-    info.name = std::move(name);
-    info.pointCount = pointCount;
-    info.format = writer.format();
-    info.quantization = writer.quantization();
-    const Bounds stored = writer.storedBounds(bounds);
-    info.min = stored.min;
-    info.max = stored.max;
-    return info;
+void ConvertedRecordSource::startRecords(std::string name, std::uint64_t pointCount, bool color,
+                                         bool normals, const Bounds& bounds, double coordinateStep,
+                                         std::vector<std::string> warnings) {
+    try {
+        writer_.emplace(color, normals, bounds);
+    } catch (const Error& error) {
+        throwNamed(name, error);
+    }
+    bounds_ = bounds;
+    keptStep_ = coordinateStep > 0.0
+                    ? std::max(coordinateStep, coarsestStep(writer_->quantization()))
+                    : 0.0;
+    info_.name = std::move(name);
+    info_.pointCount = pointCount;
+    info_.format = writer_->format();
+    info_.warnings = std::move(warnings);
+    setQuantization(writer_->quantization());
+}
+
+void ConvertedRecordSource::useQuantization(const Quantization& quantization) {
+    setQuantization(quantization);
+    const double step = coarsestStep(quantization);
+    // Scales are powers of ten held in doubles: one equal to the kept step may differ from it in
+    // the last place.
+    if (keptStep_ > 0.0 && step > keptStep_ * (1.0 + 1e-9)) {
+        info_.warnings.push_back(fmt::format(
+            "{}: its coordinates are written to steps of {:g}, but the grid it shares with the "
+            "other inputs (the finest their combined extent allows in 32-bit integers) has steps "
+            "of {:g}: they are rounded to it",
+            info_.name, keptStep_, step));
+    }
+}
+
+void ConvertedRecordSource::setQuantization(const Quantization& quantization) {
+    writer_->setQuantization(quantization);
+    info_.quantization = quantization;
+    const Bounds stored = writer_->storedBounds(bounds_);
+    info_.min = stored.min;
+    info_.max = stored.max;
 }
 
 void throwNamed(const std::string& name, const Error& error) {

@@ -97,6 +97,9 @@ class ConvertedRecordWriter {
 
     const PointRecordFormat& format() const { return format_; }
     const Quantization& quantization() const { return quantization_; }
+    /// Quantizes on `quantization` from now on (a grid a merge chose), which must hold the
+    /// bounds given to the constructor.
+    void setQuantization(const Quantization& quantization) { quantization_ = quantization; }
     /// The bounds of the stored coordinates of points within `bounds`, in file coordinates.
     Bounds storedBounds(const Bounds& bounds) const;
     /// Appends the point's record; throws subscan::Error when it lies outside the bounds given
@@ -111,10 +114,39 @@ class ConvertedRecordWriter {
     bool normals_;
 };
 
-/// The information of a converted input once its points are known.
-PointRecordSourceInfo convertedSourceInfo(std::string name, std::uint64_t pointCount,
-                                          const ConvertedRecordWriter& writer,
-                                          const Bounds& bounds);
+/// The source of an input that is not LAS: its points become records through a
+/// ConvertedRecordWriter. Such an input has no grid of its own: it gets the finest its bounds
+/// allow, or the one a merge chose for several such inputs (mergePointRecordSources).
+class ConvertedRecordSource : public PointRecordSource {
+  public:
+    const PointRecordSourceInfo& info() const final { return info_; }
+    /// The exact bounds of the input's coordinates, in file coordinates.
+    const Bounds& bounds() const { return bounds_; }
+    /// Puts the records on `quantization`, which must hold bounds(). A warning names the input
+    /// where its step is coarser than the grid the input's coordinates were written on (a text's
+    /// decimals) and than the one chosen for its own bounds: they are rounded to it.
+    void useQuantization(const Quantization& quantization);
+
+  protected:
+    /// Call once the points are known (a first pass, or the cloud loaded): the records get the
+    /// finest grid `bounds` allow. `coordinateStep` is as PointCloud's: the input's own grid, 0
+    /// for none.
+    void startRecords(std::string name, std::uint64_t pointCount, bool color, bool normals,
+                      const Bounds& bounds, double coordinateStep,
+                      std::vector<std::string> warnings);
+    const ConvertedRecordWriter& writer() const { return *writer_; }
+
+  private:
+    void setQuantization(const Quantization& quantization);
+
+    std::optional<ConvertedRecordWriter> writer_;
+    PointRecordSourceInfo info_;
+    Bounds bounds_;
+    /// The step the input's coordinates keep on their own: that of the grid they were written
+    /// on, or of the grid chosen for their bounds where that is coarser; 0 where the input has
+    /// no grid (floats, doubles).
+    double keptStep_ = 0.0;
+};
 
 /// The warning of a converted input whose faces point records cannot hold: they were dropped
 /// without a word where LAZ, COPC and the octree took a mesh.

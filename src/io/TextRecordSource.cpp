@@ -96,14 +96,15 @@ std::string readTextHead(const InputFile& file) {
     return head;
 }
 
-class TextRecordSource final : public PointRecordSource {
+class TextRecordSource final : public ConvertedRecordSource {
   public:
     TextRecordSource(const std::filesystem::path& path) : file_(path) {
-        info_.name = path.string();
+        const std::string name = path.string();
         ReadContext context;
         start(context);
+        std::vector<std::string> warnings;
         for (const std::string& warning : context.warnings) {
-            info_.warnings.push_back(fmt::format("{}: {}", info_.name, warning));
+            warnings.push_back(fmt::format("{}: {}", name, warning));
         }
         const PointTextLayout& layout = reader_->layout();
         Bounds bounds;
@@ -134,21 +135,17 @@ class TextRecordSource final : public PointRecordSource {
             throw Error("it holds no points, only PTS count lines");
         }
         colorEncoding_ = layout.colorEncodingFromName ? layout.colorEncoding : colors.encoding();
-        writer_.emplace(layout.color.has_value(), layout.normal.has_value(), bounds);
-        std::vector<std::string> warnings = std::move(info_.warnings);
         if (!intensitiesFit) {
-            warnings.push_back(intensitiesNotKept(info_.name));
+            warnings.push_back(intensitiesNotKept(name));
         }
-        info_ = convertedSourceInfo(info_.name, count, *writer_, bounds);
-        info_.warnings = std::move(warnings);
+        startRecords(name, count, layout.color.has_value(), layout.normal.has_value(), bounds,
+                     reader_->coordinateStep(), std::move(warnings));
         rewind();
     }
 
-    const PointRecordSourceInfo& info() const override { return info_; }
-
     std::size_t read(std::vector<std::byte>& records, std::size_t maxPoints) override {
         try {
-            const std::size_t recordLength = info_.format.recordLength();
+            const std::size_t recordLength = info().format.recordLength();
             std::size_t done = 0;
             while (done < maxPoints) {
                 if (pendingPoint_ == pending_.size() / recordLength) {
@@ -159,7 +156,7 @@ class TextRecordSource final : public PointRecordSource {
                         break;
                     }
                     reader_->parse(piece, [&](std::span<const double> values, std::size_t) {
-                        writer_->append(pending_, point(values));
+                        writer().append(pending_, point(values));
                     });
                     continue;
                 }
@@ -174,7 +171,7 @@ class TextRecordSource final : public PointRecordSource {
             }
             return done;
         } catch (const Error& error) {
-            throwNamed(info_.name, error);
+            throwNamed(info().name, error);
         }
     }
 
@@ -231,10 +228,8 @@ class TextRecordSource final : public PointRecordSource {
     }
 
     InputFile file_;
-    PointRecordSourceInfo info_;
     std::optional<PointTextReader> reader_;
     std::optional<LinePieces> pieces_;
-    std::optional<ConvertedRecordWriter> writer_;
     // From every colour value of the first pass; the reader's layout has the first lines' guess.
     TextColorEncoding colorEncoding_ = TextColorEncoding::Byte;
     std::vector<std::byte> pending_;  // the records of the piece parsed last

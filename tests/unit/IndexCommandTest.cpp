@@ -55,6 +55,19 @@ TEST(IndexCommandTest, ALasFileBecomesACopcFileWithEveryRecord) {
               sortedRecords(expected, written.recordLength));
 }
 
+TEST(IndexCommandTest, ScansThatAreNotLasOfDifferentSizesMergeIntoOneFile) {
+    // Each got its own grid from its own extent, so the merge refused them.
+    const test::TempDir folder;
+    const auto small = folder.write("small.xyz", "0.125 0.25 0.5\n1 0.75 0.375\n");
+    const auto large = folder.write("large.xyz", "1000.5 2000.25 10\n9000.75 -3000.5 20\n");
+    const std::filesystem::path output = folder / "both.copc.laz";
+    const test::CommandResult result =
+        runSubscan({"index", small.string(), large.string(), "-o", output.string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.out, StartsWith(output.string() + ": 4 points"));
+    EXPECT_TRUE(result.err.empty()) << result.err;
+}
+
 TEST(IndexCommandTest, TheOutputMustBeACopcFileAndNotAnInput) {
     const test::TempDir folder;
     const std::filesystem::path input = lasInput(folder);

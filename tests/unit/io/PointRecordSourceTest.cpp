@@ -21,6 +21,7 @@
 
 #include "core/Error.h"
 #include "io/Las14Writer.h"
+#include "io/LasWriter.h"
 #include "io/LazWriter.h"
 #include "io/PointRecordSource.h"
 #include "io/RecordSourceSupport.h"
@@ -972,6 +973,47 @@ TEST(PointRecordSourceTest, InputsThatCannotShareAGridAreOneSentenceNamingBoth) 
     // Far apart: no one grid of 32-bit integers at 0.01 holds 0 and 1e8.
     const auto far = dir.write("far.las", threePointLas(6, glm::dvec3(0.01), {1e8, 0, 0}));
     EXPECT_THAT(mergeError({a, far}), HasSubstr("too far apart"));
+}
+
+TEST(PointRecordSourceTest, InputsThatAreNotLasShareTheFinestGridThatHoldsThemAll) {
+    // Alone, the 1 m scan gets steps of 1e-9 and the 9 km one 1e-5 in x: a merge refused them
+    // (found by the outside hunt). Together they get the grid of their combined bounds.
+    const test::TempDir dir;
+    const std::vector<glm::dvec3> smallPoints{{0.125, 0.25, 0.5}, {1.0, 0.75, 0.375}};
+    const std::vector<glm::dvec3> largePoints{{1000.5, 2000.25, 10.0}, {9000.75, -3000.5, 20.0}};
+    const auto small = dir.write("small.xyz", "0.125 0.250 0.500\n1.000 0.750 0.375\n");
+    const auto large = dir.write("large.xyz", "1000.5 2000.25 10\n9000.75 -3000.5 20\n");
+    EXPECT_NE(open(small)->info().quantization, open(large)->info().quantization);
+    const auto merged = mergePointRecordSources(openAll({small, large}));
+    const PointRecordSourceInfo& info = merged->info();
+    Bounds combined;
+    for (const auto* points : {&smallPoints, &largePoints}) {
+        for (const glm::dvec3& p : *points) {
+            combined.add(p);
+        }
+    }
+    const LasScaling expected = chooseLasScaling(combined);
+    EXPECT_EQ(info.quantization, (Quantization{expected.scale, expected.offset}));
+    EXPECT_EQ(info.quantization.scale, glm::dvec3(1e-5, 1e-5, 1e-8));
+    EXPECT_THAT(info.warnings, IsEmpty());  // 3 decimals at most: every one kept
+    const std::vector<std::byte> records = readAllRecords(*merged, 3);
+    ASSERT_EQ(records.size(), 4 * info.format.recordLength());
+    for (std::size_t i = 0; i < 4; ++i) {
+        const Las14Fields f = recordFields(records, info.format, i);
+        const glm::dvec3 stored(f.xyz[0], f.xyz[1], f.xyz[2]);
+        const glm::dvec3 position = stored * info.quantization.scale + info.quantization.offset;
+        const glm::dvec3 original = i < 2 ? smallPoints[i] : largePoints[i - 2];
+        for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_NEAR(position[axis], original[axis], 1e-9) << "point " << i;
+        }
+    }
+
+    // 7 decimals are more than the shared grid's 5 keep: said, naming the input.
+    const auto fine = dir.write("fine.xyz", "0.1234567 0.5 0.25\n1 1 1\n");
+    EXPECT_THAT(mergePointRecordSources(openAll({fine, large}))->info().warnings,
+                Contains(AllOf(HasSubstr(fine.string() + ": its coordinates are written to "
+                                                         "steps of 1e-07"),
+                               HasSubstr("has steps of 1e-05: they are rounded to it"))));
 }
 
 TEST(PointRecordSourceTest, AMergeOfManyFilesHoldsOneOpenAtATime) {
