@@ -252,6 +252,7 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
             }
         };
         append(cloud.colors, part.colors, colors);
+        cloud.colorCutTo8Bits = cloud.colorCutTo8Bits || (colors && part.colorCutTo8Bits);
         append(cloud.normals, part.normals, normals);
         append(cloud.intensities, part.intensities, intensities);
         append(cloud.classifications, part.classifications, classifications);

@@ -1,12 +1,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numbers>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include <unistd.h>
@@ -251,6 +253,44 @@ TEST(ConvertCommandTest, TextOfMillimetresKeepsThemInPlyAndPcd) {
         // and again when the output is.
         test::expectPositionsNear(loadScan(output.string()).cloud, test::cloudOf(positions), 1e-3);
     }
+}
+
+TEST(ConvertCommandTest, SixteenBitColourCutToEightIsNamed) {
+    // 16-bit colour (a binary PLY's ushort, kept as such in LAZ) came out of PLY, PCD and XYZ
+    // as 8 bits without a word (found by the outside hunt).
+    const test::TempDir dir;
+    std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty float x\n"
+        "property float y\nproperty float z\nproperty ushort red\nproperty ushort green\n"
+        "property ushort blue\nend_header\n";
+    for (const auto& [x, color] :
+         {std::pair{0.0f, std::array<std::uint16_t, 3>{1000, 40000, 65535}},
+          std::pair{1.0f, std::array<std::uint16_t, 3>{300, 2, 7}}}) {
+        for (const float coordinate : {x, 0.0f, 0.0f}) {
+            ply.append(reinterpret_cast<const char*>(&coordinate), sizeof coordinate);
+        }
+        ply.append(reinterpret_cast<const char*>(color.data()), sizeof color);
+    }
+    const auto laz = dir / "rgb16.laz";
+    convert(dir.write("rgb16.ply", ply).string(), laz);
+    for (const std::string name : {"out.ply", "out.pcd", "out.xyz"}) {
+        const auto output = dir / name;
+        const test::CommandResult result =
+            runSubscan({"convert", laz.string(), "-o", output.string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        EXPECT_THAT(result.err, HasSubstr("warning: " + output.string() + ": " +
+                                          (name == "out.ply"   ? "PLY"
+                                           : name == "out.pcd" ? "PCD"
+                                                               : "XYZ text") +
+                                          " output is written with 8-bit colour: the input's "
+                                          "16-bit colour is cut to 8 bits"));
+    }
+    // Through LAS 1.2 and back the colour is 8-bit times 257: nothing more to cut.
+    const auto las = dir / "rgb8.las";
+    convert((dir / "out.ply").string(), las);
+    const test::CommandResult again =
+        runSubscan({"convert", las.string(), "-o", (dir / "again.ply").string()});
+    EXPECT_THAT(again.err, ::testing::Not(HasSubstr("colour")));
 }
 
 TEST(ConvertCommandTest, IntensitiesLasCannotHoldAreNamed) {

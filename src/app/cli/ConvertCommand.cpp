@@ -154,6 +154,14 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
     if (format.extension == ".las" && !fitIntensityWords(cloud.intensities)) {
         fmt::print(stderr, "subscan: warning: {}\n", intensitiesNotKept(output));
     }
+    // Every format written from a cloud holds its 8-bit colour only. PLY could declare ushort
+    // colour, but Open3D's reader divides any PLY colour by 255, and 16-bit colour would break it.
+    if (cloud.colorCutTo8Bits) {
+        fmt::print(stderr,
+                   "subscan: warning: {}: {} output is written with 8-bit colour: the input's "
+                   "16-bit colour is cut to 8 bits\n",
+                   output, format.name);
+    }
     if (!scan.grid.empty()) {
         fmt::print(stderr,
                    "subscan: warning: {}: the input's organised grid ({} x {}) is not kept: the "

@@ -255,6 +255,7 @@ TEST(LasReaderTest, SixteenBitColourIsReducedWithRounding) {
     EXPECT_EQ(cloud.colors[0], (Rgba8{0, 128, 255, 255}));
     EXPECT_EQ(cloud.colors[1], (Rgba8{1, 2, 254, 255}));
     EXPECT_EQ(cloud.colors[2], (Rgba8{0, 1, 255, 255}));
+    EXPECT_TRUE(cloud.colorCutTo8Bits);  // convert says so of its 8-bit outputs
 }
 
 TEST(LasReaderTest, EightBitColourInSixteenBitFieldsIsTakenAsIs) {
@@ -267,12 +268,22 @@ TEST(LasReaderTest, EightBitColourInSixteenBitFieldsIsTakenAsIs) {
     EXPECT_EQ(cloud.colors[0], (Rgba8{0, 128, 255, 255}));
     EXPECT_EQ(cloud.colors[1], (Rgba8{1, 2, 3, 255}));
     EXPECT_EQ(cloud.colors[2], (Rgba8{200, 100, 50, 255}));
+    EXPECT_FALSE(cloud.colorCutTo8Bits);
 
     // One value above 255 anywhere, even in the last point, makes the whole file 16-bit.
     points[2].rgb = {200, 100, 256};
     const PointCloud sixteen = decode(writeLas({}, points), "rgb16.las").cloud;
     EXPECT_EQ(sixteen.colors[0], (Rgba8{0, 0, 1, 255}));
     EXPECT_EQ(sixteen.colors[2], (Rgba8{1, 0, 1, 255}));
+    EXPECT_TRUE(sixteen.colorCutTo8Bits);
+
+    // 8-bit colour times 257, as writeLas stores it, is 16-bit colour that 8 bits give back.
+    for (LasPoint& point : points) {
+        for (auto& channel : point.rgb) {
+            channel = static_cast<std::uint16_t>(channel % 256 * 257);
+        }
+    }
+    EXPECT_FALSE(decode(writeLas({}, points), "rgb257.las").cloud.colorCutTo8Bits);
 }
 
 TEST(LasReaderTest, EveryPointFormatDecodesPositionsAndColour) {
