@@ -253,6 +253,12 @@ PointCloud loadNodes(const NodeSource& source, std::span<const std::size_t> node
         };
         append(cloud.colors, part.colors, colors);
         cloud.colorCutTo8Bits = cloud.colorCutTo8Bits || (colors && part.colorCutTo8Bits);
+        // A dataset's tiles share its grid; of several, the finest is the one to keep.
+        if (part.coordinateStep > 0.0) {
+            cloud.coordinateStep = cloud.coordinateStep > 0.0
+                                       ? std::min(cloud.coordinateStep, part.coordinateStep)
+                                       : part.coordinateStep;
+        }
         append(cloud.normals, part.normals, normals);
         append(cloud.intensities, part.intensities, intensities);
         append(cloud.classifications, part.classifications, classifications);

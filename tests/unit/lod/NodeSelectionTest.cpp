@@ -111,11 +111,12 @@ TEST(NodeSelectionTest, ANodeThatCannotBeReadLeavesItsCubeAtItsParentsSpacing) {
     }
 }
 
-/// One node of three points whose normals are the zeros some exporters write (an index of
-/// such a file keeps them).
-class ZeroNormalSource final : public NodeSource {
+/// One node of three points as a LAS tile gives them, on a grid of 0.01 with its 16-bit colour
+/// cut to 8 bits, and with normals that are the zeros some exporters write (an index of such a
+/// file keeps them).
+class OneTileSource final : public NodeSource {
   public:
-    ZeroNormalSource() {
+    OneTileSource() {
         info_.name = "zeros";
         info_.cube = OctreeCube{glm::dvec3(0.0), 1.0, kRootSpacing};
         info_.bounds.add(glm::dvec3(-1.0));
@@ -131,20 +132,34 @@ class ZeroNormalSource final : public NodeSource {
             cloud.positions.emplace_back(position);
             cloud.bounds.add(position);
             cloud.normals.emplace_back(0.0f);
+            cloud.colors.emplace_back();
         }
+        cloud.coordinateStep = 0.01;
+        cloud.colorCutTo8Bits = true;
         return cloud;
     }
 };
 
 TEST(NodeSelectionTest, NodesWhoseNormalsAreAllZeroHaveNone) {
     // As a whole file's: the surface was shaded flat with them.
-    const ZeroNormalSource source;
+    const OneTileSource source;
     std::vector<std::string> warnings;
     const std::vector<std::size_t> nodes{0};
     const PointCloud cloud = loadNodes(source, nodes, warnings);
     EXPECT_EQ(cloud.size(), 3u);
     EXPECT_FALSE(cloud.hasNormals());
     EXPECT_THAT(warnings, ::testing::ElementsAre(::testing::HasSubstr("normals are all zero")));
+}
+
+TEST(NodeSelectionTest, NodesKeepTheirGridAndSayTheirColourWasCut) {
+    // What convert's PLY and PCD output of an EPT dataset decide by: doubles where floats lose
+    // the grid, and a warning for the 16 bits of colour they do not hold.
+    const OneTileSource source;
+    std::vector<std::string> warnings;
+    const std::vector<std::size_t> nodes{0};
+    const PointCloud cloud = loadNodes(source, nodes, warnings);
+    EXPECT_EQ(cloud.coordinateStep, 0.01);
+    EXPECT_TRUE(cloud.colorCutTo8Bits);
 }
 
 }  // namespace
