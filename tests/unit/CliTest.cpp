@@ -81,6 +81,22 @@ TEST(CliTest, BadScatteringValuesNameTheirOptionAsUsageErrors) {
                                 "refraction of a medium denser than air)\n");
 }
 
+TEST(CliTest, ABadBackgroundIsAUsageErrorNamingTheOption) {
+    // It exited 1 after the parse; refused while parsing, nothing renders.
+    for (const std::string command : {"render", "turntable"}) {
+        for (const std::string colour : {"2,2,2", "0.5,0.5", "#12345g", "red"}) {
+            const test::CommandResult result = runSubscan(
+                {command, "synthetic:sphere", "-o", "never-written", "--background", colour});
+            EXPECT_EQ(result.exitCode, 2) << command << " " << colour;
+            EXPECT_THAT(result.err, ::testing::StartsWith("--background: '" + colour +
+                                                          "' is not R,G,B with values in 0..1 "
+                                                          "or #rrggbb"))
+                << command;
+        }
+    }
+    EXPECT_FALSE(std::filesystem::exists("never-written"));
+}
+
 TEST(CliTest, ACameraFileExcludesTheOptionsItFixes) {
     // The file's size and view won without a word: --width 640 rendered at the file's width.
     const test::TempDir dir;

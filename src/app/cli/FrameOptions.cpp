@@ -12,8 +12,8 @@ namespace subscan::cli {
 
 namespace {
 
-/// "R,G,B" with sRGB components in 0..1, or "#rrggbb".
-glm::vec3 parseBackground(const std::string& text) {
+/// "R,G,B" with sRGB components in 0..1, or "#rrggbb"; nullopt for anything else.
+std::optional<glm::vec3> parseBackground(const std::string& text) {
     if (text.size() == 7 && text[0] == '#' &&
         text.find_first_not_of("0123456789abcdefABCDEF", 1) == std::string::npos) {
         const unsigned long value = std::stoul(text.substr(1), nullptr, 16);
@@ -22,10 +22,9 @@ glm::vec3 parseBackground(const std::string& text) {
     const std::optional<glm::vec3> color = parseCommaSeparatedRgb(text);
     if (!color || glm::any(glm::lessThan(*color, glm::vec3(0.0f))) ||
         glm::any(glm::greaterThan(*color, glm::vec3(1.0f)))) {
-        throw Error(
-            fmt::format("--background '{}' is not R,G,B with values in 0..1 or #rrggbb", text));
+        return std::nullopt;
     }
-    return *color;
+    return color;
 }
 
 }  // namespace
@@ -79,7 +78,15 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
                                "--view", "--sensor"}) {
         camera->excludes(command.get_option(placed));
     }
-    command.add_option("--background", background, "R,G,B (sRGB 0..1) or #rrggbb");
+    // A bad colour is a usage error, refused while parsing with the option's name.
+    command.add_option("--background", background, "R,G,B (sRGB 0..1) or #rrggbb")
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                return parseBackground(text)
+                           ? std::string()
+                           : fmt::format("'{}' is not R,G,B with values in 0..1 or #rrggbb", text);
+            },
+            ""));
     command.add_option("--raster", raster, "Compute rasterizer: auto | int64 | two-pass")
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
     addResolutionOption(command, resolution);
@@ -120,7 +127,7 @@ RenderSettings FrameOptions::settings() const {
         rasterSettings.stage = parseStage(stage);
     }
     if (!background.empty()) {
-        rasterSettings.backgroundSrgb = parseBackground(background);
+        rasterSettings.backgroundSrgb = *parseBackground(background);  // as add() checked
     }
     scattering.apply(settings.scattering);
     streaming.apply(settings.streaming);
