@@ -1,5 +1,4 @@
 // `subscan bench` on llvmpipe: a smoke test of its JSON with few frames at a small size.
-#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -181,30 +180,6 @@ TEST(BenchCommandGLTest, TextTableNamesTheScatteringRuns) {
     EXPECT_THAT(result.out, ::testing::HasSubstr("sss:single"));
 }
 
-TEST(BenchCommandGLTest, BadScatteringSuffixIsOneSentence) {
-    const auto unknown =
-        runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface,sss:fast"});
-    EXPECT_EQ(unknown.exitCode, 1);
-    EXPECT_THAT(unknown.err, ::testing::HasSubstr("--modes entry 'sss:fast': 'fast' is neither a "
-                                                  "scattering method of the sss mode "
-                                                  "(sss:gaussian, sss:single or sss:both) nor "
-                                                  "no-shadows (surface and sss)"));
-    EXPECT_EQ(std::count(unknown.err.begin(), unknown.err.end(), '\n'), 1) << unknown.err;
-
-    for (const char* mode : {"surface:single", "points:no-shadows", "sss:single:both"}) {
-        const auto refused =
-            runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", mode});
-        EXPECT_EQ(refused.exitCode, 1) << mode;
-        EXPECT_THAT(refused.err, ::testing::HasSubstr(std::string("--modes entry '") + mode))
-            << mode;
-    }
-
-    const auto twice = runSubscan(
-        {"bench", "synthetic:sphere", "--frames", "2", "--modes", "sss:single,sss:single"});
-    EXPECT_EQ(twice.exitCode, 1);
-    EXPECT_THAT(twice.err, ::testing::HasSubstr("--modes names 'sss:single' twice"));
-}
-
 TEST(BenchCommandGLTest, RunsWithLightMapsReportWhatBuildingThemCosts) {
     test::TempDir dir;
     const std::filesystem::path settings =
@@ -251,13 +226,6 @@ TEST(BenchCommandGLTest, BenchesAStreamedSurveyWithinItsBudget) {
     EXPECT_GT(streamed, 50'000u);
     EXPECT_LE(streamed, 150'000u);
     EXPECT_EQ(points({"--lod", "off"}), 518'862u);  // every point of the file
-}
-
-TEST(BenchCommandGLTest, UnknownModeIsOneSentence) {
-    const auto result =
-        runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", "surface,voxels"});
-    EXPECT_EQ(result.exitCode, 1);
-    EXPECT_THAT(result.err, ::testing::HasSubstr("'voxels' is not a render mode"));
 }
 
 }  // namespace

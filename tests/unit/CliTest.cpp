@@ -97,6 +97,27 @@ TEST(CliTest, ABadBackgroundIsAUsageErrorNamingTheOption) {
     EXPECT_FALSE(std::filesystem::exists("never-written"));
 }
 
+TEST(CliTest, ABadModesListIsAUsageErrorNamingTheOption) {
+    // bench refused it with exit 1 once the command had started; refused while parsing, nothing
+    // renders.
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {"surface,sss:fast",
+         "--modes: 'fast' in 'sss:fast' is neither a scattering method of the sss mode "
+         "(sss:gaussian, sss:single or sss:both) nor no-shadows (surface and sss)"},
+        {"surface:single", "--modes: 'single' in 'surface:single' is neither"},
+        {"points:no-shadows", "--modes: 'no-shadows' in 'points:no-shadows' is neither"},
+        {"sss:single:both", "--modes: 'both' in 'sss:single:both' is neither"},
+        {"surface,voxels", "--modes: 'voxels' is not a render mode"},
+        {"sss:single,sss:single", "--modes: 'sss:single' is named twice"},
+    };
+    for (const auto& [modes, message] : cases) {
+        const test::CommandResult result =
+            runSubscan({"bench", "synthetic:sphere", "--frames", "2", "--modes", modes});
+        EXPECT_EQ(result.exitCode, 2) << modes;
+        EXPECT_THAT(result.err, ::testing::StartsWith(message)) << modes;
+    }
+}
+
 TEST(CliTest, ACameraFileExcludesTheOptionsItFixes) {
     // The file's size and view won without a word: --width 640 rendered at the file's width.
     const test::TempDir dir;

@@ -87,13 +87,15 @@ BenchMode parseMode(const std::string& name) {
             }
         }
         throw Error(
-            fmt::format("--modes entry '{}': '{}' is neither a scattering method of the sss mode "
+            fmt::format("'{}' in '{}' is neither a scattering method of the sss mode "
                         "(sss:gaussian, sss:single or sss:both) nor no-shadows (surface and sss)",
-                        name, part));
+                        part, name));
     }
     return entry;
 }
 
+/// The entries of a --modes list; throws subscan::Error saying what is wrong with it, which the
+/// option's check gives CLI11 to name the option with.
 std::vector<BenchMode> parseModes(const std::string& list) {
     std::vector<BenchMode> modes;
     std::set<std::string> names;
@@ -101,12 +103,12 @@ std::vector<BenchMode> parseModes(const std::string& list) {
     std::string name;
     while (std::getline(stream, name, ',')) {
         if (!names.insert(name).second) {
-            throw Error(fmt::format("--modes names '{}' twice", name));
+            throw Error(fmt::format("'{}' is named twice", name));
         }
         modes.push_back(parseMode(name));
     }
     if (modes.empty()) {
-        throw Error("--modes names no render mode");
+        throw Error("no render mode is named");
     }
     return modes;
 }
@@ -294,7 +296,7 @@ std::vector<nlohmann::json> benchModes(GlContext& context, const LoadedScan& sca
 }
 
 int runBench(const BenchOptions& options) {
-    const std::vector<BenchMode> modes = parseModes(options.modes);
+    const std::vector<BenchMode> modes = parseModes(options.modes);  // as --modes' check did
     RenderSettings settings;
     if (!options.settingsFile.empty()) {
         settings = readSettingsFile(options.settingsFile);
@@ -398,11 +400,13 @@ Command addBenchCommand(CLI::App& parent) {
     options->heightOption =
         bench->add_option("--height", options->height, "Image height (default 1080)")
             ->check(CLI::Range(1, 65536));
-    bench->add_option("--modes", options->modes,
-                      "Comma-separated modes (default points-gl,points,surface,sss); "
-                      "sss:gaussian, sss:single and sss:both run the sss mode with that "
-                      "scattering method (plain sss: the settings' method), each its own run; "
-                      "a further :no-shadows (surface, sss) turns the light maps off");
+    bench
+        ->add_option("--modes", options->modes,
+                     "Comma-separated modes (default points-gl,points,surface,sss); "
+                     "sss:gaussian, sss:single and sss:both run the sss mode with that "
+                     "scattering method (plain sss: the settings' method), each its own run; "
+                     "a further :no-shadows (surface, sss) turns the light maps off")
+        ->check(parsedBy([](const std::string& list) { parseModes(list); }));
     addResolutionOption(*bench, options->resolution);
     bench->add_option("--settings", options->settingsFile, "Settings JSON for every mode")
         ->check(CLI::ExistingFile);

@@ -32,6 +32,19 @@ CLI::Validator finiteNumber() {
         "FINITE");
 }
 
+CLI::Validator parsedBy(std::function<void(const std::string&)> parse) {
+    return CLI::Validator(
+        [parse = std::move(parse)](std::string& text) {
+            try {
+                parse(text);
+                return std::string();
+            } catch (const Error& error) {
+                return std::string(error.what());
+            }
+        },
+        "");
+}
+
 void requireOutputFolder(const std::filesystem::path& output) {
     const std::filesystem::path folder = output.parent_path();
     std::error_code error;
@@ -162,16 +175,7 @@ void ScatteringOptions::add(CLI::App& command) {
     command
         .add_option("--material", material,
                     "Translucent material of the sss mode (see `subscan materials`)")
-        ->check(CLI::Validator(
-            [](std::string& name) {
-                try {
-                    findMaterial(name);
-                    return std::string();
-                } catch (const Error& error) {
-                    return std::string(error.what());
-                }
-            },
-            ""));
+        ->check(parsedBy([](const std::string& name) { findMaterial(name); }));
     command.add_option("--unit", unit, "Length unit of the scan: mm | cm | m | in")
         ->check(CLI::IsMember({"mm", "cm", "m", "in"}));
     command

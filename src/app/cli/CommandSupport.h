@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -29,6 +30,10 @@ inline constexpr const char* kUpAxisHelp =
 /// and its range checks let NaN through (every comparison with it is false), which gave an
 /// empty picture and exit 0.
 CLI::Validator finiteNumber();
+
+/// A check that refuses a value `parse` throws subscan::Error for, with the error's sentence:
+/// a bad value is then a usage error that CLI11 names the option in (`--material: ...`).
+CLI::Validator parsedBy(std::function<void(const std::string&)> parse);
 
 /// Throws subscan::Error when the folder `output` (a file to write) would go into does not
 /// exist: said before the work, not after it, with other outputs already written.
