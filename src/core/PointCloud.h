@@ -65,8 +65,8 @@ struct PointCloud {
     /// Whether the file stored coordinates as doubles (a PLY or PCD double property, E57): finer
     /// than floats hold, on no grid.
     bool doubleCoordinates = false;
-    /// Whether the file's colour had 16 bits a channel (LAS colour values other than 8-bit ones
-    /// times 257), which `colors` holds cut to 8.
+    /// Whether the file's colour used more than 8 bits a channel (16-bit values other than 8-bit
+    /// ones times 257; PLY colour over 255 in 32-bit channels), which `colors` holds cut to 8.
     bool colorCutTo8Bits = false;
 
     std::size_t size() const { return positions.size(); }

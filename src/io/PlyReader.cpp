@@ -645,6 +645,27 @@ PointCloud PlyBodyReader::read() {
         return Rgba8{channel(c[0]), channel(c[1]), channel(c[2]),
                      layout.alpha ? channel(*layout.alpha) : std::uint8_t{255}};
     };
+    // Whether the kept vertices' red, green and blue used more than 8 bits, which the 8-bit
+    // colour read from them loses: a 16-bit value other than an 8-bit one times 257 (lost when
+    // the file's colour reads as 16-bit), or a 32-bit value over 255 (clamped).
+    std::vector<std::size_t> wideIntegerColors;
+    if (layout.color) {
+        wideIntegerColors.assign(layout.color->begin(), layout.color->end());
+        std::erase_if(wideIntegerColors, [&](std::size_t p) {
+            return !isPlyInteger(colorType(p)) || plySizeOf(colorType(p)) == 1;
+        });
+    }
+    bool wordColorBeyondBytes = false;
+    bool widerColorClamped = false;
+    const auto noteColorBeyondBytes = [&](auto&& value) {
+        for (const std::size_t p : wideIntegerColors) {
+            if (plySizeOf(colorType(p)) == 2) {
+                wordColorBeyondBytes = wordColorBeyondBytes || std::fmod(value(p), 257.0) != 0.0;
+            } else {
+                widerColorClamped = widerColorClamped || value(p) > 255.0;
+            }
+        }
+    };
     auto makeRecord = [&](auto&& value) {
         PointRecord record;
         record.position = {value(layout.position[0]), value(layout.position[1]),
@@ -665,6 +686,9 @@ PointCloud PlyBodyReader::read() {
     const auto addVertex = [&](auto&& value) {
         const std::size_t kept = builder.validPoints();
         builder.add(makeRecord(value));
+        if (builder.validPoints() > kept) {
+            noteColorBeyondBytes(value);
+        }
         if (!colorScaleOpen) {
             return;
         }
@@ -773,6 +797,7 @@ PointCloud PlyBodyReader::read() {
     if (largeColorValues) {
         cloud.colors = std::move(largeValueColors);
     }
+    cloud.colorCutTo8Bits = (largeColorValues && wordColorBeyondBytes) || widerColorClamped;
     return cloud;
 }
 

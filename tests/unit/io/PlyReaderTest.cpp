@@ -147,6 +147,24 @@ TEST(PlyReaderTest, SixteenBitColourIsEightBitUnlessAValueOfTheFileIsLarger) {
     EXPECT_EQ(words.colors[1], (Rgba8{0, 1, 255, 255}));
 }
 
+TEST(PlyReaderTest, ColourBeyondEightBitsIsMarkedCut) {
+    // convert warns of it as of LAS colour; it cut 16-bit PLY colour to 8 bits without a word.
+    using Word = std::array<std::uint16_t, 3>;
+    const auto cut = [](const std::string& file) {
+        return decode(file, "colour.ply").cloud.colorCutTo8Bits;
+    };
+    EXPECT_TRUE(cut(colorPly<std::uint16_t>("ushort", {Word{1000, 0, 0}})));
+    // 8-bit values, or 16-bit ones that are 8-bit values times 257, lose nothing.
+    EXPECT_FALSE(cut(colorPly<std::uint16_t>("ushort", {Word{255, 3, 0}})));
+    EXPECT_FALSE(cut(colorPly<std::uint16_t>("ushort", {Word{65535, 514, 0}})));
+    // colorPly drops the second vertex (NaN): its colour is not written.
+    EXPECT_FALSE(cut(colorPly<std::uint16_t>("ushort", {Word{65535, 0, 0}, Word{1, 2, 3}})));
+    // 32-bit colour over 255 is clamped.
+    using Wide = std::array<std::uint32_t, 3>;
+    EXPECT_TRUE(cut(colorPly<std::uint32_t>("uint", {Wide{0, 300, 0}})));
+    EXPECT_FALSE(cut(colorPly<std::uint32_t>("uint", {Wide{0, 255, 0}})));
+}
+
 TEST(PlyReaderTest, FloatColourIsZeroToOneUnlessAValueOfTheFileIsLarger) {
     using Floats = std::array<float, 3>;
     // (255, 128, 0) was clamped to (255, 255, 0).
