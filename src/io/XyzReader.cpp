@@ -1085,13 +1085,23 @@ PointCloud readPoints(std::string_view text, PointTextReader& reader, ReadContex
     attributes.intensity = layout.intensity.has_value();
     PointCloudBuilder builder(attributes, reader.expectedPoints(text.size() - reader.dataOffset()));
     std::uint64_t pointLines = 0;
+    // Whether a kept point's 16-bit colour is no 8-bit value times 257, which 8 bits lose.
+    bool wordColorBeyondBytes = false;
     const auto addPoint = [&](std::span<const double> values, std::size_t) {
         if (layout.color) {
             for (const std::size_t column : *layout.color) {
                 colors.add(values[column]);
             }
         }
+        const std::size_t kept = builder.validPoints();
         builder.add(makeRecord(layout, values));
+        if (layout.color && layout.colorEncoding == ColorEncoding::Word16 &&
+            builder.validPoints() > kept) {
+            for (const std::size_t column : *layout.color) {
+                wordColorBeyondBytes =
+                    wordColorBeyondBytes || std::fmod(values[column], 257.0) != 0.0;
+            }
+        }
         if (++pointLines > kMaxPoints) {
             throw Error(fmt::format("it has more than the {} points subscan can hold", kMaxPoints));
         }
@@ -1108,6 +1118,7 @@ PointCloud readPoints(std::string_view text, PointTextReader& reader, ReadContex
     reader.finish();
     PointCloud cloud = builder.finish(context.warnings);
     cloud.coordinateStep = reader.coordinateStep();
+    cloud.colorCutTo8Bits = wordColorBeyondBytes;
     return cloud;
 }
 

@@ -230,6 +230,20 @@ TEST(XyzReaderTest, ColourValuesClampAndOtherEncodingsAreRecognised) {
     EXPECT_EQ(fractions.cloud.colors[0], (Rgba8{255, 128, 0, 255}));
 }
 
+TEST(XyzReaderTest, SixteenBitColourBeyondEightBitsIsMarkedCut) {
+    // convert warns of it as of LAS colour; it cut 16-bit text colour to 8 bits without a word.
+    const auto cut = [](const std::string& text) {
+        return decode(text, "colour.csv").cloud.colorCutTo8Bits;
+    };
+    EXPECT_TRUE(cut("X,Y,Z,Red,Green,Blue\n1,2,3,65535,0,1000\n"));
+    // 8-bit values, or 16-bit ones that are 8-bit values times 257 (32896 = 128 x 257), lose
+    // nothing.
+    EXPECT_FALSE(cut("X,Y,Z,Red,Green,Blue\n1,2,3,255,0,100\n"));
+    EXPECT_FALSE(cut("X,Y,Z,Red,Green,Blue\n1,2,3,65535,0,32896\n"));
+    // A dropped point's colour is not written.
+    EXPECT_FALSE(cut("X,Y,Z,Red,Green,Blue\n1,2,3,65535,0,0\nnan,2,3,1000,1000,1000\n"));
+}
+
 /// 150 dark points ("x y z r g b", values 0..149), then 850 in 16-bit colour (up to 64955), and
 /// one to drop.
 std::string darkStartThenSixteenBit(bool header) {
@@ -251,6 +265,7 @@ TEST(XyzReaderTest, ColourEncodingIsJudgedFromEveryLineNotTheFirstOnes) {
         EXPECT_EQ(scan.cloud.colors[149].r, 1);    // 149 / 257, rounded
         EXPECT_EQ(scan.cloud.colors[150].r, 104);  // 26750 / 257
         EXPECT_EQ(scan.cloud.colors[999].r, 253);  // 64955 / 257
+        EXPECT_TRUE(scan.cloud.colorCutTo8Bits);   // as the second reading found
         // Read twice, warned once.
         EXPECT_THAT(scan.warnings, ElementsAre(HasSubstr("dropped 1 of 1001 points")));
     }
