@@ -785,13 +785,26 @@ std::uint8_t toColorChannel(double value, double minimum, double maximum) {
     return static_cast<std::uint8_t>(std::clamp(std::round(scaled), 0.0, 255.0));
 }
 
+/// Whether toColorChannel loses bits of `value`: its limits span more than 8 bits (16-bit
+/// colour, for one) and it is not one of the 256 values that an 8-bit channel gives back
+/// (8-bit values times 257 in 0..65535).
+bool colorNeedsMoreThanEightBits(double value, double minimum, double maximum) {
+    const double span = maximum - minimum;
+    if (!(span > 255.0)) {
+        return false;
+    }
+    const double steps = (value - minimum) * 255.0;  // exact for integer fields
+    return steps != std::round(steps / span) * span;
+}
+
 /// Where the decoded records go: positions through the pose, attributes, progress.
 struct RecordSink {
     PointCloudBuilder& builder;
     const ReadContext& context;
     std::uint64_t totalRecords = 0;
     std::uint64_t done = 0;
-    std::uint64_t invalid = 0;  // dropped for their invalid state
+    std::uint64_t invalid = 0;     // dropped for their invalid state
+    bool colorCutTo8Bits = false;  // a kept point's colour needed more than 8 bits
 };
 
 void emitRecords(const ScanLayout& scan, std::vector<FieldDecoder>& decoders,
@@ -831,7 +844,15 @@ void emitRecords(const ScanLayout& scan, std::vector<FieldDecoder>& decoders,
                             toColorChannel(color[2], scan.colorMinimum[2], scan.colorMaximum[2]),
                             255};
         }
+        const std::size_t kept = sink.builder.validPoints();
         sink.builder.add(record);
+        if (colorInvalid == 0.0 && sink.builder.validPoints() > kept) {
+            for (int c = 0; c < 3; ++c) {
+                sink.colorCutTo8Bits = sink.colorCutTo8Bits ||
+                                       colorNeedsMoreThanEightBits(color[c], scan.colorMinimum[c],
+                                                                   scan.colorMaximum[c]);
+            }
+        }
     }
     sink.done += count;
     sink.context.reportProgress(sink.done, sink.totalRecords);
@@ -1096,6 +1117,7 @@ PointCloud readE57(std::span<const std::byte> file, ReadContext& context) {
     // Positions are computed in double (scaled integers, spherical coordinates, each scan's
     // pose), so they are doubles whatever the fields' types; keeping them so is simplest.
     cloud.doubleCoordinates = true;
+    cloud.colorCutTo8Bits = attributes.color && sink.colorCutTo8Bits;
     return cloud;
 }
 

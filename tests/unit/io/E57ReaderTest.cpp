@@ -509,6 +509,28 @@ TEST(E57ReaderTest, ColourLimitsMapToBytesAndInvalidFlagsAreHonoured) {
     EXPECT_EQ(bounded.colors[2], (Rgba8{128, 128, 9, 255}));  // 127.5 rounds up
 }
 
+TEST(E57ReaderTest, ColourBeyondEightBitsIsMarkedCut) {
+    // convert warns of it as of LAS colour; it cut 16-bit E57 colour to 8 bits without a word.
+    const auto cut = [](const std::vector<std::int64_t>& red, std::int64_t maximum) {
+        TestScan scan;
+        scan.fields = {doubleField("cartesianX", {0, 1, 2}),
+                       doubleField("cartesianY", {0, 0, 0}),
+                       doubleField("cartesianZ", {0, 0, 0}),
+                       integerField("colorRed", 0, maximum, red),
+                       integerField("colorGreen", 0, maximum, {0, 0, 0}),
+                       integerField("colorBlue", 0, maximum, {0, 0, 0}),
+                       integerField("isColorInvalid", 0, 1, {0, 0, 1})};
+        return read(writeE57({scan})).colorCutTo8Bits;
+    };
+    EXPECT_TRUE(cut({65535, 1000, 0}, 65535));
+    EXPECT_TRUE(cut({4095, 2048, 0}, 4095));
+    // Values that 8 bits give back (8-bit ones times 257), or limits of 8 bits, lose nothing.
+    EXPECT_FALSE(cut({65535, 257 * 100, 0}, 65535));
+    EXPECT_FALSE(cut({255, 17, 0}, 255));
+    // The colour of a point marked isColorInvalid is not the point's.
+    EXPECT_FALSE(cut({65535, 0, 1000}, 65535));
+}
+
 TEST(E57ReaderTest, ColourKeptOnlyWhenEveryScanHasIt) {
     TestScan plain;
     plain.fields = {doubleField("cartesianX", {1}), doubleField("cartesianY", {2}),
