@@ -78,6 +78,13 @@ struct PointCloud {
     glm::dvec3 fileCoordinates(std::size_t i) const { return origin + glm::dvec3(positions[i]); }
 };
 
+/// Whether the 16-bit colour value `value` is one 8 bits do not give back: not an 8-bit value
+/// times 257, as LAS writers (subscan's too) store 8-bit colour in 16 bits. The readers' test for
+/// PointCloud::colorCutTo8Bits.
+inline bool colorWordNeedsSixteenBits(double value) {
+    return std::fmod(value, 257.0) != 0.0;
+}
+
 /// Which optional attributes a reader will provide for every point.
 struct PointAttributes {
     bool color = false;

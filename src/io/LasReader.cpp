@@ -250,14 +250,13 @@ ColorDepth detectColorDepth(const std::byte* points, std::size_t count, std::siz
     return ColorDepth::EightBit;
 }
 
-/// Whether 16-bit colour holds a value that 8-bit colour does not give back: one that is not an
-/// 8-bit value times 257, as writeLas and most writers store 8-bit colour.
+/// Whether 16-bit colour holds a value that 8-bit colour does not give back.
 bool colorNeedsSixteenBits(const std::byte* points, std::size_t count, std::size_t stride,
                            std::size_t colorOffset) {
     for (std::size_t i = 0; i < count; ++i) {
         const std::byte* rgb = points + i * stride + colorOffset;
         for (std::size_t channel = 0; channel < 3; ++channel) {
-            if (loadLittleEndian<std::uint16_t>(rgb + 2 * channel) % 257 != 0) {
+            if (colorWordNeedsSixteenBits(loadLittleEndian<std::uint16_t>(rgb + 2 * channel))) {
                 return true;
             }
         }
@@ -538,9 +537,8 @@ PointCloud lasRecordsToCloud(std::span<const std::byte> head, const LasHeader& h
     PointCloud cloud = builder.finish(warnings);
     const glm::dvec3 step = glm::abs(header.scale);
     cloud.coordinateStep = std::min({step.x, step.y, step.z});
-    cloud.colorCutTo8Bits =
-        depth == ColorDepth::SixteenBit &&
-        colorNeedsSixteenBits(points, count, header.recordLength, *colorOffset);
+    cloud.colorCutTo8Bits = depth == ColorDepth::SixteenBit &&
+                            colorNeedsSixteenBits(points, count, header.recordLength, *colorOffset);
     return cloud;
 }
 

@@ -660,7 +660,7 @@ PointCloud PlyBodyReader::read() {
     const auto noteColorBeyondBytes = [&](auto&& value) {
         for (const std::size_t p : wideIntegerColors) {
             if (plySizeOf(colorType(p)) == 2) {
-                wordColorBeyondBytes = wordColorBeyondBytes || std::fmod(value(p), 257.0) != 0.0;
+                wordColorBeyondBytes = wordColorBeyondBytes || colorWordNeedsSixteenBits(value(p));
             } else {
                 widerColorClamped = widerColorClamped || value(p) > 255.0;
             }

@@ -1099,7 +1099,7 @@ PointCloud readPoints(std::string_view text, PointTextReader& reader, ReadContex
             builder.validPoints() > kept) {
             for (const std::size_t column : *layout.color) {
                 wordColorBeyondBytes =
-                    wordColorBeyondBytes || std::fmod(values[column], 257.0) != 0.0;
+                    wordColorBeyondBytes || colorWordNeedsSixteenBits(values[column]);
             }
         }
         if (++pointLines > kMaxPoints) {

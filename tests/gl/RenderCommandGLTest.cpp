@@ -855,11 +855,8 @@ TEST(RenderCommandGLTest, AModesOwnOptionsInAnotherModeAreNamed) {
     // since --save-settings keeps them for the other modes.
     const test::TempDir dir;
     const std::string out = (dir / "x.png").string();
-    auto render = [&](std::vector<std::string> options) {
-        std::vector<std::string> arguments{"render", "synthetic:sphere", "-o", out, "--width",
-                                           "32",     "--height",         "24"};
-        arguments.insert(arguments.end(), options.begin(), options.end());
-        return runSubscan(arguments);
+    auto render = [&](const std::vector<std::string>& options) {
+        return test::renderSmallSphere(out, options);
     };
     const test::CommandResult material = render({"--mode", "surface", "--material", "skin1"});
     EXPECT_EQ(material.exitCode, 0) << material.err;

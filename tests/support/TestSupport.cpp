@@ -144,6 +144,13 @@ CommandResult runSubscan(const std::vector<std::string>& arguments,
     return runProgram(SUBSCAN_EXECUTABLE, arguments, variables);
 }
 
+CommandResult renderSmallSphere(const std::string& out, const std::vector<std::string>& options) {
+    std::vector<std::string> arguments{"render", "synthetic:sphere", "-o", out, "--width",
+                                       "32",     "--height",         "24"};
+    arguments.insert(arguments.end(), options.begin(), options.end());
+    return runSubscan(arguments);
+}
+
 std::string subscanExecutable() {
     return SUBSCAN_EXECUTABLE;
 }

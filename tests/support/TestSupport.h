@@ -75,6 +75,10 @@ struct CommandResult {
 CommandResult runSubscan(const std::vector<std::string>& arguments,
                          const std::vector<std::string>& environment = {});
 
+/// `subscan render synthetic:sphere -o out --width 32 --height 24` and `options`: a picture
+/// small enough for any test of the command's options.
+CommandResult renderSmallSphere(const std::string& out, const std::vector<std::string>& options);
+
 /// The subscan executable built with this test (for commands that must run through a shell).
 std::string subscanExecutable();
 

@@ -136,11 +136,8 @@ TEST(CliTest, OptionsTheViewWouldIgnoreAreRefused) {
     // are named in a warning: RenderCommandGLTest, since those pictures are drawn.
     const test::TempDir dir;
     const std::string out = (dir / "x.png").string();
-    auto render = [&](std::vector<std::string> options) {
-        std::vector<std::string> arguments{"render", "synthetic:sphere", "-o", out, "--width",
-                                           "32",     "--height",         "24"};
-        arguments.insert(arguments.end(), options.begin(), options.end());
-        return runSubscan(arguments);
+    auto render = [&](const std::vector<std::string>& options) {
+        return test::renderSmallSphere(out, options);
     };
     // The sensor's view has no orbit.
     for (const std::string option : {"--yaw", "--pitch", "--distance"}) {
