@@ -67,7 +67,7 @@ struct PointCloud {
     bool doubleCoordinates = false;
     /// Whether the file's colour used more than 8 bits a channel (16-bit values other than 8-bit
     /// ones times 257, E57 values of wider limits that 8 bits do not give back, PLY colour over
-    /// 255 in 32-bit channels), which `colors` holds cut to 8.
+    /// 255 and PCD colour over 65535 in 32-bit channels), which `colors` holds cut to 8.
     bool colorCutTo8Bits = false;
 
     std::size_t size() const { return positions.size(); }

@@ -534,6 +534,7 @@ double loadValue(PcdType type, const std::byte* p) {
     return 0.0;
 }
 
+/// Packed rgb/rgba holds 8 bits a channel by definition: nothing in it is cut to 8 bits.
 Rgba8 unpackColor(std::uint32_t bits, bool hasAlpha) {
     return {static_cast<std::uint8_t>(bits >> 16), static_cast<std::uint8_t>(bits >> 8),
             static_cast<std::uint8_t>(bits),
@@ -561,9 +562,18 @@ class ChannelColors {
             if (isWide(types_[channel]) && value > 255.0) {
                 wideValuesAbove8Bits_ = true;
             }
+            if (channel < 3 && isWide(types_[channel]) && value > 0.0 &&
+                (value > 65535.0 || colorWordNeedsSixteenBits(value))) {
+                wideValueBeyondBytes_ = true;
+            }
         }
         values_.push_back(kept);
     }
+
+    /// Whether the red, green and blue of the kept points used more than 8 bits, which
+    /// applyTo's 8-bit colour loses: read as 16-bit, a value other than an 8-bit one times 257,
+    /// or one over 65535 (clamped).
+    bool cutTo8Bits() const { return wideValuesAbove8Bits_ && wideValueBeyondBytes_; }
 
     void applyTo(std::vector<Rgba8>& colors) const {
         for (std::size_t i = 0; i < colors.size() && i < values_.size(); ++i) {
@@ -593,6 +603,7 @@ class ChannelColors {
 
     std::array<PcdType, 4> types_{};
     bool wideValuesAbove8Bits_ = false;
+    bool wideValueBeyondBytes_ = false;
     std::vector<std::array<float, 4>> values_;
 };
 
@@ -648,6 +659,7 @@ class PointSink {
         PointCloud cloud = builder_.finish(warnings);
         if (channelColors_) {
             channelColors_->applyTo(cloud.colors);
+            cloud.colorCutTo8Bits = channelColors_->cutTo8Bits();
         }
         return cloud;
     }

@@ -381,6 +381,31 @@ TEST(PcdReaderTest, PdalUpperCaseNamesAndSeparateColourChannels) {
     EXPECT_EQ(scan.cloud.colors[0], (Rgba8{10, 20, 30, 40}));
 }
 
+TEST(PcdReaderTest, ColourBeyondEightBitsIsMarkedCut) {
+    // convert warns of it as of LAS colour; it cut PDAL's 16-bit PCD colour to 8 bits without a
+    // word.
+    const auto cut = [](const std::string& sizeAndType, const std::vector<std::string>& points) {
+        std::string lines;
+        for (const std::string& point : points) {
+            lines += point + "\n";
+        }
+        const std::string fields =
+            "FIELDS x y z red green blue\n" + sizeAndType + "COUNT 1 1 1 1 1 1\n";
+        return decode(pcdHeader(fields, points.size(), 1, "ascii") + lines, "colour.pcd")
+            .cloud.colorCutTo8Bits;
+    };
+    const std::string words = "SIZE 4 4 4 2 2 2\nTYPE F F F U U U\n";
+    EXPECT_TRUE(cut(words, {"0 0 0 1000 0 0"}));
+    // 8-bit values, or 16-bit ones that are 8-bit values times 257, lose nothing.
+    EXPECT_FALSE(cut(words, {"0 0 0 255 3 0"}));
+    EXPECT_FALSE(cut(words, {"0 0 0 65535 514 0"}));
+    // The first point is dropped (NaN): its colour is not kept.
+    EXPECT_FALSE(cut(words, {"nan 0 0 1000 0 0", "0 0 0 65535 0 0"}));
+    // 32-bit channels read as 16-bit: a value over 65535 is clamped, though it is 300 times 257.
+    EXPECT_TRUE(cut("SIZE 4 4 4 4 4 4\nTYPE F F F U U U\n", {"0 0 0 77100 0 0"}));
+    EXPECT_FALSE(cut("SIZE 4 4 4 1 1 1\nTYPE F F F U U U\n", {"0 0 0 255 3 0"}));
+}
+
 TEST(PcdReaderTest, CompressedPclLayoutWithoutPaddingColumns) {
     // PCL's writer leaves '_' fields out of the compressed columns; both layouts are read.
     const std::string fields = "FIELDS x _ y z\nSIZE 4 1 4 4\nTYPE F U F F\nCOUNT 1 4 1 1\n";
