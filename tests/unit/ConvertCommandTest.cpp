@@ -282,9 +282,21 @@ TEST(ConvertCommandTest, SixteenBitColourCutToEightIsNamed) {
                                           (name == "out.ply"   ? "PLY"
                                            : name == "out.pcd" ? "PCD"
                                                                : "XYZ text") +
-                                          " output is written with 8-bit colour: the input's "
-                                          "16-bit colour is cut to 8 bits"));
+                                          " output is written with 8-bit colour, so the "
+                                          "input's colour of more than 8 bits a channel is cut "
+                                          "to 8 bits"));
     }
+    // It said "16-bit" of every input, E57 colour of 12-bit limits too. A PCD's 16-bit
+    // channels, as PDAL writes them, are named alike.
+    const std::filesystem::path pcd = dir.write(
+        "rgb16.pcd",
+        "VERSION 0.7\nFIELDS x y z red green blue\nSIZE 4 4 4 2 2 2\nTYPE F F F U U U\n"
+        "COUNT 1 1 1 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n0 0 0 1000 40000 7\n");
+    const test::CommandResult fromPcd =
+        runSubscan({"convert", pcd.string(), "-o", (dir / "from-pcd.ply").string()});
+    ASSERT_EQ(fromPcd.exitCode, 0) << fromPcd.err;
+    EXPECT_THAT(fromPcd.err, HasSubstr("the input's colour of more than 8 bits a channel"));
+    EXPECT_THAT(fromPcd.err, ::testing::Not(HasSubstr("16-bit")));
     // Through LAS 1.2 and back the colour is 8-bit times 257: nothing more to cut.
     const auto las = dir / "rgb8.las";
     convert((dir / "out.ply").string(), las);

@@ -157,9 +157,10 @@ void warnAboutWhatIsNotWritten(const std::string& output, const OutputFormat& fo
     // Every format written from a cloud holds its 8-bit colour only. PLY could declare ushort
     // colour, but Open3D's reader divides any PLY colour by 255, and 16-bit colour would break it.
     if (cloud.colorCutTo8Bits) {
+        // Not "16-bit": E57 colour limits span any width (12-bit is common).
         fmt::print(stderr,
-                   "subscan: warning: {}: {} output is written with 8-bit colour: the input's "
-                   "16-bit colour is cut to 8 bits\n",
+                   "subscan: warning: {}: {} output is written with 8-bit colour, so the input's "
+                   "colour of more than 8 bits a channel is cut to 8 bits\n",
                    output, format.name);
     }
     if (!scan.grid.empty()) {
