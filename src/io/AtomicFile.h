@@ -2,7 +2,9 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <ostream>
+#include <string>
 #include <string_view>
 
 namespace subscan {
@@ -15,5 +17,9 @@ void writeFileAtomically(const std::filesystem::path& path,
 
 /// Convenience for content already in memory.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+
+/// The name of the file writeFileAtomically was writing where `name` is one of its temporary
+/// files' (".NAME.0123abcd.tmp"), which a process killed while writing leaves; else nullopt.
+std::optional<std::string> atomicWriteTargetOf(std::string_view name);
 
 }  // namespace subscan

@@ -74,5 +74,22 @@ TEST(AtomicFileTest, MissingDirectoryIsAClearError) {
     }
 }
 
+TEST(AtomicFileTest, ATemporaryFileNamesItsTarget) {
+    // A process killed while writing leaves its temporary file: turntable removes those in its
+    // own staging folders by the names of the files they were to become.
+    const test::TempDir dir;
+    std::string temporary;
+    writeFileAtomically(dir / "0003.png", [&](std::ostream& stream) {
+        temporary = test::folderEntries(dir.path()).at(0);
+        stream << "frame";
+    });
+    EXPECT_EQ(atomicWriteTargetOf(temporary), "0003.png");
+    for (const char* other :
+         {"0003.png", ".0003.png.tmp", ".0003.png.0123ABCD.tmp", "..0123abcd.tmp",
+          ".0003.png-0123abcd.tmp", "0003.png.0123abcd.tmp"}) {
+        EXPECT_EQ(atomicWriteTargetOf(other), std::nullopt) << other;
+    }
+}
+
 }  // namespace
 }  // namespace subscan
