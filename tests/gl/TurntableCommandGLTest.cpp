@@ -1,5 +1,8 @@
 // `subscan turntable`: numbered PNGs or an MP4 through the temporal filter, the first frame
 // already converged, the yaw growing by degrees / frames, per-frame buffers, and refusals.
+#include <signal.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -126,17 +129,20 @@ TEST(TurntableCommandGLTest, WritesAnMp4WithFfmpeg) {
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "SPIN.MP4"));
 }
 
-/// Starts an endless turntable of `output` (and `more` options), sends it a terminal's Ctrl-C
-/// once `written` (a shell glob) matches a file, and returns its exit status and stderr.
+/// Starts an endless turntable of `output` (and `more` options), sends it `signal` (a
+/// terminal's Ctrl-C unless named) once `written` (a shell glob) matches a file, and returns its
+/// exit status and stderr.
 test::CommandResult interruptTurntable(const std::filesystem::path& output,
-                                       const std::string& written, const std::string& more = "") {
+                                       const std::string& written, const std::string& more = "",
+                                       const std::string& signal = "INT") {
     const test::TempDir capture;
     const std::string command = fmt::format(
         "SUBSCAN_GL_DEBUG=1 '{}' turntable synthetic:sphere?points=4000 --mode surface "
         "--width 64 --height 48 --frames 100000 -o '{}' {} 2> '{}' & pid=$!; "
         "for i in $(seq 600); do ls -d {} > /dev/null 2>&1 && break; sleep 0.1; done; "
-        "kill -INT $pid; wait $pid",
-        test::subscanExecutable(), output.string(), more, (capture / "err").string(), written);
+        "kill -{} $pid; wait $pid",
+        test::subscanExecutable(), output.string(), more, (capture / "err").string(), written,
+        signal);
     test::CommandResult run = test::runProgram("/bin/sh", {"-c", command});
     run.err = test::fileBytes(capture / "err");
     return run;
@@ -194,6 +200,60 @@ TEST(TurntableCommandGLTest, CtrlCLeavesAFolderAsItWas) {
         interruptTurntable(dir / "new", (dir / "new" / ".frames-*/0000.png").string());
     EXPECT_EQ(fresh.exitCode, 130) << fresh.err;
     EXPECT_FALSE(std::filesystem::exists(dir / "new"));
+}
+
+TEST(TurntableCommandGLTest, ALaterTurntableRemovesTheStagingFoldersOfAKilledOne) {
+    // kill -9 (or a second Ctrl-C) leaves the hidden staging folders: the next turntable into
+    // that --export-buffers folder refused it as someone else's files, and the frames' folder
+    // kept the killed run's frames hidden in it.
+    const test::TempDir dir;
+    const auto frames = dir / "frames";
+    const auto exported = dir / "buffers";
+    const auto killed =
+        interruptTurntable(frames, (exported / ".buffers-*/0001/camera.json").string(),
+                           "--export-buffers '" + exported.string() + "'", "KILL");
+    EXPECT_EQ(killed.exitCode, 128 + SIGKILL) << killed.err;
+    const std::vector<std::string> leftFrames = test::folderEntries(frames);
+    const std::vector<std::string> leftBuffers = test::folderEntries(exported);
+    ASSERT_EQ(leftFrames.size(), 1u);
+    ASSERT_EQ(leftBuffers.size(), 1u);
+    ASSERT_THAT(leftFrames[0], ::testing::StartsWith(".frames-"));
+    ASSERT_THAT(leftBuffers[0], ::testing::StartsWith(".buffers-"));
+
+    const auto turntable = [&] {
+        return runSubscan(
+            with(with({"turntable"}, kScene), {"-o", frames.string(), "--frames", "2", "--warmup",
+                                               "1", "--export-buffers", exported.string()}));
+    };
+    const auto later = turntable();
+    ASSERT_EQ(later.exitCode, 0) << later.err;
+    for (const auto& left : {frames / leftFrames[0], exported / leftBuffers[0]}) {
+        EXPECT_THAT(later.err, HasSubstr("subscan: removed " + left.string() +
+                                         ", which a killed turntable "
+                                         "left\n"));
+    }
+    EXPECT_EQ(test::folderEntries(frames), (std::vector<std::string>{"0000.png", "0001.png"}));
+    EXPECT_EQ(test::folderEntries(exported), (std::vector<std::string>{"0000", "0001"}));
+
+    // Only a folder named exactly as one, of a process that has ended, holding only a
+    // turntable's files: anything else is left as it is, and the export folder refused.
+    std::filesystem::create_directories(exported / leftBuffers[0] / "0000");
+    const auto notes = dir.write("buffers/" + leftBuffers[0] + "/0000/notes.txt", "mine");
+    const auto lookalike = frames / (leftFrames[0] + "x");
+    const auto running = frames / fmt::format(".frames-{}", ::getpid());
+    for (const auto& folder : {lookalike, running}) {
+        std::filesystem::create_directories(folder);
+        std::filesystem::copy_file(frames / "0000.png", folder / "0000.png");
+    }
+    const auto refused = turntable();
+    EXPECT_EQ(refused.exitCode, 1);
+    EXPECT_THAT(refused.err, HasSubstr((exported / leftBuffers[0]).string() +
+                                       ": --export-buffers replaces the files of an earlier "
+                                       "export in its folder"));
+    EXPECT_THAT(refused.err, ::testing::Not(HasSubstr("removed")));
+    EXPECT_EQ(test::fileBytes(notes), "mine");
+    EXPECT_EQ(test::folderEntries(lookalike), std::vector<std::string>{"0000.png"});
+    EXPECT_EQ(test::folderEntries(running), std::vector<std::string>{"0000.png"});
 }
 
 TEST(TurntableCommandGLTest, AFolderHoldsThisSequenceAlone) {

@@ -213,15 +213,26 @@ std::unique_ptr<GlContext> FrameOptions::context() const {
     return context;
 }
 
-void FrameOptions::refuseToOverwriteInputs(const std::filesystem::path& output,
-                                           std::string_view what) const {
+const char* FrameOptions::inputKindOf(const std::filesystem::path& file) const {
     for (const auto& [input, kind] :
          {std::pair{&source, "scan"}, std::pair{&settingsFile, "settings file"},
           std::pair{&cameraFile, "camera file"}}) {
-        if (!input->empty() && !input->starts_with("synthetic:") && sameFile(output, *input)) {
-            throw Error(fmt::format("{}: refusing to write {} over the input {}", output.string(),
-                                    what, kind));
+        if (!input->empty() && !input->starts_with("synthetic:") && sameFile(file, *input)) {
+            return kind;
         }
+    }
+    return nullptr;
+}
+
+bool FrameOptions::isInput(const std::filesystem::path& file) const {
+    return inputKindOf(file) != nullptr;
+}
+
+void FrameOptions::refuseToOverwriteInputs(const std::filesystem::path& output,
+                                           std::string_view what) const {
+    if (const char* kind = inputKindOf(output)) {
+        throw Error(
+            fmt::format("{}: refusing to write {} over the input {}", output.string(), what, kind));
     }
 }
 

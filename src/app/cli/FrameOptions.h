@@ -66,6 +66,8 @@ struct FrameOptions {
     /// Throws subscan::Error when `output` is the input scan or the settings file: nothing is
     /// ever written over an input. `what` names the output ("the image", "the settings").
     void refuseToOverwriteInputs(const std::filesystem::path& output, std::string_view what) const;
+    /// Whether `file` is one of the inputs: the scan, the settings file or the camera file.
+    bool isInput(const std::filesystem::path& file) const;
     /// Writes --save-settings, if given (after the inputs are read).
     void saveSettings(const RenderSettings& settings) const;
 
@@ -73,6 +75,8 @@ struct FrameOptions {
     /// Whether the option `name` was given (not its default).
     bool given(const char* name) const;
     void checkIgnoredOptions(RenderMode effectiveMode) const;
+    /// What kind of input `file` is ("scan", "settings file", "camera file"), or nullptr.
+    const char* inputKindOf(const std::filesystem::path& file) const;
 };
 
 }  // namespace subscan::cli

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -26,6 +27,7 @@
 #include "app/cli/FrameOptions.h"
 #include "app/cli/InterruptWatcher.h"
 #include "core/Error.h"
+#include "io/AtomicFile.h"
 #include "io/Image.h"
 #include "io/TextParsing.h"
 #include "lod/NodeSelection.h"
@@ -226,22 +228,154 @@ void createFolder(const std::filesystem::path& folder, std::string_view what) {
     }
 }
 
+/// The name of the hidden folder StagingFolder makes for process `pid`.
+std::string stagingName(std::string_view prefix, std::string_view what, pid_t pid) {
+    return fmt::format(".{}{}-{}", prefix, what, pid);
+}
+
+/// The process whose staging folder `name` is, where stagingName gives `name` for `prefix` and
+/// `what`; else nullopt.
+std::optional<pid_t> stagingOwner(std::string_view name, std::string_view prefix,
+                                  std::string_view what) {
+    const std::size_t dash = name.rfind('-');
+    if (dash == std::string_view::npos) {
+        return std::nullopt;
+    }
+    const std::string_view digits = name.substr(dash + 1);
+    pid_t pid = 0;
+    const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), pid);
+    if (error != std::errc() || end != digits.data() + digits.size() || pid <= 0 ||
+        stagingName(prefix, what, pid) != name) {
+        return std::nullopt;
+    }
+    return pid;
+}
+
+/// What a staging folder holds: numbered PNGs, or numbered folders of buffer files.
+enum class Staged { Frames, Buffers };
+
+std::string_view stagedName(Staged staged) {
+    return staged == Staged::Frames ? "frames" : "buffers";
+}
+
+/// The entries of `folder` where each has the type `type` (links are none of theirs) and, for
+/// files, a name `isOurs` takes, or is a partial file of one (its writer killed); else nullopt.
+std::optional<std::vector<std::filesystem::path>> entriesIfOurs(
+    const std::filesystem::path& folder, std::filesystem::file_type type,
+    const std::function<bool(const std::string&)>& isOurs) {
+    std::error_code error;
+    const std::filesystem::directory_iterator entries(folder, error);
+    if (error) {
+        return std::nullopt;
+    }
+    std::vector<std::filesystem::path> ours;
+    for (const auto& entry : entries) {
+        const std::string name = entry.path().filename().string();
+        const std::optional<std::string> partialOf = atomicWriteTargetOf(name);
+        if (entry.symlink_status(error).type() != type ||
+            !isOurs(partialOf && type == std::filesystem::file_type::regular ? *partialOf : name)) {
+            return std::nullopt;
+        }
+        ours.push_back(entry.path());
+    }
+    return ours;
+}
+
+/// What the staging folder `path` holds where a turntable killed while it ran (a second Ctrl-C,
+/// kill -9) left it: named by stagingName, of a process that no longer runs, and holding only
+/// what a turntable stages there, none of it an input. Files come first, then frame folders,
+/// then `path`: an order they can be removed in one by one. Else nullopt.
+std::optional<std::vector<std::filesystem::path>> leftStagingFolder(
+    const std::filesystem::path& path, std::string_view prefix, Staged staged,
+    const FrameOptions& frame) {
+    const std::optional<pid_t> owner =
+        stagingOwner(path.filename().string(), prefix, stagedName(staged));
+    // kill(pid, 0) says whether the process exists (EPERM: as someone else's), which may be
+    // another turntable staging its frames. This process has made none yet.
+    if (!owner || (*owner != ::getpid() && (::kill(*owner, 0) == 0 || errno == EPERM))) {
+        return std::nullopt;
+    }
+    std::error_code error;
+    if (std::filesystem::symlink_status(path, error).type() !=
+        std::filesystem::file_type::directory) {
+        return std::nullopt;
+    }
+    using std::filesystem::file_type;
+    std::vector<std::filesystem::path> files;
+    std::vector<std::filesystem::path> folders;
+    if (staged == Staged::Frames) {
+        auto frames = entriesIfOurs(path, file_type::regular, [](const std::string& name) {
+            return frameIndexOf(name, ".png").has_value();
+        });
+        if (!frames) {
+            return std::nullopt;
+        }
+        files = std::move(*frames);
+    } else {
+        auto frameFolders = entriesIfOurs(path, file_type::directory, [](const std::string& name) {
+            return frameIndexOf(name, "").has_value();
+        });
+        if (!frameFolders) {
+            return std::nullopt;
+        }
+        for (const std::filesystem::path& frameFolder : *frameFolders) {
+            const auto buffers =
+                entriesIfOurs(frameFolder, file_type::regular,
+                              [](const std::string& name) { return isBufferFile(name); });
+            if (!buffers) {
+                return std::nullopt;
+            }
+            files.insert(files.end(), buffers->begin(), buffers->end());
+        }
+        folders = std::move(*frameFolders);
+    }
+    if (std::any_of(files.begin(), files.end(),
+                    [&](const std::filesystem::path& file) { return frame.isInput(file); })) {
+        return std::nullopt;
+    }
+    files.insert(files.end(), folders.begin(), folders.end());
+    files.push_back(path);
+    return files;
+}
+
+/// Removes the staging folders in `folder` that killed turntables left there (a later export
+/// into the folder refused them as someone else's files), and says so; anything else stays.
+void removeLeftStagingFolders(const std::filesystem::path& folder, std::string_view prefix,
+                              Staged staged, const FrameOptions& frame) {
+    std::vector<std::filesystem::path> entries;
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(
+             folder.empty() ? std::filesystem::path(".") : folder, error)) {
+        entries.push_back(entry.path());
+    }
+    for (const std::filesystem::path& path : entries) {
+        const auto left = leftStagingFolder(path, prefix, staged, frame);
+        if (!left) {
+            continue;
+        }
+        for (const std::filesystem::path& item : *left) {
+            removeEarlierOutput(item, "what a killed turntable left");
+        }
+        fmt::print(stderr, "subscan: removed {}, which a killed turntable left\n", path.string());
+    }
+}
+
 /// A hidden folder in `folder` (made if missing) that holds a run's frames until they are
 /// complete, removed with what is left in it when the run ends, and `folder` too where the run
 /// made it and put nothing else there: an interrupted or failed turntable leaves none of its
 /// output.
 class StagingFolder {
   public:
-    /// `what` ("frames", "buffers") names it, after `prefix`, and the folder in errors.
-    StagingFolder(const std::filesystem::path& folder, std::string_view what,
-                  std::string_view prefix = "")
+    /// stagedName(staged) names it, after `prefix`, and the folder in errors.
+    StagingFolder(const std::filesystem::path& folder, Staged staged, std::string_view prefix = "")
         : folder_(folder),
           madeFolder_(!folder.empty() && !std::filesystem::exists(folder)),
-          path_(folder / fmt::format(".{}{}-{}", prefix, what, ::getpid())) {
+          path_(folder / stagingName(prefix, stagedName(staged), ::getpid())) {
         if (!folder.empty()) {
-            createFolder(folder, what);  // said of the folder given, not of the hidden one
+            // Said of the folder given, not of the hidden one.
+            createFolder(folder, stagedName(staged));
         }
-        createFolder(path_, what);
+        createFolder(path_, stagedName(staged));
     }
     ~StagingFolder() {
         std::error_code ignored;
@@ -279,9 +413,6 @@ int runTurntable(const TurntableOptions& options) {
          video ? std::vector<std::filesystem::path>() : framesIn(output, ".png")) {
         frame.refuseToOverwriteInputs(earlier, "a frame");
     }
-    if (!options.exportDirectory.empty()) {
-        checkExportFolders(options);
-    }
     std::optional<std::filesystem::path> ffmpeg;
     if (video) {
         ffmpeg = findFfmpeg();
@@ -291,6 +422,17 @@ int runTurntable(const TurntableOptions& options) {
                 "numbered PNGs instead",
                 output.string()));
         }
+    }
+    // Before checkExportFolders, which would refuse them as someone else's files.
+    if (video) {
+        removeLeftStagingFolders(output.parent_path(), output.filename().string() + ".",
+                                 Staged::Frames, frame);
+    } else {
+        removeLeftStagingFolders(output, "", Staged::Frames, frame);
+    }
+    if (!options.exportDirectory.empty()) {
+        removeLeftStagingFolders(options.exportDirectory, "", Staged::Buffers, frame);
+        checkExportFolders(options);
     }
     RenderSettings settings = frame.settings();
     settings.temporal.enabled = true;
@@ -336,12 +478,12 @@ int runTurntable(const TurntableOptions& options) {
     // From the frames' folder on an interrupt stops at the next frame, which cleans up.
     interrupts.defer();
     // A video's frames beside it, a folder's in it (so that they move in by renaming).
-    const StagingFolder frames =
-        video ? StagingFolder(output.parent_path(), "frames", output.filename().string() + ".")
-              : StagingFolder(output, "frames");
+    const StagingFolder frames = video ? StagingFolder(output.parent_path(), Staged::Frames,
+                                                       output.filename().string() + ".")
+                                       : StagingFolder(output, Staged::Frames);
     std::optional<StagingFolder> buffers;
     if (!options.exportDirectory.empty()) {
-        buffers.emplace(options.exportDirectory, "buffers");
+        buffers.emplace(options.exportDirectory, Staged::Buffers);
     }
     const FrameOutputs outputs =
         options.exportDirectory.empty() ? FrameOutputs::Picture : FrameOutputs::Everything;
