@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <vector>
 
 #include <fmt/format.h>
@@ -76,11 +77,48 @@ PointCloud PointCloudBuilder::finish(std::vector<std::string>& warnings) {
     // finest steps. The shift is computed in double and applied once.
     const glm::dvec3 newOrigin = cloud_.bounds.center();
     const glm::dvec3 shift = cloud_.origin - newOrigin;
-    for (glm::vec3& p : cloud_.positions) {
-        p = glm::vec3(glm::dvec3(p) + shift);
+    if (keepResiduals_) {
+        // The positions as without residuals; each residual gains what the shift rounds off.
+        for (std::size_t i = 0; i < cloud_.positions.size(); ++i) {
+            const glm::dvec3 shifted = glm::dvec3(cloud_.positions[i]) + shift;
+            cloud_.positions[i] = glm::vec3(shifted);
+            cloud_.positionResiduals[i] = glm::vec3(lostToFloat(shifted, cloud_.positions[i]) +
+                                                    glm::dvec3(cloud_.positionResiduals[i]));
+        }
+    } else {
+        for (glm::vec3& p : cloud_.positions) {
+            p = glm::vec3(glm::dvec3(p) + shift);
+        }
     }
     cloud_.origin = newOrigin;
     return std::move(cloud_);
+}
+
+double positionTolerance(const PointCloud& cloud) {
+    if (cloud.coordinateStep > 0.0) {
+        return 0.5 * cloud.coordinateStep;
+    }
+    if (cloud.doubleCoordinates) {
+        return kDoubleCoordinateTolerance;
+    }
+    const glm::dvec3 extent = cloud.bounds.empty() ? glm::dvec3(0.0) : cloud.bounds.extent();
+    return kFloatErrorFraction * std::max({extent.x, extent.y, extent.z});
+}
+
+void keepResidualsWhereNeeded(PointCloud& cloud) {
+    if (!cloud.hasPositionResiduals()) {
+        return;
+    }
+    const auto tolerance = static_cast<float>(positionTolerance(cloud));
+    const bool needed = std::any_of(
+        cloud.positionResiduals.begin(), cloud.positionResiduals.end(), [&](const glm::vec3& r) {
+            return std::abs(r.x) > tolerance || std::abs(r.y) > tolerance ||
+                   std::abs(r.z) > tolerance;
+        });
+    if (!needed) {
+        cloud.positionResiduals.clear();
+        cloud.positionResiduals.shrink_to_fit();
+    }
 }
 
 Bounds framingBounds(const PointCloud& cloud) {

@@ -48,11 +48,17 @@ struct Bounds {
 /// A point cloud in memory, one array per attribute (structure of arrays).
 ///
 /// Positions are floats relative to `origin`, a double offset near the centre of the cloud, so
-/// a scan in UTM coordinates keeps millimetre precision: file coordinate = origin + position.
-/// Optional attributes are either empty or exactly one entry per point.
+/// a scan in UTM coordinates keeps millimetre precision: file coordinate = origin + position
+/// (+ positionResiduals, where kept). Optional attributes are either empty or exactly one entry
+/// per point.
 struct PointCloud {
     glm::dvec3 origin{0.0};
     std::vector<glm::vec3> positions;
+    /// What the float positions lost of the file's coordinates, per point: file coordinate =
+    /// origin + position + residual (each in double). Kept only where a load asked for the file's
+    /// precision (`convert`, see keepResidualsWhereNeeded) and the floats round by more than
+    /// positionTolerance; else empty. The renderer never reads it.
+    std::vector<glm::vec3> positionResiduals;
     std::vector<Rgba8> colors;                  // sRGB-encoded
     std::vector<glm::vec3> normals;             // unit length where the file had them
     std::vector<float> intensities;             // as stored in the file (no normalisation)
@@ -75,14 +81,49 @@ struct PointCloud {
     bool hasNormals() const { return !normals.empty(); }
     bool hasIntensities() const { return !intensities.empty(); }
     bool hasClassifications() const { return !classifications.empty(); }
-    glm::dvec3 fileCoordinates(std::size_t i) const { return origin + glm::dvec3(positions[i]); }
+    bool hasPositionResiduals() const { return !positionResiduals.empty(); }
+    glm::dvec3 fileCoordinates(std::size_t i) const {
+        return hasPositionResiduals()
+                   ? origin + (glm::dvec3(positions[i]) + glm::dvec3(positionResiduals[i]))
+                   : origin + glm::dvec3(positions[i]);
+    }
 };
+
+/// Where no grid of the file's own says how finely its coordinates are meant (no
+/// coordinateStep), float coordinates are taken to be exact to this fraction of the extent: a
+/// micrometre on a metre-sized object scan, whose float files are no finer.
+inline constexpr double kFloatErrorFraction = 1e-6;
+/// Doubles on no grid (PLY or PCD double properties, E57) are kept to this, in scene units: a
+/// micrometre in metres, finer than scanners measure.
+inline constexpr double kDoubleCoordinateTolerance = 1e-6;
+
+/// How far a coordinate may move from the file's and still be the file's own: half a step of
+/// its grid (coordinateStep: a LAS scale, a text's decimals), kDoubleCoordinateTolerance for
+/// doubles on no grid, a millionth of the extent for floats.
+double positionTolerance(const PointCloud& cloud);
+
+/// Drops `cloud.positionResiduals` unless one exceeds positionTolerance(cloud): only clouds whose
+/// float positions lose more than the file's own precision (a 200 km survey on a millimetre
+/// grid) pay for them. Call once the reader has set coordinateStep and doubleCoordinates.
+void keepResidualsWhereNeeded(PointCloud& cloud);
 
 /// Whether the 16-bit colour value `value` is one 8 bits do not give back: not an 8-bit value
 /// times 257, as LAS writers (subscan's too) store 8-bit colour in 16 bits. The readers' test for
 /// PointCloud::colorCutTo8Bits.
 inline bool colorWordNeedsSixteenBits(double value) {
     return std::fmod(value, 257.0) != 0.0;
+}
+
+/// `value - rounded`, exactly, where `rounded` is `value` rounded to float: what the float lost.
+/// The float is read back through a volatile: GCC 12's C++ front end, whose only mode is
+/// -fexcess-precision=fast, folds double(float(x)) to x in vectorised code, which made this 0.
+inline glm::dvec3 lostToFloat(const glm::dvec3& value, const glm::vec3& rounded) {
+    glm::dvec3 lost;
+    for (int axis = 0; axis < 3; ++axis) {
+        const volatile float opaque = rounded[axis];
+        lost[axis] = value[axis] - static_cast<double>(opaque);
+    }
+    return lost;
 }
 
 /// Which optional attributes a reader will provide for every point.
@@ -142,7 +183,12 @@ class PointCloudBuilder {
             vertexRemap_.push_back(static_cast<std::uint32_t>(cloud_.positions.size()));
         }
         cloud_.bounds.add(p);
-        cloud_.positions.emplace_back(p - cloud_.origin);
+        const glm::dvec3 relative = p - cloud_.origin;
+        const glm::vec3 position(relative);
+        cloud_.positions.push_back(position);
+        if (keepResiduals_) {
+            cloud_.positionResiduals.emplace_back(lostToFloat(relative, position));
+        }
         if (attributes_.color) {
             cloud_.colors.push_back(point.color);
         }
@@ -161,6 +207,13 @@ class PointCloudBuilder {
     /// drops triangles that touched one.
     void addTriangle(const Triangle& t) { cloud_.triangles.push_back(t); }
 
+    /// Records, for every point, what its float position loses of the file's coordinate
+    /// (PointCloud::positionResiduals). Call before the first add().
+    void keepPositionResiduals() {
+        keepResiduals_ = true;
+        cloud_.positionResiduals.reserve(cloud_.positions.capacity());
+    }
+
     std::size_t validPoints() const { return cloud_.positions.size(); }
     std::size_t droppedPoints() const { return droppedPoints_; }
 
@@ -172,6 +225,7 @@ class PointCloudBuilder {
 
     PointAttributes attributes_;
     bool mapVertexIndices_;
+    bool keepResiduals_ = false;
     PointCloud cloud_;
     std::size_t droppedPoints_ = 0;
     // File vertex index -> kept index (kInvalidIndex when dropped); filled only for files with

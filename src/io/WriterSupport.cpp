@@ -8,10 +8,6 @@ namespace subscan {
 
 namespace {
 
-/// Without a grid of the file's own, float output may round by this fraction of the extent: a
-/// micrometre on a metre-sized object scan, whose float files are no finer.
-constexpr double kFloatErrorFraction = 1e-6;
-
 /// How far rounding a coordinate of this magnitude to float moves it at most: half a step.
 double floatRounding(double magnitude) {
     const auto value = static_cast<float>(magnitude);
@@ -33,11 +29,14 @@ bool needsDoubleCoordinates(const PointCloud& cloud) {
     const double written = floatRounding(largestComponent(cloud.bounds.min, cloud.bounds.max));
     const glm::dvec3 extent = cloud.bounds.extent();
     const double size = std::max({extent.x, extent.y, extent.z});
-    const double inMemory = floatRounding(
-        largestComponent(cloud.bounds.min - cloud.origin, cloud.bounds.max - cloud.origin));
+    // Residuals give back what the floats relative to the centre lost; without them, what
+    // memory already lost cannot be kept by doubles either.
+    const double inMemory = cloud.hasPositionResiduals()
+                                ? 0.0
+                                : floatRounding(largestComponent(cloud.bounds.min - cloud.origin,
+                                                                 cloud.bounds.max - cloud.origin));
     // On a file's grid, less than half a step still rounds back to the stored integer; doubles
-    // from the file are kept as far as memory kept them; what memory already lost (floats
-    // relative to the centre) cannot be kept by doubles either.
+    // from the file are kept as far as memory kept them.
     const double allowed =
         cloud.coordinateStep > 0.0 ? std::max(0.5 * cloud.coordinateStep, inMemory)
         : cloud.doubleCoordinates  ? inMemory

@@ -12,7 +12,8 @@
 namespace subscan {
 
 /// Whether float would round the cloud's file coordinates by more than the data's own
-/// resolution, but no less than memory keeps (floats relative to the centre): half a step of
+/// resolution, but no less than memory keeps (floats relative to the centre, unless
+/// PointCloud::positionResiduals give back what they lost): half a step of
 /// the file's grid (PointCloud::coordinateStep: a LAS scale, a text's decimals); nothing where
 /// the file held doubles; else, for floats, a millionth of the extent. UTM coordinates, where a
 /// float step is half a metre, are so; the writers of formats that can choose (PLY, PCD) then

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -37,6 +38,68 @@ TEST(PointCloudTest, RecentresOnBoundsAndKeepsUtmPrecision) {
     EXPECT_NEAR(cloud.fileCoordinates(0).x, 500000.001, 4e-6);
     EXPECT_NEAR(cloud.fileCoordinates(1).y, 5400050.004, 4e-6);
     EXPECT_NEAR(cloud.fileCoordinates(2).z, 11.0, 4e-6);
+}
+
+TEST(PointCloudTest, ResidualsGiveBackTheFilesCoordinatesAndLeaveThePositionsAlone) {
+    // 200 km of millimetres far from the origin: floats relative to the centre round by up to
+    // 4 mm (and the first point's origin, then the centre, round twice). With residuals the file
+    // coordinates come back to far less than the millimetre grid's half step; the positions the
+    // renderer draws are bit for bit those of a builder that keeps none.
+    std::mt19937 random(7);
+    std::uniform_int_distribution<int> millimetres(0, 200'000'000);
+    std::vector<glm::dvec3> points;
+    for (int i = 0; i < 1000; ++i) {
+        points.emplace_back(400000.0 + 0.001 * millimetres(random),
+                            5000000.0 + 0.001 * millimetres(random), 0.001 * (i % 977));
+    }
+    PointCloudBuilder plain({}, points.size());
+    PointCloudBuilder exact({}, points.size());
+    exact.keepPositionResiduals();
+    for (const glm::dvec3& p : points) {
+        plain.add(at(p.x, p.y, p.z));
+        exact.add(at(p.x, p.y, p.z));
+    }
+    std::vector<std::string> warnings;
+    const PointCloud floats = plain.finish(warnings);
+    PointCloud cloud = exact.finish(warnings);
+    EXPECT_EQ(cloud.positions, floats.positions);
+    EXPECT_EQ(cloud.origin, floats.origin);
+    ASSERT_EQ(cloud.positionResiduals.size(), points.size());
+    double floatError = 0.0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        for (int axis = 0; axis < 3; ++axis) {
+            // Double sums of values about 5e6 round by 1e-9; the residual's float is finer.
+            EXPECT_NEAR(cloud.fileCoordinates(i)[axis], points[i][axis], 1e-8);
+            floatError =
+                std::max(floatError, std::abs(floats.fileCoordinates(i)[axis] - points[i][axis]));
+        }
+    }
+    EXPECT_GT(floatError, 0.0005);  // what the residuals are for
+    // A millimetre grid needs them at this extent; so do doubles on no grid (a micrometre).
+    cloud.coordinateStep = 0.001;
+    keepResidualsWhereNeeded(cloud);
+    EXPECT_TRUE(cloud.hasPositionResiduals());
+    // A grid of 10 m is kept by the floats alone: no memory is spent on residuals.
+    cloud.coordinateStep = 10.0;
+    keepResidualsWhereNeeded(cloud);
+    EXPECT_FALSE(cloud.hasPositionResiduals());
+    EXPECT_EQ(cloud.positionResiduals.capacity(), 0u);
+}
+
+TEST(PointCloudTest, ResidualsOfASmallScanAreDropped) {
+    // A 2 m object scan of doubles: floats relative to the centre keep 0.1 micrometre, finer
+    // than kDoubleCoordinateTolerance, so the cloud keeps no residuals.
+    PointCloudBuilder builder({}, 3);
+    builder.keepPositionResiduals();
+    builder.add(at(0.123456789, 1.0, -1.0));
+    builder.add(at(2.0, 0.333333333333, 0.0));
+    builder.add(at(1.0, 0.5, 0.7777777777));
+    std::vector<std::string> warnings;
+    PointCloud cloud = builder.finish(warnings);
+    cloud.doubleCoordinates = true;
+    ASSERT_TRUE(cloud.hasPositionResiduals());
+    keepResidualsWhereNeeded(cloud);
+    EXPECT_FALSE(cloud.hasPositionResiduals());
 }
 
 TEST(PointCloudTest, DropsNonFinitePointsWithTheirAttributes) {
