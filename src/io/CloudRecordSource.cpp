@@ -10,7 +10,8 @@
 #include "io/ScanLoader.h"
 
 // Inputs read whole (ASCII PLY, PCD, E57, OFF, synthetic:NAME) as records: the cloud's
-// positions are its origin plus float offsets, quantized like writeLas quantizes them; colour,
+// positions are its file coordinates (origin, float offsets and their residuals where kept),
+// quantized like writeLas quantizes them; colour,
 // normals, intensity and classification are kept.
 namespace subscan {
 
@@ -19,7 +20,8 @@ namespace {
 class CloudRecordSource final : public ConvertedRecordSource {
   public:
     explicit CloudRecordSource(const std::string& source) {
-        LoadedScan scan = loadScan(source);
+        // Records are quantized from the file's coordinates, not from the floats drawn.
+        LoadedScan scan = loadScan(source, {}, /*keepFilePrecision=*/true);
         std::vector<std::string> warnings;
         for (const std::string& warning : scan.warnings) {
             warnings.push_back(fmt::format("{}: {}", source, warning));

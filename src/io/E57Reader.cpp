@@ -1097,6 +1097,9 @@ PointCloud readE57(std::span<const std::byte> file, ReadContext& context) {
     // Never reserve beyond what the file could hold: a lying recordCount must not allocate.
     const std::uint64_t reserve = std::min<std::uint64_t>(totalRecords, file.size());
     PointCloudBuilder builder(attributes, static_cast<std::size_t>(reserve));
+    if (context.keepFilePrecision) {
+        builder.keepPositionResiduals();
+    }
     RecordSink sink{builder, context, totalRecords};
     for (const ScanLayout& scan : scans) {
         decodeScan(paged, scan, sink);

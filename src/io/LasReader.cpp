@@ -520,6 +520,9 @@ PointCloud lasRecordsToCloud(std::span<const std::byte> head, const LasHeader& h
     attributes.intensity = true;
     attributes.classification = true;
     PointCloudBuilder builder(attributes, count);
+    if (context.keepFilePrecision) {
+        builder.keepPositionResiduals();
+    }
     switch (depth) {
         case ColorDepth::None:
             decodePoints<ColorDepth::None>(points, count, header, 0, normal, builder, context);

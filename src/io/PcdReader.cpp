@@ -610,7 +610,8 @@ class ChannelColors {
 /// Turns decoded field values into points for the builder.
 class PointSink {
   public:
-    PointSink(const PcdHeader& header, const FieldLayout& layout, std::size_t expectedPoints)
+    PointSink(const PcdHeader& header, const FieldLayout& layout, std::size_t expectedPoints,
+              bool keepFilePrecision)
         : layout_(layout),
           builder_(PointAttributes{layout.packedColor || layout.colorChannels,
                                    layout.normal.has_value(), layout.intensity.has_value()},
@@ -618,6 +619,9 @@ class PointSink {
           organised_(header.height > 1) {
         if (layout.colorChannels) {
             channelColors_.emplace(header, layout);
+        }
+        if (keepFilePrecision) {
+            builder_.keepPositionResiduals();
         }
     }
 
@@ -932,7 +936,8 @@ PointCloud readPcd(std::span<const std::byte> file, ReadContext& context) {
         expectedPoints =
             std::min(expectedPoints, kMaxLzfExpansion * body.size() / header.stride + 1);
     }
-    PointSink sink(header, layout, static_cast<std::size_t>(expectedPoints));
+    PointSink sink(header, layout, static_cast<std::size_t>(expectedPoints),
+                   context.keepFilePrecision);
     switch (header.dataKind) {
         case PcdDataKind::Ascii:
             readAscii(text.substr(header.bodyOffset), header, layout, sink, context);

@@ -626,6 +626,9 @@ PointCloud PlyBodyReader::read() {
     attributes.normal = layout.normal.has_value();
     attributes.intensity = layout.intensity.has_value();
     PointCloudBuilder builder(attributes, expected, face != nullptr);
+    if (context_.keepFilePrecision) {
+        builder.keepPositionResiduals();
+    }
 
     const auto colorType = [&](std::size_t index) { return vertex->properties[index].type; };
     const std::vector<std::size_t> colorChannels = layout.colorChannels();

@@ -24,6 +24,9 @@ struct ReadContext {
     OrganisedGrid grid;
     /// Threads for readers that decode independent blocks (LAZ chunks); 0: one per core.
     unsigned decodeThreads = 0;
+    /// Whether the cloud should give back the file's coordinates to the file's own precision
+    /// (PointCloud::positionResiduals, where floats lose it): for writing them, not for drawing.
+    bool keepFilePrecision = false;
 
     void reportProgress(std::size_t done, std::size_t total) const {
         if (progress && total > 0) {

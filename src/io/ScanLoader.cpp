@@ -131,12 +131,13 @@ void ignoreZeroNormals(PointCloud& cloud, std::vector<std::string>& warnings) {
 }
 
 LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
-                      const std::function<void(double)>& progress) {
+                      const std::function<void(double)>& progress, bool keepFilePrecision) {
     if (file.empty()) {
         throw Error("the file is empty");
     }
     ReadContext context;
     context.progress = progress;
+    context.keepFilePrecision = keepFilePrecision;
     LoadedScan scan;
     switch (format) {
         case ScanFormat::Ply:
@@ -169,6 +170,7 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
                 "of coordinates");
     }
     ignoreZeroNormals(scan.cloud, context.warnings);
+    keepResidualsWhereNeeded(scan.cloud);
     scan.formatDetail = std::move(context.formatDetail);
     scan.warnings = std::move(context.warnings);
     scan.sensor = std::move(context.sensor);
@@ -176,7 +178,8 @@ LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
     return scan;
 }
 
-LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress) {
+LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress,
+                    bool keepFilePrecision) {
     const auto start = std::chrono::steady_clock::now();
     LoadedScan scan;
     if (const std::filesystem::path path{std::string(source)};
@@ -222,7 +225,8 @@ LoadedScan loadScan(std::string_view source, const std::function<void(double)>& 
                 "the file became shorter while it was read (another program "
                 "truncated or rewrote it); read it again once it is complete");
             try {
-                scan = decodeScan(mapped.bytes(), detectFormat(mapped.bytes(), path), progress);
+                scan = decodeScan(mapped.bytes(), detectFormat(mapped.bytes(), path), progress,
+                                  keepFilePrecision);
             } catch (const Error&) {
                 if (mapped.shrank()) {
                     throw shrank;

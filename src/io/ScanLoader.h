@@ -38,7 +38,11 @@ struct LoadedScan {
 /// (see makeSyntheticScene).
 /// Throws subscan::Error with one sentence that names the source and the problem.
 /// `progress` (may be empty) receives the fraction done while a file is decoded.
-LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress = {});
+/// `keepFilePrecision`: the cloud gives back the file's coordinates to the file's own precision
+/// where floats would lose it (PointCloud::positionResiduals), as writers of files need; the
+/// float positions, what the renderer draws, are the same either way.
+LoadedScan loadScan(std::string_view source, const std::function<void(double)>& progress = {},
+                    bool keepFilePrecision = false);
 
 /// Some exporters fill the normal fields with zeros: no direction at all, which would shade the
 /// whole surface flat. Such normals count as absent (they are estimated as for a file without
@@ -48,6 +52,7 @@ void ignoreZeroNormals(PointCloud& cloud, std::vector<std::string>& warnings);
 /// Decodes an in-memory file of a known format; what loadScan does after mapping the file.
 /// Errors are not prefixed with a file name.
 LoadedScan decodeScan(std::span<const std::byte> file, ScanFormat format,
-                      const std::function<void(double)>& progress = {});
+                      const std::function<void(double)>& progress = {},
+                      bool keepFilePrecision = false);
 
 }  // namespace subscan

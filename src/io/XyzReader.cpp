@@ -1084,6 +1084,9 @@ PointCloud readPoints(std::string_view text, PointTextReader& reader, ReadContex
     attributes.normal = layout.normal.has_value();
     attributes.intensity = layout.intensity.has_value();
     PointCloudBuilder builder(attributes, reader.expectedPoints(text.size() - reader.dataOffset()));
+    if (context.keepFilePrecision) {
+        builder.keepPositionResiduals();
+    }
     std::uint64_t pointLines = 0;
     // Whether a kept point's 16-bit colour is no 8-bit value times 257, which 8 bits lose.
     bool wordColorBeyondBytes = false;

@@ -2,10 +2,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
+#include <memory>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -16,8 +20,10 @@
 #include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "io/PointRecordSource.h"
 #include "io/ScanLoader.h"
 #include "support/TestSupport.h"
 
@@ -252,6 +258,240 @@ TEST(ConvertCommandTest, TextOfMillimetresKeepsThemInPlyAndPcd) {
         // Floats relative to the centre, 9 km at most, round by 0.49 mm when the text is read
         // and again when the output is.
         test::expectPositionsNear(loadScan(output.string()).cloud, test::cloudOf(positions), 1e-3);
+    }
+}
+
+/// A LAS 1.2 file of point format 0 on a millimetre grid (scale 0.001) about UTM-like offsets,
+/// with its stored integers, built here byte by byte from the LAS 1.2 specification.
+struct MillimetreSurvey {
+    std::string bytes;
+    std::vector<std::array<std::int32_t, 3>> stored;
+    glm::dvec3 offset{412345.0, 5123456.0, 100.0};
+    static constexpr double kScale = 0.001;
+
+    glm::dvec3 fileCoordinates(std::size_t i) const {
+        return {stored[i][0] * kScale + offset.x, stored[i][1] * kScale + offset.y,
+                stored[i][2] * kScale + offset.z};
+    }
+};
+
+/// `count` points spanning `spanMetres` in x and y (the first two at opposite corners) and 500 m
+/// in z, each coordinate a pseudo-random whole number of millimetres.
+MillimetreSurvey millimetreSurvey(std::size_t count, double spanMetres) {
+    MillimetreSurvey survey;
+    const auto span = static_cast<std::int32_t>(spanMetres / MillimetreSurvey::kScale);
+    std::uint64_t state = 0x9E3779B97F4A7C15u;
+    const auto next = [&](std::int32_t bound) {
+        state = state * 6364136223846793005u + 1442695040888963407u;
+        return static_cast<std::int32_t>((state >> 33) % static_cast<std::uint64_t>(bound));
+    };
+    survey.stored.push_back({0, 0, 0});
+    survey.stored.push_back({span, span, 500000});
+    while (survey.stored.size() < count) {
+        survey.stored.push_back({next(span), next(span), next(500000)});
+    }
+    glm::dvec3 min(std::numeric_limits<double>::infinity());
+    glm::dvec3 max(-std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < count; ++i) {
+        min = glm::min(min, survey.fileCoordinates(i));
+        max = glm::max(max, survey.fileCoordinates(i));
+    }
+    constexpr std::uint16_t kHeaderSize = 227;
+    constexpr std::uint16_t kRecordLength = 20;
+    std::string& b = survey.bytes;
+    b = "LASF";
+    b.append(4, '\0');   // file source ID, global encoding
+    b.append(16, '\0');  // project GUID
+    b += '\x01';
+    b += '\x02';
+    b.append(64, '\0');  // system identifier, generating software
+    test::appendBytes(b, std::uint16_t{1});
+    test::appendBytes(b, std::uint16_t{2026});
+    test::appendBytes(b, kHeaderSize);
+    test::appendBytes(b, std::uint32_t{kHeaderSize});  // offset to the point data
+    test::appendBytes(b, std::uint32_t{0});            // VLRs
+    b += '\0';                                         // point format 0
+    test::appendBytes(b, kRecordLength);
+    test::appendBytes(b, static_cast<std::uint32_t>(count));
+    test::appendBytes(b, static_cast<std::uint32_t>(count));  // first returns
+    b.append(16, '\0');
+    for (int axis = 0; axis < 3; ++axis) {
+        test::appendBytes(b, MillimetreSurvey::kScale);
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        test::appendBytes(b, survey.offset[axis]);
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        test::appendBytes(b, max[axis]);
+        test::appendBytes(b, min[axis]);
+    }
+    EXPECT_EQ(b.size(), kHeaderSize);
+    for (std::size_t i = 0; i < count; ++i) {
+        for (const std::int32_t value : survey.stored[i]) {
+            test::appendBytes(b, value);
+        }
+        test::appendBytes(b, static_cast<std::uint16_t>(i % 4096));  // intensity
+        test::appendBytes(b, std::uint8_t{0x09});                    // return 1 of 1
+        test::appendBytes(b, std::uint8_t{2});                       // ground
+        b.append(4, '\0');  // scan angle, user data, point source ID
+    }
+    return survey;
+}
+
+/// x, y and z of every point of a binary little-endian PLY or PCD file as subscan writes them,
+/// read by this test from the formats' descriptions (not by subscan's readers, which keep
+/// floats); `coordinateType` receives the type the header gives x.
+std::vector<glm::dvec3> readCoordinates(const std::filesystem::path& path,
+                                        std::string& coordinateType) {
+    const std::string file = test::fileBytes(path);
+    const bool ply = path.extension() == ".ply";
+    const std::string end = ply ? "end_header\n" : "DATA binary\n";
+    const std::size_t body = file.find(end);
+    if (body == std::string::npos) {
+        ADD_FAILURE() << path << " has no " << end;
+        return {};
+    }
+    std::vector<std::string> names, types;
+    std::vector<std::size_t> sizes;
+    std::size_t count = 0;
+    std::istringstream header(file.substr(0, body));
+    for (std::string line; std::getline(header, line);) {
+        std::istringstream words(line);
+        std::string keyword;
+        words >> keyword;
+        if (ply && keyword == "property") {
+            std::string type, name;
+            words >> type >> name;
+            types.push_back(type);
+            names.push_back(name);
+            sizes.push_back(type == "double" ? 8 : type == "float" || type == "uint" ? 4 : 1);
+        } else if (ply && keyword == "element") {
+            std::string element;
+            words >> element >> count;
+            if (element != "vertex") {
+                break;  // subscan writes faces after the vertices only for meshes
+            }
+        } else if (!ply && keyword == "FIELDS") {
+            for (std::string name; words >> name;) {
+                names.push_back(name);
+            }
+        } else if (!ply && keyword == "SIZE") {
+            for (std::size_t size = 0; words >> size;) {
+                sizes.push_back(size);
+            }
+        } else if (!ply && keyword == "TYPE") {
+            for (std::string type; words >> type;) {
+                types.push_back(type);
+            }
+        } else if (!ply && keyword == "POINTS") {
+            words >> count;
+        }
+    }
+    std::size_t stride = 0;
+    for (const std::size_t size : sizes) {
+        stride += size;
+    }
+    EXPECT_GE(names.size(), 3u);
+    EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 3),
+              (std::vector<std::string>{"x", "y", "z"}));
+    coordinateType = types.at(0) + " " + std::to_string(sizes.at(0));
+    EXPECT_EQ(file.size(), body + end.size() + count * stride) << path;
+    std::vector<glm::dvec3> coordinates(count);
+    const char* data = file.data() + body + end.size();
+    for (std::size_t i = 0; i < count; ++i) {
+        for (int axis = 0; axis < 3; ++axis) {
+            const char* at = data + i * stride + static_cast<std::size_t>(axis) * sizes[0];
+            if (sizes[0] == 8) {
+                std::memcpy(&coordinates[i][axis], at, 8);
+            } else {
+                float value = 0.0f;
+                std::memcpy(&value, at, 4);
+                coordinates[i][axis] = value;
+            }
+        }
+    }
+    return coordinates;
+}
+
+TEST(ConvertCommandTest, ASurveyOf200KmKeepsItsMillimetresInEveryFormat) {
+    // 200 km of millimetres: floats relative to the first point, then the centre, rounded them
+    // by up to 12 mm in memory (7.7 mm at worst here), which PLY and PCD output kept in their
+    // doubles (the outside hunt's 200 km survey). Each coordinate must come back to within half
+    // the scale's step, which gives back the stored integer.
+    const test::TempDir dir;
+    const MillimetreSurvey survey = millimetreSurvey(3000, 200000.0);
+    const auto input = dir.write("survey.las", survey.bytes);
+    const double halfStep = 0.5 * MillimetreSurvey::kScale;
+    for (const std::string name : {"survey.ply", "survey.pcd"}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / name;
+        convert(input.string(), output);
+        std::string type;
+        const std::vector<glm::dvec3> coordinates = readCoordinates(output, type);
+        ASSERT_EQ(coordinates.size(), survey.stored.size());
+        EXPECT_TRUE(type == "double 8" || type == "F 8") << type;
+        double worst = 0.0;
+        std::size_t wrong = 0;
+        for (std::size_t i = 0; i < coordinates.size(); ++i) {
+            const glm::dvec3 error = glm::abs(coordinates[i] - survey.fileCoordinates(i));
+            const double largest = std::max({error.x, error.y, error.z});
+            worst = std::max(worst, largest);
+            wrong += largest >= halfStep ? 1 : 0;
+        }
+        EXPECT_EQ(wrong, 0u) << "worst error " << worst << " m";
+    }
+    // LAS and LAZ pass the records on: the same integers on the same grid, exactly.
+    const std::unique_ptr<PointRecordSource> original = openPointRecordSource(input);
+    std::vector<std::byte> originalRecords;
+    while (original->read(originalRecords, 1024) > 0) {
+    }
+    for (const std::string name : {"survey.las", "survey.laz"}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / ("out_" + name);
+        convert(input.string(), output);
+        const std::unique_ptr<PointRecordSource> written = openPointRecordSource(output);
+        EXPECT_EQ(written->info().quantization, original->info().quantization);
+        std::vector<std::byte> records;
+        while (written->read(records, 1024) > 0) {
+        }
+        const std::size_t length = written->info().format.recordLength();
+        ASSERT_EQ(records.size(), survey.stored.size() * length);
+        for (std::size_t i = 0; i < survey.stored.size(); ++i) {
+            std::array<std::int32_t, 3> xyz{};
+            std::memcpy(xyz.data(), records.data() + i * length, sizeof xyz);
+            ASSERT_EQ(xyz, survey.stored[i]) << "point " << i;
+        }
+    }
+    EXPECT_EQ(test::fileBytes(input), survey.bytes);  // the input is never written
+}
+
+TEST(ConvertCommandTest, DoublesOf200KmComeBackAsTheyWere) {
+    // A PLY of double coordinates on no grid spanning 200 km: kept to a micrometre
+    // (kDoubleCoordinateTolerance), where the floats in memory lost millimetres.
+    const test::TempDir dir;
+    std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 500\nproperty double x\n"
+        "property double y\nproperty double z\nend_header\n";
+    std::vector<glm::dvec3> points;
+    for (int i = 0; i < 500; ++i) {
+        const double t = i / 499.0;
+        points.emplace_back(400000.0 + 200000.0 * t + 1e-4 / 3.0 * i,
+                            5000000.0 + 200000.0 * std::sqrt(t), 100.0 + std::sin(i));
+        for (int axis = 0; axis < 3; ++axis) {
+            test::appendBytes(ply, points.back()[axis]);
+        }
+    }
+    const auto input = dir.write("doubles.ply", ply);
+    for (const std::string name : {"out.ply", "out.pcd"}) {
+        SCOPED_TRACE(name);
+        convert(input.string(), dir / name);
+        std::string type;
+        const std::vector<glm::dvec3> coordinates = readCoordinates(dir / name, type);
+        ASSERT_EQ(coordinates.size(), points.size());
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            // Double sums of values about 5e6 round by 1e-9, the float residual finer still.
+            ASSERT_LT(glm::length(coordinates[i] - points[i]), 1e-8) << "point " << i;
+        }
     }
 }
 

@@ -62,12 +62,13 @@ void removeEarlierOutput(const std::filesystem::path& path, std::string_view wha
     }
 }
 
-LoadedScan loadScanForCommand(std::string_view source) {
+LoadedScan loadScanForCommand(std::string_view source, bool keepFilePrecision) {
     constexpr std::uintmax_t kProgressBarBytes = 50u << 20;
     std::error_code ignored;
     const std::uintmax_t bytes = std::filesystem::file_size(std::string(source), ignored);
     ProgressBar bar("loading", !ignored && bytes > kProgressBarBytes);
-    LoadedScan scan = loadScan(source, [&](double fraction) { bar.update(fraction); });
+    LoadedScan scan = loadScan(
+        source, [&](double fraction) { bar.update(fraction); }, keepFilePrecision);
     for (const std::string& warning : scan.warnings) {
         fmt::print(stderr, "subscan: warning: {}: {}\n", source, warning);
     }

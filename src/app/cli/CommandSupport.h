@@ -45,8 +45,9 @@ void requireOutputFolder(const std::filesystem::path& output);
 void removeEarlierOutput(const std::filesystem::path& path, std::string_view what);
 
 /// Loads a scan for a command: a progress bar on stderr for big files on a terminal, then the
-/// reader's warnings printed as "subscan: warning: ...".
-LoadedScan loadScanForCommand(std::string_view source);
+/// reader's warnings printed as "subscan: warning: ...". `keepFilePrecision` as loadScan's
+/// (commands that write the points as files).
+LoadedScan loadScanForCommand(std::string_view source, bool keepFilePrecision = false);
 
 /// A record source's warnings (io/PointRecordSource.h) as "subscan: warning: ..." lines, as
 /// loadScanForCommand prints a reader's.

@@ -212,7 +212,8 @@ int runConvert(const ConvertOptions& options) {
         return 0;
     }
     const OutputFormat& format = *outputFormat(output);  // the option's check accepted it
-    LoadedScan scan = loadScanForCommand(options.source);
+    // The file's coordinates to its own precision, not only as floats hold them.
+    LoadedScan scan = loadScanForCommand(options.source, /*keepFilePrecision=*/true);
     if (options.estimateNormals) {
         if (!format.normals) {
             throw Error(
