@@ -296,7 +296,8 @@ std::vector<double> cpuFrontSpacing(const std::vector<double>& pyramid,
 /// The CPU twin of HiddenPointRemoval.comp. Returns nullopt where a quantity lies within
 /// rounding distance of a decision boundary (the flag may then legitimately differ).
 /// `frontSpacing` (cpuFrontSpacing), with the local spacing: the walk's last level so far goes
-/// on to span two expected gaps of each occluding neighbour.
+/// on to span two expected gaps of each occluding neighbour, and x's radius at a clearly nearer
+/// one's depth.
 std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<double>& pyramid,
                                int px, int py, double spacingRatio,
                                const std::vector<double>* frontSpacing = nullptr) {
@@ -310,10 +311,9 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     constexpr double kTie = 1e-4;  // float evaluation of omega differs from double by ~1e-6
     const glm::dvec3 x = harness.viewPosition(px + 0.5, py + 0.5, depth);
     const glm::dvec3 toCamera = glm::normalize(-x);
-    const double levelValue =
-        std::clamp(std::log2(surface.visibilityRadius * kSpacing * std::min(spacingRatio, 1.0) *
-                             harness.focal() / depth),
-                   0.0, static_cast<double>(all.size() - 1));
+    const double radius = surface.visibilityRadius * kSpacing * std::min(spacingRatio, 1.0);
+    const double levelValue = std::clamp(std::log2(radius * harness.focal() / depth), 0.0,
+                                         static_cast<double>(all.size() - 1));
     if (std::abs(levelValue - std::round(levelValue)) < kTie) {
         return std::nullopt;
     }
@@ -348,11 +348,18 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
             if (askOccluders) {
                 tie = tie || std::abs(value - tau) < kTie;
                 if (value < tau) {
-                    // Two of the occluder's expected gaps, at its depth.
-                    const double occluderLevel =
-                        std::clamp(std::log2(2.0 * surface.fillRadius * kSpacing *
-                                             (*frontSpacing)[texel] * harness.focal() / d),
-                                   0.0, static_cast<double>(all.size() - 1));
+                    // Two of the occluder's expected gaps, at its depth; and x's own radius at
+                    // that depth where it reaches 0.35 levels beyond x's (a clearly nearer
+                    // surface).
+                    double occluderLevel = std::log2(2.0 * surface.fillRadius * kSpacing *
+                                                     (*frontSpacing)[texel] * harness.focal() / d);
+                    const double nearerLevel = std::log2(radius * harness.focal() / d);
+                    tie = tie || std::abs(nearerLevel - (levelValue + 0.35)) < kTie;
+                    if (nearerLevel >= levelValue + 0.35) {
+                        occluderLevel = std::max(occluderLevel, nearerLevel);
+                    }
+                    occluderLevel =
+                        std::clamp(occluderLevel, 0.0, static_cast<double>(all.size() - 1));
                     tie = tie || std::abs(occluderLevel - std::round(occluderLevel)) < kTie;
                     maxLevel = std::max(maxLevel, static_cast<int>(occluderLevel));
                 }
