@@ -70,10 +70,9 @@ bool visibleAt(ivec2 pixel, float depth) {
     }
     LevelLayout place = levelLayout(0u);
     for (uint level = 0u; level <= levels; ++level, place = nextLevel(place)) {
-        // With the local spacing, the walk's last level so far asks whether a nearer
-        // neighbour's surface is sparser than the radius spans (once per level reached: the
-        // coarsest texels hold the nearest points around).
-        bool askOccluders = localSpacing && level == levels;
+        // The walk's last level so far asks whether an occluding neighbour calls for going on
+        // (once per level reached: the coarsest texels hold the nearest points around).
+        bool askOccluders = level == levels;
         for (int k = 0; k < 8; ++k) {
             ivec2 texel = (pixel >> level) + kDirections[k];
             bool withinImage = all(greaterThanEqual(texel, ivec2(0))) &&
@@ -85,17 +84,19 @@ bool visibleAt(ivec2 pixel, float depth) {
             float value = 1.0 - dot(normalize(y - x), toCamera);
             omega[k] = withinImage && !isinf(neighbourDepth) ? min(omega[k], value) : omega[k];
             if (askOccluders && withinImage && !isinf(neighbourDepth) && value < tau) {
-                // The walk goes on until it spans two of the occluder's expected gaps.
-                uint index = texelIndex(place, texel);
-                float occluderSpacing = texelFetch(frontSpacingTexels, int(index)).r;
-                float occluderLevel =
-                    levelForRadius(2.0 * surface.fill.x * occluderSpacing, neighbourDepth);
-                // And, where the occluder is clearly nearer, until x's radius spans its gaps
-                // at its depth (kNearerOccluderLevels says why only there).
+                // Where the occluder is clearly nearer, the walk goes on until x's radius spans
+                // its gaps at its depth (kNearerOccluderLevels says why only there).
                 float nearerLevel = levelForRadius(radius, neighbourDepth);
-                occluderLevel = nearerLevel >= maxLevel + kNearerOccluderLevels
-                                    ? max(occluderLevel, nearerLevel)
-                                    : occluderLevel;
+                float occluderLevel =
+                    nearerLevel >= maxLevel + kNearerOccluderLevels ? nearerLevel : 0.0;
+                if (localSpacing) {
+                    // And until it spans two of the occluder's expected gaps.
+                    uint index = texelIndex(place, texel);
+                    float occluderSpacing = texelFetch(frontSpacingTexels, int(index)).r;
+                    occluderLevel = max(occluderLevel, levelForRadius(2.0 * surface.fill.x *
+                                                                          occluderSpacing,
+                                                                      neighbourDepth));
+                }
                 levels = max(levels, uint(clamp(occluderLevel, 0.0, float(levelCount() - 1u))));
             }
         }

@@ -115,8 +115,8 @@ inline bool colorWordNeedsSixteenBits(double value) {
 }
 
 /// `value - rounded`, exactly, where `rounded` is `value` rounded to float: what the float lost.
-/// The float is read back through a volatile: GCC 12's C++ front end, whose only mode is
-/// -fexcess-precision=fast, folds double(float(x)) to x in vectorised code, which made this 0.
+/// The float is read back through a volatile: GCC 12.2 at -O2 (x86-64, no fast-math) was seen
+/// to fold double(float(x)) back to x in a vectorised loop, which made this 0.
 inline glm::dvec3 lostToFloat(const glm::dvec3& value, const glm::vec3& rounded) {
     glm::dvec3 lost;
     for (int axis = 0; axis < 3; ++axis) {

@@ -551,7 +551,8 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
     std::vector<std::byte> storage;
     const std::span<const std::byte> records = pointRecords(file, header, context, storage);
     // Decompression already reported the progress of a LAZ file; the record pass is quick.
-    const ReadContext silent;
+    ReadContext silent;
+    silent.keepFilePrecision = context.keepFilePrecision;
     PointCloud cloud = lasRecordsToCloud(file, header, records, records,
                                          header.laszipRecord ? silent : context, context.warnings);
     context.reportProgress(1, 1);

@@ -157,8 +157,9 @@ LasScaling chooseLasScaling(const Bounds& bounds) {
 }
 
 void writeLas(const std::filesystem::path& path, const PointCloud& cloud) {
-    // The stored bounds must be those of the coordinates written (origin + float position), not
-    // the cloud's exact ones from its file, which they miss by float rounding.
+    // The stored bounds must be those of the coordinates written (fileCoordinates), not the
+    // cloud's exact ones from its file, which they miss by float rounding where no residuals
+    // are kept.
     Bounds bounds;
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         bounds.add(cloud.fileCoordinates(i));

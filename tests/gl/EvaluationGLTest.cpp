@@ -111,9 +111,10 @@ TEST(EvaluationGLTest, NormalsFollowARoundOutlineAndLeaveCreases) {
 // subsampled scan is drawn so). Seen through such a gap in the sphere's front, a point of its
 // back lay beyond the hidden point test's radius, projected at that point's depth, of the front
 // around the gap, and showed through. Measured on llvmpipe (2026-12-07), these 20,000 points:
-// 1.1 % of the covered pixels before the walk went on to the nearer occluder's depth, 0.09 %
-// after; the bound leaves room for another driver's rounding and fails at a tenth of the
-// error before.
+// with the local spacing 1.0 % of the covered pixels before the walk went on to the nearer
+// occluder's depth, 0.07 % after; with the global h alone 6.8 % before, 0.01 % after. The
+// bound leaves room for another driver's rounding and fails at well under half the error
+// before.
 TEST(EvaluationGLTest, ARandomlySampledSphereHidesItsBack) {
     std::mt19937 random(7);
     std::normal_distribution<double> normal;
@@ -127,12 +128,17 @@ TEST(EvaluationGLTest, ARandomlySampledSphereHidesItsBack) {
     settings.views = 4;
     settings.width = 256;
     settings.height = 256;
-    const EvaluationReport report = evaluate(test::glTestContext(), *makeBuiltInScene("sphere"),
-                                             points, settings, RenderSettings{});
-    std::printf("occlusion errors %.4f, coverage %.4f\n", report.surface.occlusionErrorRate,
-                report.surface.coverage);
-    EXPECT_LT(report.surface.occlusionErrorRate, 0.004);
-    EXPECT_GT(report.surface.coverage, 0.99);  // measured 0.996: hiding the back, not the front
+    for (const bool localSpacing : {true, false}) {
+        RenderSettings render;
+        render.surface.localSpacing = localSpacing;
+        const EvaluationReport report =
+            evaluate(test::glTestContext(), *makeBuiltInScene("sphere"), points, settings, render);
+        std::printf("local spacing %d: occlusion errors %.4f, coverage %.4f\n", localSpacing,
+                    report.surface.occlusionErrorRate, report.surface.coverage);
+        EXPECT_LT(report.surface.occlusionErrorRate, 0.004) << localSpacing;
+        // Measured 0.996 both: hiding the back, not the front.
+        EXPECT_GT(report.surface.coverage, 0.99) << localSpacing;
+    }
 }
 
 /// The median distance from a point to its nearest other point, by brute force: the spacing h

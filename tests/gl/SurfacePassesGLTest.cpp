@@ -293,11 +293,14 @@ std::vector<double> cpuFrontSpacing(const std::vector<double>& pyramid,
     return spacing;
 }
 
+/// HiddenPointRemoval.comp's kNearerOccluderLevels.
+constexpr double kNearerOccluderLevels = 0.35;
+
 /// The CPU twin of HiddenPointRemoval.comp. Returns nullopt where a quantity lies within
 /// rounding distance of a decision boundary (the flag may then legitimately differ).
-/// `frontSpacing` (cpuFrontSpacing), with the local spacing: the walk's last level so far goes
-/// on to span two expected gaps of each occluding neighbour, and x's radius at a clearly nearer
-/// one's depth.
+/// The walk's last level so far goes on to span x's radius at a clearly nearer occluding
+/// neighbour's depth and, with the local spacing (`frontSpacing`, cpuFrontSpacing), two expected
+/// gaps of each occluding neighbour.
 std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<double>& pyramid,
                                int px, int py, double spacingRatio,
                                const std::vector<double>* frontSpacing = nullptr) {
@@ -327,7 +330,7 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     bool tie = false;
     for (int l = 0; l <= maxLevel; ++l) {
         const Level& level = all[l];
-        const bool askOccluders = frontSpacing && l == maxLevel;
+        const bool askOccluders = l == maxLevel;
         for (int k = 0; k < 8; ++k) {
             const int qx = (px >> l) + directions[k][0], qy = (py >> l) + directions[k][1];
             // The walk sees only texels wholly inside the image (odd sizes: not the last one).
@@ -348,19 +351,24 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
             if (askOccluders) {
                 tie = tie || std::abs(value - tau) < kTie;
                 if (value < tau) {
-                    // Two of the occluder's expected gaps, at its depth; and x's own radius at
-                    // that depth where it reaches 0.35 levels beyond x's (a clearly nearer
-                    // surface).
-                    double occluderLevel = std::log2(2.0 * surface.fillRadius * kSpacing *
-                                                     (*frontSpacing)[texel] * harness.focal() / d);
+                    // x's own radius at the occluder's depth where it reaches
+                    // kNearerOccluderLevels beyond x's (a clearly nearer surface); with the
+                    // local spacing, two of the occluder's expected gaps at its depth too.
                     const double nearerLevel = std::log2(radius * harness.focal() / d);
-                    tie = tie || std::abs(nearerLevel - (levelValue + 0.35)) < kTie;
-                    if (nearerLevel >= levelValue + 0.35) {
-                        occluderLevel = std::max(occluderLevel, nearerLevel);
+                    tie =
+                        tie || std::abs(nearerLevel - (levelValue + kNearerOccluderLevels)) < kTie;
+                    double occluderLevel =
+                        nearerLevel >= levelValue + kNearerOccluderLevels ? nearerLevel : 0.0;
+                    if (frontSpacing) {
+                        occluderLevel = std::max(
+                            occluderLevel, std::log2(2.0 * surface.fillRadius * kSpacing *
+                                                     (*frontSpacing)[texel] * harness.focal() / d));
                     }
                     occluderLevel =
                         std::clamp(occluderLevel, 0.0, static_cast<double>(all.size() - 1));
-                    tie = tie || std::abs(occluderLevel - std::round(occluderLevel)) < kTie;
+                    // Rounding matters only where it could raise the last level.
+                    tie = tie || (std::abs(occluderLevel - std::round(occluderLevel)) < kTie &&
+                                  std::round(occluderLevel) > maxLevel);
                     maxLevel = std::max(maxLevel, static_cast<int>(occluderLevel));
                 }
             }

@@ -422,24 +422,6 @@ TEST(ConvertCommandTest, ASurveyOf200KmKeepsItsMillimetresInEveryFormat) {
     const MillimetreSurvey survey = millimetreSurvey(3000, 200000.0);
     const auto input = dir.write("survey.las", survey.bytes);
     const double halfStep = 0.5 * MillimetreSurvey::kScale;
-    for (const std::string name : {"survey.ply", "survey.pcd"}) {
-        SCOPED_TRACE(name);
-        const auto output = dir / name;
-        convert(input.string(), output);
-        std::string type;
-        const std::vector<glm::dvec3> coordinates = readCoordinates(output, type);
-        ASSERT_EQ(coordinates.size(), survey.stored.size());
-        EXPECT_TRUE(type == "double 8" || type == "F 8") << type;
-        double worst = 0.0;
-        std::size_t wrong = 0;
-        for (std::size_t i = 0; i < coordinates.size(); ++i) {
-            const glm::dvec3 error = glm::abs(coordinates[i] - survey.fileCoordinates(i));
-            const double largest = std::max({error.x, error.y, error.z});
-            worst = std::max(worst, largest);
-            wrong += largest >= halfStep ? 1 : 0;
-        }
-        EXPECT_EQ(wrong, 0u) << "worst error " << worst << " m";
-    }
     // LAS and LAZ pass the records on: the same integers on the same grid, exactly.
     const std::unique_ptr<PointRecordSource> original = openPointRecordSource(input);
     std::vector<std::byte> originalRecords;
@@ -461,6 +443,27 @@ TEST(ConvertCommandTest, ASurveyOf200KmKeepsItsMillimetresInEveryFormat) {
             std::memcpy(xyz.data(), records.data() + i * length, sizeof xyz);
             ASSERT_EQ(xyz, survey.stored[i]) << "point " << i;
         }
+    }
+    // From the LAS and from the LAZ just written (its reader decompresses first).
+    for (const auto& [from, name] : {std::pair{input, "survey.ply"}, std::pair{input, "survey.pcd"},
+                                     std::pair{dir / "out_survey.laz", "from_laz.ply"},
+                                     std::pair{dir / "out_survey.laz", "from_laz.pcd"}}) {
+        SCOPED_TRACE(name);
+        const auto output = dir / name;
+        convert(from.string(), output);
+        std::string type;
+        const std::vector<glm::dvec3> coordinates = readCoordinates(output, type);
+        ASSERT_EQ(coordinates.size(), survey.stored.size());
+        EXPECT_TRUE(type == "double 8" || type == "F 8") << type;
+        double worst = 0.0;
+        std::size_t wrong = 0;
+        for (std::size_t i = 0; i < coordinates.size(); ++i) {
+            const glm::dvec3 error = glm::abs(coordinates[i] - survey.fileCoordinates(i));
+            const double largest = std::max({error.x, error.y, error.z});
+            worst = std::max(worst, largest);
+            wrong += largest >= halfStep ? 1 : 0;
+        }
+        EXPECT_EQ(wrong, 0u) << "worst error " << worst << " m";
     }
     EXPECT_EQ(test::fileBytes(input), survey.bytes);  // the input is never written
 }

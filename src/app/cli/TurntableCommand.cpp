@@ -339,7 +339,8 @@ std::optional<std::vector<std::filesystem::path>> leftStagingFolder(
 }
 
 /// Removes the staging folders in `folder` that killed turntables left there (a later export
-/// into the folder refused them as someone else's files), and says so; anything else stays.
+/// into the folder refused them as someone else's files), and says so; anything else, and what
+/// cannot be removed, stays.
 void removeLeftStagingFolders(const std::filesystem::path& folder, std::string_view prefix,
                               Staged staged, const FrameOptions& frame) {
     std::vector<std::filesystem::path> entries;
@@ -353,10 +354,22 @@ void removeLeftStagingFolders(const std::filesystem::path& folder, std::string_v
         if (!left) {
             continue;
         }
+        // A folder that cannot be removed (another user's, in a shared folder) stays: it is in
+        // no one's way but an export into this folder, which then refuses it and says why.
+        std::error_code failed;
         for (const std::filesystem::path& item : *left) {
-            removeEarlierOutput(item, "what a killed turntable left");
+            if (std::filesystem::remove(item, failed); failed) {
+                fmt::print(stderr,
+                           "subscan: warning: {}: cannot remove what a killed turntable left "
+                           "({}); it stays\n",
+                           item.string(), failed.message());
+                break;
+            }
         }
-        fmt::print(stderr, "subscan: removed {}, which a killed turntable left\n", path.string());
+        if (!failed) {
+            fmt::print(stderr, "subscan: removed {}, which a killed turntable left\n",
+                       path.string());
+        }
     }
 }
 
