@@ -1,6 +1,7 @@
 // `subscan turntable`: numbered PNGs or an MP4 through the temporal filter, the first frame
 // already converged, the yaw growing by degrees / frames, per-frame buffers, and refusals.
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -254,6 +255,41 @@ TEST(TurntableCommandGLTest, ALaterTurntableRemovesTheStagingFoldersOfAKilledOne
     EXPECT_EQ(test::fileBytes(notes), "mine");
     EXPECT_EQ(test::folderEntries(lookalike), std::vector<std::string>{"0000.png"});
     EXPECT_EQ(test::folderEntries(running), std::vector<std::string>{"0000.png"});
+}
+
+/// The PID of a process that has ended (another gets it only once the kernel's PIDs wrap).
+pid_t endedProcessId() {
+    const pid_t child = ::fork();
+    if (child == 0) {
+        ::_exit(0);
+    }
+    ::waitpid(child, nullptr, 0);
+    return child;
+}
+
+TEST(TurntableCommandGLTest, AKilledTurntablesPartialFramesGoButAnInputStays) {
+    // Killed while writing, a turntable leaves a frame half written (.NAME.xxxxxxxx.tmp) beside
+    // its finished ones: still its own. A staging folder that holds the scan being rendered (a
+    // PLY under a frame's name) is never removed.
+    const test::TempDir dir;
+    const auto frames = dir / "frames";
+    const auto killed = frames / fmt::format(".frames-{}", endedProcessId());
+    const auto holdingInput = frames / fmt::format(".frames-{}", endedProcessId());
+    std::filesystem::create_directories(killed);
+    std::filesystem::create_directories(holdingInput);
+    dir.write("frames/" + killed.filename().string() + "/0000.png", "a frame");
+    dir.write("frames/" + killed.filename().string() + "/.0001.png.0123abcd.tmp", "half");
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    const auto input = dir.write("frames/" + holdingInput.filename().string() + "/0000.png", ply);
+    const auto later = runSubscan({"turntable", input.string(), "-o", frames.string(), "--frames",
+                                   "2", "--warmup", "1", "--width", "40", "--height", "32"});
+    ASSERT_EQ(later.exitCode, 0) << later.err;
+    EXPECT_FALSE(std::filesystem::exists(killed));
+    EXPECT_THAT(later.err, HasSubstr("subscan: removed " + killed.string()));
+    EXPECT_EQ(test::fileBytes(input), ply);
+    EXPECT_THAT(later.err, ::testing::Not(HasSubstr(holdingInput.string())));
 }
 
 TEST(TurntableCommandGLTest, AFolderHoldsThisSequenceAlone) {
