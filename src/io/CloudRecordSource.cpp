@@ -74,6 +74,13 @@ class CloudRecordSource final : public ConvertedRecordSource {
         if (!fitIntensityWords(cloud_.intensities)) {
             warnings.push_back(intensitiesNotKept(source));
         }
+        // The cloud holds 8-bit colour; records of an input loaded whole can carry no more.
+        if (cloud_.colorCutTo8Bits) {
+            warnings.push_back(fmt::format(
+                "{}: colour of more than 8 bits a channel is cut to 8 bits (the input is loaded "
+                "whole, as 8-bit colour)",
+                source));
+        }
         startRecords(source, cloud_.size(), cloud_.hasColors(), cloud_.hasNormals(), bounds,
                      cloud_.coordinateStep, std::move(warnings));
     }

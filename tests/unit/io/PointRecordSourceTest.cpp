@@ -634,6 +634,31 @@ TEST(PointRecordSourceTest, IntensitiesLasCannotHoldAreNamed) {
               1);
 }
 
+TEST(PointRecordSourceTest, ColourCutTo8BitsByALoadedWholeInputIsNamed) {
+    // An ascii PLY (like a PCD or an E57 file) is loaded whole, as 8-bit colour: its 16-bit
+    // colour reached COPC cut to 8 bits without a word, where convert names the cut.
+    const test::TempDir dir;
+    auto cutWarnings = [](const PointRecordSource& source) {
+        int count = 0;
+        for (const std::string& warning : source.info().warnings) {
+            count += warning.find("colour of more than 8 bits a channel is cut to 8 bits") !=
+                     std::string::npos;
+        }
+        return count;
+    };
+    const std::string header =
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nproperty ushort red\nproperty ushort green\nproperty ushort blue\n"
+        "end_header\n";
+    EXPECT_EQ(cutWarnings(*open(dir.write("deep.ply", header + "0 0 0 1000 2000 65535\n"
+                                                               "1 0 0 300 40000 7\n"))),
+              1);
+    // 8-bit values times 257, as LAS writers store 8-bit colour: nothing is cut.
+    EXPECT_EQ(cutWarnings(*open(dir.write("bytes.ply", header + "0 0 0 257 514 65535\n"
+                                                                "1 0 0 0 2570 771\n"))),
+              0);
+}
+
 /// A binary PLY of float x y z and colour channels of `type`, one vertex per colour.
 template <class Channel>
 std::string binaryColorPly(const char* type, const std::vector<std::array<Channel, 3>>& colors) {
