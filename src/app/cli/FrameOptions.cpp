@@ -78,15 +78,14 @@ void FrameOptions::add(CLI::App& command, RenderMode modeByDefault) {
                                "--view", "--sensor"}) {
         camera->excludes(command.get_option(placed));
     }
-    // A bad colour is a usage error, refused while parsing with the option's name.
+    // A bad colour is a usage error, refused while parsing with the option's name (cli::, not
+    // the member parsedBy).
     command.add_option("--background", background, "R,G,B (sRGB 0..1) or #rrggbb")
-        ->check(CLI::Validator(
-            [](std::string& text) {
-                return parseBackground(text)
-                           ? std::string()
-                           : fmt::format("'{}' is not R,G,B with values in 0..1 or #rrggbb", text);
-            },
-            ""));
+        ->check(cli::parsedBy([](const std::string& text) {
+            if (!parseBackground(text)) {
+                throw Error(fmt::format("'{}' is not R,G,B with values in 0..1 or #rrggbb", text));
+            }
+        }));
     command.add_option("--raster", raster, "Compute rasterizer: auto | int64 | two-pass")
         ->check(CLI::IsMember({"auto", "int64", "two-pass"}));
     addResolutionOption(command, resolution);
