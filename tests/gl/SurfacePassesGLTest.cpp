@@ -293,17 +293,23 @@ std::vector<double> cpuFrontSpacing(const std::vector<double>& pyramid,
     return spacing;
 }
 
-/// HiddenPointRemoval.comp's kNearerOccluderLevels.
+/// HiddenPointRemoval.comp's kNearerOccluderLevels, kNearSurfaceProbeLevels and
+/// kNearSurfaceLevels.
 constexpr double kNearerOccluderLevels = 0.35;
+constexpr int kNearSurfaceProbeLevels = 2;
+constexpr double kNearSurfaceLevels = 2.0;
 
 /// The CPU twin of HiddenPointRemoval.comp. Returns nullopt where a quantity lies within
 /// rounding distance of a decision boundary (the flag may then legitimately differ).
 /// The walk's last level so far goes on to span x's radius at a clearly nearer occluding
 /// neighbour's depth and, with the local spacing (`frontSpacing`, cpuFrontSpacing), two expected
-/// gaps of each occluding neighbour.
+/// gaps of each occluding neighbour. With `nearSurfaceProbe`, the walk first reaches as far as
+/// x's radius spans at the nearest depth of the 3x3 texels kNearSurfaceProbeLevels above its
+/// last level, where that lies kNearSurfaceLevels beyond (a surface far in front).
 std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<double>& pyramid,
                                int px, int py, double spacingRatio,
-                               const std::vector<double>* frontSpacing = nullptr) {
+                               const std::vector<double>* frontSpacing = nullptr,
+                               bool nearSurfaceProbe = true) {
     const auto all = levels();
     const double depth = pyramid[py * kWidth + px];
     if (std::isinf(depth)) {
@@ -321,13 +327,37 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
         return std::nullopt;
     }
     int maxLevel = static_cast<int>(levelValue);
+    const int topLevel = static_cast<int>(all.size()) - 1;
+    bool tie = false;
+    if (nearSurfaceProbe) {
+        const int probe = std::min(maxLevel + kNearSurfaceProbeLevels, topLevel);
+        const Level& level = all[probe];
+        double nearest = kInf;
+        for (int dy = -1; dy <= 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int qx = std::clamp((px >> probe) + dx, 0, level.width - 1);
+                const int qy = std::clamp((py >> probe) + dy, 0, level.height - 1);
+                nearest = std::min(nearest, pyramid[level.offset + qy * level.width + qx]);
+            }
+        }
+        if (!std::isinf(nearest)) {
+            const double nearLevel = std::log2(radius * harness.focal() / nearest);
+            // Rounding matters only where it could decide or raise the last level.
+            tie = std::abs(nearLevel - (levelValue + kNearSurfaceLevels)) < kTie ||
+                  (std::abs(nearLevel - std::round(nearLevel)) < kTie &&
+                   std::round(nearLevel) > maxLevel);
+            if (nearLevel >= levelValue + kNearSurfaceLevels) {
+                maxLevel =
+                    std::max(maxLevel, static_cast<int>(std::min(nearLevel, 1.0 * topLevel)));
+            }
+        }
+    }
     const int directions[8][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1},
                                   {-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
     std::array<double, 8> omega{};
     std::array<bool, 8> found{};
     std::array<int, 8> seen{};
     omega.fill(1.0);
-    bool tie = false;
     for (int l = 0; l <= maxLevel; ++l) {
         const Level& level = all[l];
         const bool askOccluders = l == maxLevel;
@@ -442,6 +472,56 @@ TEST_P(SurfacePassesSpacingGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
     EXPECT_LT(ties, 5);      // ties are rare; many would mean the test checks little
     EXPECT_GT(visible, 50);  // both outcomes occur in this frame
     EXPECT_GT(hidden, 20);
+}
+
+/// A close-up: the eye so near a scan's flank that its points lie several pixels apart, a dense
+/// surface far behind. Points of the far surface between the near points see none of them on
+/// their own walk (its radius at their depth spans a few pixels); the walk must reach out to
+/// the near surface's gaps, or the far surface shows through between the near points.
+TEST(SurfacePassesGLTest, HiddenPointRemovalReachesASparseSurfaceFarInFront) {
+    PassHarness harness = makeHarness();
+    // Far: every pixel at depth 20 (x's radius there spans log2(2.4 * 24.7 / 20) = 1.6
+    // levels). Near: every 12th pixel each way, on the left at depth 4 (5 times nearer: 2.3
+    // levels beyond), on the right at 6.7 (3 times nearer: 1.6 levels, not far enough in front).
+    std::vector<float> depth(kWidth * kHeight), color(kWidth * kHeight * 4, 0.5f);
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const bool near = x % 12 == 3 && y % 12 == 3;
+            const float nearDepth = x < kWidth / 2 ? 4.0f : 6.7f;
+            depth[y * kWidth + x] = near ? nearDepth : 20.0f + 0.01f * static_cast<float>(x);
+            color[4 * (y * kWidth + x) + 3] = 1.0f;
+        }
+    }
+    FrameResources& resources = harness.resources();
+    resources.ensureTexture("depth", TextureFormat::R32F, kWidth, kHeight).uploadFloats(depth);
+    resources.ensureTexture("color", TextureFormat::RGBA16F, kWidth, kHeight).uploadFloats(color);
+    FrameContext frame = harness.context();
+    MinDepthPyramidPass(harness.sources()).execute(frame);
+    HiddenPointRemovalPass(harness.sources()).execute(frame);
+    const std::vector<float> flags = harness.resources().texture("visibility").readFloats();
+    const std::vector<double> pyramid = cpuPyramid(depth);
+    int ties = 0, farHidden = 0, farHiddenOnlyByTheProbe = 0;
+    for (int y = 0; y < kHeight; ++y) {
+        for (int x = 0; x < kWidth; ++x) {
+            const std::optional<bool> expected = cpuVisible(harness, pyramid, x, y, 1.0);
+            const std::optional<bool> withoutProbe =
+                cpuVisible(harness, pyramid, x, y, 1.0, nullptr, false);
+            if (!expected || !withoutProbe) {
+                ++ties;
+                continue;
+            }
+            EXPECT_EQ(flags[y * kWidth + x] > 0.5f, *expected) << x << "," << y;
+            if (depth[y * kWidth + x] > 10.0f && !*expected) {
+                ++farHidden;
+                farHiddenOnlyByTheProbe += *withoutProbe ? 1 : 0;
+            }
+        }
+    }
+    EXPECT_LT(ties, 5);  // ties are rare; many would mean the test checks little
+    // Most of the far surface is hidden (620 of its 845 pixels), 409 of them only because the walk
+    // reached the near surface's gaps (without that, the frame would not test the probe).
+    EXPECT_GT(farHidden, kWidth * kHeight / 2);
+    EXPECT_GT(farHiddenOnlyByTheProbe, 200);
 }
 
 /// The CPU twin of PullPush.glsl's pushedNormal on `pyramid` (complete on level l + 1, pulled on
