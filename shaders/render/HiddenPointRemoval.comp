@@ -52,7 +52,7 @@ const float kNearerOccluderLevels = 0.35;
 // Before the walk, the nearest depth in the 3x3 texels this many levels above its last one: a
 // surface in front whose points lie farther apart on screen than x's radius reaches (a close-up,
 // the eye a centimetre from a scan's flank) is never seen by the walk, so the rule above never
-// fires, and the back showed through in blocks (the bunny's range scans 5 cm from its centre:
+// fires, and the back showed through in blocks (the bunny's range scans 6 cm from its centre:
 // 16 % of the pixels). Where that depth is so much nearer that x's radius projected there
 // reaches kNearSurfaceLevels further (4 times nearer), the walk starts out to that level. A
 // surface only 2 times nearer is often an object beside x rather than over it, and walking that
