@@ -78,4 +78,16 @@ if [[ -f "$bunny" ]]; then
     side_by_side "$tmp/towards/view0_truth.png" "$tmp/blended/view0_surface.png" "$tmp/truth-blended.png"
     side_by_side "$tmp/truth-blended.png" "$tmp/towards/view0_surface.png" docs/images/outline-normals.png
 fi
+# A close-up of the bunny's range scans: the hidden point test before its probe for a surface
+# far in front (the shaders of commit 65482c0, which this binary still runs) and with it.
+scans="$data/bunny_scans_registered.ply"
+if [[ -f "$scans" ]]; then
+    git archive 65482c0 shaders | tar -x -C "$tmp"
+    for kind in before after; do
+        shaders=()
+        [[ $kind == before ]] && shaders=(env SUBSCAN_SHADER_DIR="$tmp/shaders")
+        "${shaders[@]}" build/src/subscan render "$scans" --mode surface --width 360 --height 360 --distance 0.06 -o "$tmp/front-$kind.png"
+    done
+    side_by_side "$tmp/front-before.png" "$tmp/front-after.png" docs/images/close-up-front.png
+fi
 ls -1 docs/images

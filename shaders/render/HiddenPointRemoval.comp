@@ -54,15 +54,16 @@ const float kNearerOccluderLevels = 0.35;
 // the eye a centimetre from a scan's flank) is never seen by the walk, so the rule above never
 // fires, and the back showed through in blocks (the bunny's range scans 6 cm from its centre:
 // 16 % of the pixels). Where that depth is so much nearer that x's radius projected there
-// reaches kNearSurfaceLevels further (4 times nearer), the walk starts out to that level. A
-// surface only 2 times nearer is often an object beside x rather than over it, and walking that
-// far beside it cost the station's views 0.02 dB (bench/README.md, "Hidden points behind a
-// close-up's sparse front").
+// reaches kNearSurfaceThresholdLevels beyond the walk's own last level (4 times nearer, where
+// that level is not clamped), the walk starts out to that level; its occluders are then asked
+// on that level, whose radius spans the near surface's gaps. A surface only 2 times nearer is
+// often an object beside x rather than over it, and walking that far beside it cost the
+// station's views 0.016 dB (bench/README.md, "Hidden points behind a close-up's sparse front").
 const uint kNearSurfaceProbeLevels = 2u;
-const float kNearSurfaceLevels = 2.0;
+const float kNearSurfaceThresholdLevels = 2.0;
 
 /// The level the walk must reach for a surface near x but much nearer the eye (above); 0 where
-/// the nearest depth in the probe's texels is not.
+/// the nearest depth in the probe's texels is not. x's own texel holds x, so that depth is finite.
 float nearSurfaceLevel(ivec2 pixel, float radius, float maxLevel) {
     uint probe = min(uint(maxLevel) + kNearSurfaceProbeLevels, levelCount() - 1u);
     LevelLayout place = levelLayout(probe);
@@ -73,8 +74,8 @@ float nearSurfaceLevel(ivec2 pixel, float radius, float maxLevel) {
             nearest = min(nearest, texelFetch(minDepthTexels, int(texelIndex(place, texel))).r);
         }
     }
-    float level = isinf(nearest) ? 0.0 : levelForRadius(radius, nearest);
-    return level >= maxLevel + kNearSurfaceLevels ? level : 0.0;
+    float level = levelForRadius(radius, nearest);
+    return level >= maxLevel + kNearSurfaceThresholdLevels ? level : 0.0;
 }
 
 bool visibleAt(ivec2 pixel, float depth) {
