@@ -107,6 +107,15 @@ PassHarness makeHarness(int stageLevel = 3, bool localSpacing = false,
     return harness;
 }
 
+/// Uploads the rasterizer's outputs the passes read: depth and colour (alpha: the local spacing
+/// ratio), `width` x `height`.
+void uploadDepthAndColor(PassHarness& harness, int width, int height,
+                         const std::vector<float>& depth, const std::vector<float>& color) {
+    FrameResources& resources = harness.resources();
+    resources.ensureTexture("depth", TextureFormat::R32F, width, height).uploadFloats(depth);
+    resources.ensureTexture("color", TextureFormat::RGBA16F, width, height).uploadFloats(color);
+}
+
 /// Depth: a curved surface at 4..6 with holes (+inf) and a few far "back" points showing
 /// through; colour random; alpha (the local spacing ratio) 1, or with `spacingRatios` random
 /// in 0.5..4.5 (sparser points search farther) and for half the pixels a random across-lines
@@ -145,9 +154,7 @@ void uploadInputs(PassHarness& harness, std::vector<float>& depth, std::vector<f
     if (spacingRatios) {
         harness.uploadAcrossAxes(axes);
     }
-    FrameResources& resources = harness.resources();
-    resources.ensureTexture("depth", TextureFormat::R32F, kWidth, kHeight).uploadFloats(depth);
-    resources.ensureTexture("color", TextureFormat::RGBA16F, kWidth, kHeight).uploadFloats(color);
+    uploadDepthAndColor(harness, kWidth, kHeight, depth, color);
 }
 
 std::vector<double> cpuPyramid(const std::vector<float>& depth) {
@@ -430,6 +437,14 @@ std::optional<bool> cpuVisible(const PassHarness& harness, const std::vector<dou
     return visible;
 }
 
+/// The hidden point test's flags for the uploaded frame (after the min-depth pyramid).
+std::vector<float> visibilityFlags(PassHarness& harness) {
+    FrameContext frame = harness.context();
+    MinDepthPyramidPass(harness.sources()).execute(frame);
+    HiddenPointRemovalPass(harness.sources()).execute(frame);
+    return harness.resources().texture("visibility").readFloats();
+}
+
 /// The reconstruction tests run twice: on the global spacing, and with per-pixel local spacing
 /// ratios (the parameter).
 class SurfacePassesSpacingGLTest : public ::testing::TestWithParam<bool> {};
@@ -443,10 +458,7 @@ TEST_P(SurfacePassesSpacingGLTest, HiddenPointRemovalFlagsMatchExceptTies) {
     PassHarness harness = makeHarness(3, GetParam());
     std::vector<float> depth, color;
     uploadInputs(harness, depth, color, GetParam());
-    FrameContext frame = harness.context();
-    MinDepthPyramidPass(harness.sources()).execute(frame);
-    HiddenPointRemovalPass(harness.sources()).execute(frame);
-    const std::vector<float> flags = harness.resources().texture("visibility").readFloats();
+    const std::vector<float> flags = visibilityFlags(harness);
     // The ratios as the GPU read them (RGBA16F).
     const std::vector<float> color16 = harness.resources().texture("color").readFloats();
     const std::vector<double> pyramid = cpuPyramid(depth);
@@ -493,13 +505,8 @@ TEST(SurfacePassesGLTest, HiddenPointRemovalReachesASparseSurfaceFarInFront) {
             color[4 * (y * kWidth + x) + 3] = 1.0f;
         }
     }
-    FrameResources& resources = harness.resources();
-    resources.ensureTexture("depth", TextureFormat::R32F, kWidth, kHeight).uploadFloats(depth);
-    resources.ensureTexture("color", TextureFormat::RGBA16F, kWidth, kHeight).uploadFloats(color);
-    FrameContext frame = harness.context();
-    MinDepthPyramidPass(harness.sources()).execute(frame);
-    HiddenPointRemovalPass(harness.sources()).execute(frame);
-    const std::vector<float> flags = harness.resources().texture("visibility").readFloats();
+    uploadDepthAndColor(harness, kWidth, kHeight, depth, color);
+    const std::vector<float> flags = visibilityFlags(harness);
     const std::vector<double> pyramid = cpuPyramid(depth);
     int ties = 0, farHidden = 0, farHiddenOnlyByTheProbe = 0;
     for (int y = 0; y < kHeight; ++y) {
@@ -1404,12 +1411,10 @@ TEST_P(SurfacePassesSpacingGLTest, FillRemovalOutlineMatchesItsCpuTwin) {
 /// spacing ratio) through the passes before it.
 std::vector<float> fillMaskOf(PassHarness& harness, int size, const std::vector<float>& depth,
                               const std::vector<float>& color) {
-    FrameResources& resources = harness.resources();
-    resources.ensureTexture("depth", TextureFormat::R32F, size, size).uploadFloats(depth);
-    resources.ensureTexture("color", TextureFormat::RGBA16F, size, size).uploadFloats(color);
+    uploadDepthAndColor(harness, size, size, depth, color);
     FrameContext frame = runPullPushPasses(harness);
     FillRemovalPass(harness.sources()).execute(frame);
-    return resources.texture("mask").readFloats();
+    return harness.resources().texture("mask").readFloats();
 }
 
 TEST(SurfacePassesGLTest, NothingBeyondTheHullOfSparsePointsIsFilled) {
@@ -1530,9 +1535,8 @@ TEST(SurfacePassesGLTest, HiddenPointsCloseABandTheVisibilityTestTookAway) {
                 }
             }
         }
+        uploadDepthAndColor(harness, kSize, kSize, depth, color);
         FrameResources& resources = harness.resources();
-        resources.ensureTexture("depth", TextureFormat::R32F, kSize, kSize).uploadFloats(depth);
-        resources.ensureTexture("color", TextureFormat::RGBA16F, kSize, kSize).uploadFloats(color);
         FrameContext frame = harness.context();
         MinDepthPyramidPass(harness.sources()).execute(frame);
         // The hidden point test's verdict, set here rather than run.
@@ -1588,13 +1592,11 @@ TEST(SurfacePassesGLTest, ScanLinesReachOnAcrossThemNotPastTheirEnds) {
             axes[y * kSize + x] = glm::vec2(-0.875f, 0.0f);
         }
     }
-    FrameResources& resources = harness.resources();
-    resources.ensureTexture("depth", TextureFormat::R32F, kSize, kSize).uploadFloats(depth);
-    resources.ensureTexture("color", TextureFormat::RGBA16F, kSize, kSize).uploadFloats(color);
+    uploadDepthAndColor(harness, kSize, kSize, depth, color);
     harness.uploadAcrossAxes(axes);
     FrameContext frame = runPullPushPasses(harness);
     FillRemovalPass(harness.sources()).execute(frame);
-    const std::vector<float> mask = resources.texture("mask").readFloats();
+    const std::vector<float> mask = harness.resources().texture("mask").readFloats();
     const auto surface = [&](int x, int y) { return mask[y * kSize + x] > 0.5f; };
     // The share of the expected gap beyond the outermost rows.
     const double reach =
