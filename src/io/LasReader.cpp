@@ -550,9 +550,11 @@ PointCloud readLas(std::span<const std::byte> file, ReadContext& context) {
     context.formatDetail = describe(header);
     std::vector<std::byte> storage;
     const std::span<const std::byte> records = pointRecords(file, header, context, storage);
-    // Decompression already reported the progress of a LAZ file; the record pass is quick.
-    ReadContext silent;
-    silent.keepFilePrecision = context.keepFilePrecision;
+    // Decompression already reported the progress of a LAZ file; the record pass is quick. It
+    // gets the caller's context without its progress, so that every option still reaches it
+    // (keepFilePrecision was once dropped by a context made afresh).
+    ReadContext silent = context;
+    silent.progress = nullptr;
     PointCloud cloud = lasRecordsToCloud(file, header, records, records,
                                          header.laszipRecord ? silent : context, context.warnings);
     context.reportProgress(1, 1);
